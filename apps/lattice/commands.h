@@ -1,0 +1,17 @@
+#pragma once
+// The `lattice` subcommands. Each adds its options to the app and returns the action that runs
+// when it is chosen; actions return the process exit code and report user errors by throwing
+// lat::InputError (exit code 2).
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace lat::cli {
+
+struct Command {
+    CLI::App* app = nullptr;
+    std::function<int()> run;
+};
+
+Command add_render_command(CLI::App& parent);
+
+}  // namespace lat::cli

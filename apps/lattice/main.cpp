@@ -1,0 +1,38 @@
+// `lattice`: one binary, several subcommands (render, rasterize, table1, compare, inspect).
+#include <cstdio>
+#include <exception>
+#include <new>
+#include <vector>
+
+#include "commands.h"
+#include "util/error.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"lattice: ray tracing with three-dimensional lattice textures"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "lattice 0.1.0");
+
+    std::vector<lat::cli::Command> commands;
+    commands.push_back(lat::cli::add_render_command(app));
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int code = app.exit(e);
+        return code == 0 ? 0 : 2;  // usage errors are user errors
+    }
+    try {
+        for (auto& c : commands)
+            if (c.app->parsed()) return c.run();
+    } catch (const lat::InputError& e) {
+        std::fprintf(stderr, "lattice: error: %s\n", e.what());
+        return 2;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "lattice: error: out of memory\n");
+        return 3;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "lattice: internal error: %s\n", e.what());
+        return 1;
+    }
+    return 2;
+}
