@@ -31,8 +31,8 @@ const MonomialTable& table() {
 
 // Coefficients of (o + t d)^n as a polynomial in t, for n = 0..4.
 void binomial_powers(double o, double d, double p[5][5]) {
-    for (auto& row : p)
-        for (double& v : row) v = 0.0;
+    for (int n = 0; n < 5; ++n)
+        for (int k = 0; k < 5; ++k) p[n][k] = 0.0;
     p[0][0] = 1.0;
     for (int n = 1; n <= 4; ++n)
         for (int k = 0; k <= n; ++k)
