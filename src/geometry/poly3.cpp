@@ -116,7 +116,8 @@ std::string Poly3::to_string() const {
         const auto e = exponents(n);
         const bool constant = e[0] + e[1] + e[2] == 0;
         double mag = std::abs(c);
-        out += out.empty() ? (c < 0 ? "-" : "") : (c < 0 ? " - " : " + ");
+        const char* sign = out.empty() ? (c < 0 ? "-" : "") : (c < 0 ? " - " : " + ");
+        out.append(sign);
         char buf[64];
         if (mag != 1.0 || constant) {
             std::snprintf(buf, sizeof buf, "%.17g", mag);
@@ -125,10 +126,13 @@ std::string Poly3::to_string() const {
         bool first = mag == 1.0 && !constant;
         for (int v = 0; v < 3; ++v) {
             if (e[static_cast<std::size_t>(v)] == 0) continue;
-            if (!first) out += "*";
+            if (!first) out.push_back('*');
             first = false;
-            out += names[v];
-            if (e[static_cast<std::size_t>(v)] > 1) out += "^" + std::to_string(e[static_cast<std::size_t>(v)]);
+            out.append(names[v]);
+            if (e[static_cast<std::size_t>(v)] > 1) {
+                out.push_back('^');
+                out.push_back(static_cast<char>('0' + e[static_cast<std::size_t>(v)]));
+            }
         }
     }
     return out.empty() ? "0" : out;
