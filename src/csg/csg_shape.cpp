@@ -1,0 +1,172 @@
+#include "csg/csg_shape.h"
+
+#include <cassert>
+#include <cmath>
+#include <deque>
+
+namespace lat {
+namespace {
+
+constexpr bool is_leaf_ref(int ref) { return ref < 0; }
+constexpr std::size_t leaf_of(int ref) { return static_cast<std::size_t>(-ref - 1); }
+
+bool apply(CsgOp op, bool a, bool b) {
+    switch (op) {
+        case CsgOp::kUnion: return a || b;
+        case CsgOp::kIntersection: return a && b;
+        case CsgOp::kDifference: return a && !b;
+    }
+    return false;
+}
+
+// Scratch lists per recursion depth, so that tracing a ray allocates nothing once warm.
+SpanList& scratch(int depth, int which) {
+    thread_local std::deque<SpanList> pool;  // a deque: growing it keeps references valid
+    const auto i = static_cast<std::size_t>(2 * depth + which);
+    if (pool.size() <= i) pool.resize(i + 1);
+    return pool[i];
+}
+
+}  // namespace
+
+void combine_spans(const SpanList& a, const SpanList& b, CsgOp op, SpanList& out) {
+    out.clear();
+    std::size_t i = 0, j = 0;
+    bool in_a = false, in_b = false, in_out = false;
+    // Each list alternates in/out crossings; walk both in order of t.
+    auto next_t = [](const SpanList& l, std::size_t k, bool inside) {
+        if (k >= l.size()) return kInfinity;
+        return inside ? l[k].out.t : l[k].in.t;
+    };
+    while (true) {
+        const double ta = next_t(a, i, in_a), tb = next_t(b, j, in_b);
+        const bool a_done = i >= a.size(), b_done = j >= b.size();
+        if (a_done && b_done) break;
+        Crossing c;
+        bool from_b;
+        if (!a_done && (b_done || ta <= tb)) {
+            c = in_a ? a[i].out : a[i].in;
+            if (in_a) ++i;
+            in_a = !in_a;
+            from_b = false;
+        } else {
+            c = in_b ? b[j].out : b[j].in;
+            if (in_b) ++j;
+            in_b = !in_b;
+            from_b = true;
+        }
+        const bool now = apply(op, in_a, in_b);
+        if (now == in_out) continue;
+        if (from_b && op == CsgOp::kDifference) c.leaf ^= Crossing::kFlipBit;
+        if (now) {
+            out.push_back({c, {kInfinity, 0, 0}});
+        } else if (c.t > out.back().in.t) {
+            out.back().out = c;
+        } else {
+            out.pop_back();  // zero-length span from coincident crossings
+        }
+        in_out = now;
+        if (!now && op != CsgOp::kUnion && (i >= a.size())) break;  // nothing more can start
+    }
+}
+
+int CsgShape::add_leaf(CsgLeaf leaf) {
+    const Bounds3 b = leaf.xf.bounds(leaf.shape->bounds());
+    leaves_.push_back({std::move(leaf), b});
+    return -static_cast<int>(leaves_.size());
+}
+
+int CsgShape::add_node(CsgOp op, std::vector<int> children) {
+    assert(!children.empty());
+    nodes_.push_back({op, std::move(children), {}});
+    return static_cast<int>(nodes_.size()) - 1;
+}
+
+void CsgShape::set_root(int ref) {
+    root_ = ref;
+    compute_bounds(root_);
+}
+
+Bounds3 CsgShape::compute_bounds(int ref) {
+    if (is_leaf_ref(ref)) return leaves_[leaf_of(ref)].bounds;
+    Node& n = nodes_[static_cast<std::size_t>(ref)];
+    Bounds3 b = compute_bounds(n.children[0]);
+    for (std::size_t k = 1; k < n.children.size(); ++k) {
+        const Bounds3 c = compute_bounds(n.children[k]);
+        if (n.op == CsgOp::kUnion) b = merge(b, c);
+        else if (n.op == CsgOp::kIntersection) b = lat::intersect(b, c);
+    }
+    n.bounds = b;
+    return b;
+}
+
+Bounds3 CsgShape::bounds() const {
+    return is_leaf_ref(root_) ? leaves_[leaf_of(root_)].bounds
+                              : nodes_[static_cast<std::size_t>(root_)].bounds;
+}
+
+void CsgShape::eval(int ref, const Ray& r, SpanList& out, int depth) const {
+    double t0 = -kInfinity, t1 = kInfinity;
+    if (is_leaf_ref(ref)) {
+        const std::size_t li = leaf_of(ref);
+        const Leaf& leaf = leaves_[li];
+        if (leaf.bounds.empty() || (leaf.bounds.finite() && !clip_ray(leaf.bounds, r, t0, t1)))
+            return;
+        const std::size_t first = out.size();
+        const Ray local = leaf.leaf.xf.is_identity() ? r : leaf.leaf.xf.inverse_ray(r);
+        leaf.leaf.shape->spans(local, out);
+        for (std::size_t k = first; k < out.size(); ++k) {
+            out[k].in.leaf = static_cast<std::uint32_t>(li);
+            out[k].out.leaf = static_cast<std::uint32_t>(li);
+        }
+        return;
+    }
+    const Node& n = nodes_[static_cast<std::size_t>(ref)];
+    if (n.bounds.empty() || !clip_ray(n.bounds, r, t0, t1)) return;
+    eval(n.children[0], r, out, depth + 1);
+    for (std::size_t k = 1; k < n.children.size(); ++k) {
+        if (out.empty() && n.op != CsgOp::kUnion) return;
+        SpanList& b = scratch(depth, 0);
+        b.clear();
+        eval(n.children[k], r, b, depth + 1);
+        if (b.empty() && n.op != CsgOp::kIntersection) continue;
+        SpanList& c = scratch(depth, 1);
+        combine_spans(out, b, n.op, c);
+        out.swap(c);
+    }
+}
+
+void CsgShape::spans(const Ray& r, SpanList& out) const {
+    SpanList& tmp = scratch(0, 0);
+    tmp.clear();
+    eval(root_, r, tmp, 1);
+    out.insert(out.end(), tmp.begin(), tmp.end());
+}
+
+bool CsgShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    SpanList& tmp = scratch(0, 1);
+    tmp.clear();
+    eval(root_, r, tmp, 1);
+    return first_crossing(tmp, tmin, tmax, hit);
+}
+
+Vec3 CsgShape::normal(const Ray& r, const Crossing& c) const {
+    const CsgLeaf& leaf = leaves_[c.leaf_index()].leaf;
+    const Ray local = leaf.xf.is_identity() ? r : leaf.xf.inverse_ray(r);
+    Vec3 n = leaf.shape->normal(local, {c.t, c.part, 0});
+    if (!leaf.xf.is_identity()) n = normalize(leaf.xf.normal(n));
+    return c.flipped() ? -n : n;
+}
+
+bool CsgShape::inside(int ref, Vec3 p) const {
+    if (is_leaf_ref(ref)) {
+        const CsgLeaf& leaf = leaves_[leaf_of(ref)].leaf;
+        return leaf.shape->inside(leaf.xf.is_identity() ? p : leaf.xf.inverse_point(p));
+    }
+    const Node& n = nodes_[static_cast<std::size_t>(ref)];
+    bool v = inside(n.children[0], p);
+    for (std::size_t k = 1; k < n.children.size(); ++k) v = apply(n.op, v, inside(n.children[k], p));
+    return v;
+}
+
+}  // namespace lat

@@ -1,0 +1,65 @@
+#pragma once
+// Constructive solid geometry (paper 3.1): a tree whose leaves are shapes and whose inner nodes
+// are union, intersection and difference. A ray is answered by merging the leaves' sorted
+// span lists bottom-up; surfaces of subtracted solids come back with their normals turned.
+#include <memory>
+#include <vector>
+
+#include "geometry/shape.h"
+#include "math/transform.h"
+
+namespace lat {
+
+enum class CsgOp { kUnion, kIntersection, kDifference };
+
+struct CsgLeaf {
+    std::shared_ptr<const Shape> shape;
+    Transform xf;           // leaf coordinates -> the CSG object's coordinates
+    std::uint32_t tag = 0;  // material of the leaf's surface
+};
+
+class CsgShape final : public Shape {
+public:
+    // Children are references returned by add_leaf / add_node. Nodes are n-ary: union and
+    // intersection of all children; difference is the first child minus all the others.
+    int add_leaf(CsgLeaf leaf);
+    int add_node(CsgOp op, std::vector<int> children);
+    // Ends construction; the tree must be non-empty.
+    void set_root(int ref);
+
+    std::size_t leaf_count() const { return leaves_.size(); }
+
+    Bounds3 bounds() const override;
+    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
+    void spans(const Ray& r, SpanList& out) const override;
+    Vec3 normal(const Ray& r, const Crossing& c) const override;
+    bool inside(Vec3 p) const override { return inside(root_, p); }
+    std::uint32_t tag(const Crossing& c, std::uint32_t) const override {
+        return leaves_[c.leaf_index()].leaf.tag;
+    }
+
+private:
+    struct Leaf {
+        CsgLeaf leaf;
+        Bounds3 bounds;  // in CSG coordinates
+    };
+    struct Node {
+        CsgOp op;
+        std::vector<int> children;
+        Bounds3 bounds;
+    };
+
+    std::vector<Leaf> leaves_;
+    std::vector<Node> nodes_;
+    int root_ = 0;
+
+    Bounds3 compute_bounds(int ref);
+    void eval(int ref, const Ray& r, SpanList& out, int depth) const;
+    bool inside(int ref, Vec3 p) const;
+};
+
+// out = a op b for sorted, disjoint span lists; boundaries that b contributes to a difference
+// get their flip bit toggled. Zero-length results are dropped.
+void combine_spans(const SpanList& a, const SpanList& b, CsgOp op, SpanList& out);
+
+}  // namespace lat

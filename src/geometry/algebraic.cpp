@@ -1,0 +1,97 @@
+#include "geometry/algebraic.h"
+
+#include <cmath>
+
+#include "geometry/quartic_solver.h"
+
+namespace lat {
+namespace {
+
+double horner(const double g[5], double u) {
+    return (((g[4] * u + g[3]) * u + g[2]) * u + g[1]) * u + g[0];
+}
+
+}  // namespace
+
+AlgebraicShape::AlgebraicShape(const Poly3& f, const Bounds3& bounds, Vec3 center)
+    : f_(f), bounds_(bounds), center_(center), degree_(f.degree()) {}
+
+bool AlgebraicShape::line_roots(const Ray& r, LineRoots& out) const {
+    out.count = 0;
+    const double len = length(r.d);
+    if (len == 0.0 || degree_ <= 0) return false;
+    const Vec3 dn = r.d / len;
+    double tb0 = -kInfinity, tb1 = kInfinity;
+    Vec3 c = center_;
+    if (bounds_.finite()) {
+        // Roots outside a bounded surface's box are rounding noise; the box also gives a centre.
+        const Bounds3 padded = expand(bounds_, 1e-9 * max_component(bounds_.extent()));
+        if (!clip_ray(padded, {r.o, dn}, tb0, tb1)) return false;
+        c = bounds_.center();
+    }
+    // Solve in u, the distance along the unit direction from the point nearest the centre.
+    const double shift = dot(c - r.o, dn);
+    f_.along_ray(r.o + dn * shift, dn, out.g);
+    double u[4];
+    int n = 0;
+    if (degree_ <= 2) {
+        n = solve_quadratic(out.g, u);
+    } else {
+        n = solve_quartic(out.g, u);
+    }
+    out.shift = shift;
+    out.scale = 1.0 / len;
+    for (int i = 0; i < n; ++i) {
+        const double s = shift + u[i];
+        if (s < tb0 || s > tb1) continue;
+        out.t[out.count++] = s / len;
+    }
+    return out.count > 0;
+}
+
+bool AlgebraicShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    LineRoots lr;
+    if (!line_roots(r, lr)) return false;
+    for (int i = 0; i < lr.count; ++i) {
+        if (lr.t[i] > tmin && lr.t[i] < tmax) {
+            hit = {lr.t[i], 0, 0};
+            return true;
+        }
+    }
+    return false;
+}
+
+void AlgebraicShape::spans(const Ray& r, SpanList& out) const {
+    LineRoots lr;
+    const bool any = line_roots(r, lr);
+    const double len = 1.0 / lr.scale;
+    auto inside_at = [&](double t) { return horner(lr.g, t * len - lr.shift) < 0.0; };
+    if (!any) {
+        // No crossing: the whole line is inside or outside (an unbounded solid may hold it).
+        if (!bounds_.finite() && degree_ > 0 && inside_at(0.0))
+            out.push_back({{-kInfinity, 0, 0}, {kInfinity, 0, 0}});
+        return;
+    }
+    // Classify the intervals between consecutive roots by the sign of g at their middles;
+    // a tangent (double) root has the same sign on both sides and merges away.
+    double start = -kInfinity;
+    const int n = lr.count;
+    bool in = inside_at(lr.t[0] - 1.0 - std::abs(lr.t[0]));
+    for (int i = 0; i < n; ++i) {
+        const bool after = i + 1 < n ? inside_at(0.5 * (lr.t[i] + lr.t[i + 1]))
+                                     : inside_at(lr.t[n - 1] + 1.0 + std::abs(lr.t[n - 1]));
+        if (!in && after) start = lr.t[i];
+        if (in && !after) out.push_back({{start, 0, 0}, {lr.t[i], 0, 0}});
+        in = after;
+    }
+    if (in) out.push_back({{start, 0, 0}, {kInfinity, 0, 0}});
+}
+
+Vec3 AlgebraicShape::normal(const Ray& r, const Crossing& c) const {
+    const Vec3 g = f_.gradient(r.at(c.t));
+    const double len = length(g);
+    // A singular point (cone apex): any normal facing the ray will do.
+    return len > 0.0 && std::isfinite(len) ? g / len : normalize(-r.d);
+}
+
+}  // namespace lat

@@ -1,0 +1,43 @@
+#pragma once
+// Surfaces f(x, y, z) = 0 of degree <= 4 (paper 3.2.1), f < 0 inside, intersected in closed
+// form: the ray is restricted to a univariate polynomial and solved by solve_quartic (or the
+// quadratic formula for quadrics). Normals are the normalised gradient.
+#include "geometry/poly3.h"
+#include "geometry/shape.h"
+
+namespace lat {
+
+class AlgebraicShape final : public Shape {
+public:
+    // bounds: a box known to hold the whole surface (infinite if unbounded); centre: a point
+    // near the surface, used to move the ray origin close before solving (the main source of
+    // accuracy for far-away rays).
+    AlgebraicShape(const Poly3& f, const Bounds3& bounds, Vec3 center);
+
+    const Poly3& polynomial() const { return f_; }
+    int degree() const { return degree_; }
+
+    Bounds3 bounds() const override { return bounds_; }
+    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
+    void spans(const Ray& r, SpanList& out) const override;
+    Vec3 normal(const Ray& r, const Crossing& c) const override;
+    bool inside(Vec3 p) const override { return f_.eval(p) <= 0.0; }
+
+    // The real roots of f along the ray's whole line, as ray parameters, ascending; also the
+    // univariate polynomial g(u) and the map t = (shift + u) * scale used, for sign tests.
+    struct LineRoots {
+        int count = 0;
+        double t[4] = {0, 0, 0, 0};
+        double g[5] = {0, 0, 0, 0, 0};
+        double shift = 0, scale = 1;
+    };
+    bool line_roots(const Ray& r, LineRoots& out) const;
+
+private:
+    Poly3 f_;
+    Bounds3 bounds_;
+    Vec3 center_;
+    int degree_;
+};
+
+}  // namespace lat

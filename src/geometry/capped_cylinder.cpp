@@ -1,0 +1,100 @@
+#include "geometry/capped_cylinder.h"
+
+#include <cassert>
+#include <cmath>
+
+namespace lat {
+
+CappedCylinderShape::CappedCylinderShape(Vec3 a, Vec3 b, double radius)
+    : a_(a), b_(b), len_(length(b - a)), r_(radius) {
+    assert(len_ > 0.0 && radius > 0.0);
+    axis_ = (b - a) / len_;
+}
+
+Bounds3 CappedCylinderShape::bounds() const {
+    // Exact box of the two end discs: per axis, the disc half-extent is r * sqrt(1 - a_i^2).
+    Vec3 e;
+    for (std::size_t i = 0; i < 3; ++i) e[i] = r_ * std::sqrt(std::max(0.0, 1.0 - axis_[i] * axis_[i]));
+    return {min(a_, b_) - e, max(a_, b_) + e};
+}
+
+bool CappedCylinderShape::solve(const Ray& r, Crossing& in, Crossing& out) const {
+    const Vec3 w = r.o - a_;
+    const double wa = dot(w, axis_), da = dot(r.d, axis_);
+    const Vec3 wp = w - axis_ * wa, dp = r.d - axis_ * da;
+
+    // Slab between the two end planes.
+    double s0 = -kInfinity, s1 = kInfinity;
+    std::uint32_t s0part = 1, s1part = 2;
+    if (da != 0.0) {
+        s0 = -wa / da;
+        s1 = (len_ - wa) / da;
+        if (s0 > s1) {
+            std::swap(s0, s1);
+            std::swap(s0part, s1part);
+        }
+    } else if (wa < 0.0 || wa > len_) {
+        return false;
+    }
+
+    // Infinite cylinder: |wp + t dp|^2 = r^2, solved in the stable closest-point form.
+    double c0 = -kInfinity, c1 = kInfinity;
+    const double A = length_squared(dp);
+    if (A > 0.0) {
+        const double b = -dot(wp, dp) / A;
+        const double disc = r_ * r_ - length_squared(wp + dp * b);
+        if (disc < 0.0) return false;
+        const double h = std::sqrt(disc / A);
+        const double c = (length_squared(wp) - r_ * r_) / A;
+        const double q = b + std::copysign(h, b);
+        if (q == 0.0) {
+            c0 = c1 = 0.0;
+        } else {
+            c0 = q;
+            c1 = c / q;
+            if (c0 > c1) std::swap(c0, c1);
+        }
+    } else if (length_squared(wp) > r_ * r_) {
+        return false;
+    }
+
+    in = c0 > s0 ? Crossing{c0, 0, 0} : Crossing{s0, s0part, 0};
+    out = c1 < s1 ? Crossing{c1, 0, 0} : Crossing{s1, s1part, 0};
+    return in.t < out.t;
+}
+
+bool CappedCylinderShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    Crossing in, out;
+    if (!solve(r, in, out)) return false;
+    if (in.t > tmin && in.t < tmax) {
+        hit = in;
+        return true;
+    }
+    if (out.t > tmin && out.t < tmax) {
+        hit = out;
+        return true;
+    }
+    return false;
+}
+
+void CappedCylinderShape::spans(const Ray& r, SpanList& spans) const {
+    Crossing in, out;
+    if (solve(r, in, out)) spans.push_back({in, out});
+}
+
+Vec3 CappedCylinderShape::normal(const Ray& r, const Crossing& c) const {
+    if (c.part == 1) return -axis_;
+    if (c.part == 2) return axis_;
+    const Vec3 w = r.at(c.t) - a_;
+    const Vec3 radial = w - axis_ * dot(w, axis_);
+    const double len = length(radial);
+    return len > 0.0 ? radial / len : normalize(-r.d);
+}
+
+bool CappedCylinderShape::inside(Vec3 p) const {
+    const Vec3 w = p - a_;
+    const double wa = dot(w, axis_);
+    return wa >= 0.0 && wa <= len_ && length_squared(w - axis_ * wa) <= r_ * r_;
+}
+
+}  // namespace lat

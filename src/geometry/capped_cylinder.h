@@ -1,0 +1,26 @@
+#pragma once
+#include "geometry/shape.h"
+
+namespace lat {
+
+// A finite cylinder of radius r whose axis runs from a to b, with flat ends.
+// Crossing::part: 0 the side, 1 the end at a, 2 the end at b.
+class CappedCylinderShape final : public Shape {
+public:
+    CappedCylinderShape(Vec3 a, Vec3 b, double radius);
+
+    Bounds3 bounds() const override;
+    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
+    void spans(const Ray& r, SpanList& out) const override;
+    Vec3 normal(const Ray& r, const Crossing& c) const override;
+    bool inside(Vec3 p) const override;
+
+    // The span of the ray's line inside the cylinder, if any (t0 < t1, parts as above).
+    bool solve(const Ray& r, Crossing& in, Crossing& out) const;
+
+private:
+    Vec3 a_, b_, axis_;  // axis_ is the unit vector from a to b
+    double len_, r_;
+};
+
+}  // namespace lat

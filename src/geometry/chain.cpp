@@ -1,0 +1,82 @@
+#include "geometry/chain.h"
+
+#include <algorithm>
+
+namespace lat {
+
+ChainShape::ChainShape(std::vector<ChainSphere> spheres, std::vector<ChainCylinder> cylinders)
+    : spheres_(std::move(spheres)), cylinders_(std::move(cylinders)) {
+    for (const ChainSphere& s : spheres_) sphere_parts_.emplace_back(s.center, s.radius);
+    for (const ChainCylinder& c : cylinders_)
+        cyl_parts_.emplace_back(spheres_[static_cast<std::size_t>(c.from)].center,
+                                spheres_[static_cast<std::size_t>(c.to)].center, c.radius);
+    for (std::size_t i = 0; i < primitive_count(); ++i) bounds_ = merge(bounds_, part(i).bounds());
+}
+
+const Shape& ChainShape::part(std::size_t i) const {
+    if (i < sphere_parts_.size()) return sphere_parts_[i];
+    return cyl_parts_[i - sphere_parts_.size()];
+}
+
+Bounds3 ChainShape::primitive_bounds(std::size_t i) const { return part(i).bounds(); }
+
+bool ChainShape::intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
+                                     Crossing& hit) const {
+    if (!part(i).intersect(r, tmin, tmax, hit)) return false;
+    hit.part = static_cast<std::uint32_t>(i << 2) | hit.part;
+    return true;
+}
+
+bool ChainShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    // From outside, the union's first crossing is the first crossing of any part.
+    bool found = false;
+    for (std::size_t i = 0; i < primitive_count(); ++i) {
+        if (intersect_primitive(i, r, tmin, tmax, hit)) {
+            tmax = hit.t;
+            found = true;
+        }
+    }
+    return found;
+}
+
+bool ChainShape::occluded(const Ray& r, double tmin, double tmax) const {
+    for (std::size_t i = 0; i < primitive_count(); ++i)
+        if (part(i).occluded(r, tmin, tmax)) return true;
+    return false;
+}
+
+void ChainShape::spans(const Ray& r, SpanList& out) const {
+    // Union of the parts' spans: sort by entry, then merge overlapping intervals.
+    const std::size_t first = out.size();
+    for (std::size_t i = 0; i < primitive_count(); ++i) {
+        const std::size_t before = out.size();
+        part(i).spans(r, out);
+        for (std::size_t k = before; k < out.size(); ++k) {
+            out[k].in.part = static_cast<std::uint32_t>(i << 2) | out[k].in.part;
+            out[k].out.part = static_cast<std::uint32_t>(i << 2) | out[k].out.part;
+        }
+    }
+    auto begin = out.begin() + static_cast<std::ptrdiff_t>(first);
+    std::sort(begin, out.end(), [](const Span& a, const Span& b) { return a.in.t < b.in.t; });
+    std::size_t w = first;
+    for (std::size_t k = first; k < out.size(); ++k) {
+        if (w > first && out[k].in.t <= out[w - 1].out.t) {
+            if (out[k].out.t > out[w - 1].out.t) out[w - 1].out = out[k].out;
+        } else {
+            out[w++] = out[k];
+        }
+    }
+    out.resize(w);
+}
+
+Vec3 ChainShape::normal(const Ray& r, const Crossing& c) const {
+    return part(c.part >> 2).normal(r, {c.t, c.part & 3u, 0});
+}
+
+bool ChainShape::inside(Vec3 p) const {
+    for (std::size_t i = 0; i < primitive_count(); ++i)
+        if (part(i).inside(p)) return true;
+    return false;
+}
+
+}  // namespace lat

@@ -1,0 +1,52 @@
+#pragma once
+// The paper's small primitive: spheres joined by flat-ended cylinders ("hair", "hook",
+// "thistle spike"), the solid being the union of all of them.
+#include <array>
+#include <vector>
+
+#include "geometry/capped_cylinder.h"
+#include "geometry/sphere.h"
+
+namespace lat {
+
+struct ChainSphere {
+    Vec3 center;
+    double radius;
+};
+struct ChainCylinder {
+    int from, to;  // sphere indices
+    double radius;
+};
+
+// Parts are numbered spheres first, then cylinders. Crossing::part = part << 2 | sub, where
+// sub is the cylinder's surface (0 side, 1 and 2 the ends) and 0 for spheres.
+class ChainShape final : public Shape {
+public:
+    ChainShape(std::vector<ChainSphere> spheres, std::vector<ChainCylinder> cylinders);
+
+    const std::vector<ChainSphere>& spheres() const { return spheres_; }
+    const std::vector<ChainCylinder>& cylinders() const { return cylinders_; }
+
+    Bounds3 bounds() const override { return bounds_; }
+    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
+    bool occluded(const Ray& r, double tmin, double tmax) const override;
+    void spans(const Ray& r, SpanList& out) const override;
+    Vec3 normal(const Ray& r, const Crossing& c) const override;
+    bool inside(Vec3 p) const override;
+
+    std::size_t primitive_count() const override { return sphere_parts_.size() + cyl_parts_.size(); }
+    Bounds3 primitive_bounds(std::size_t i) const override;
+    bool intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
+                             Crossing& hit) const override;
+
+private:
+    std::vector<ChainSphere> spheres_;
+    std::vector<ChainCylinder> cylinders_;
+    std::vector<SphereShape> sphere_parts_;
+    std::vector<CappedCylinderShape> cyl_parts_;
+    Bounds3 bounds_;
+
+    const Shape& part(std::size_t i) const;
+};
+
+}  // namespace lat

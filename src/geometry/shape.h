@@ -1,0 +1,78 @@
+#pragma once
+// The solid-shape interface: every leaf of the scene (quartic, sphere, sphere/cylinder chain,
+// later lattices) and every CSG tree implements it in its own coordinates.
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "math/bounds.h"
+#include "math/ray.h"
+
+namespace lat {
+
+// A point where a ray crosses a shape's boundary. `part` tells the shape which surface it was
+// (so the normal can be computed later, only for the hit that is shaded); `leaf` names the
+// CSG leaf, with kFlipBit set when the surface belongs to a subtracted solid.
+struct Crossing {
+    static constexpr std::uint32_t kFlipBit = 1u << 31;
+
+    double t = 0;
+    std::uint32_t part = 0;
+    std::uint32_t leaf = 0;
+
+    std::uint32_t leaf_index() const { return leaf & ~kFlipBit; }
+    bool flipped() const { return (leaf & kFlipBit) != 0; }
+};
+
+// One interval of a ray's line inside a solid: enters at in.t, leaves at out.t (in.t < out.t).
+// Unbounded solids give in.t = -infinity or out.t = +infinity.
+struct Span {
+    Crossing in, out;
+};
+using SpanList = std::vector<Span>;
+
+class Shape {
+public:
+    virtual ~Shape() = default;
+
+    // Bounds in the shape's coordinates; infinite for unbounded solids.
+    virtual Bounds3 bounds() const = 0;
+
+    // The closest boundary crossing with tmin < t < tmax.
+    virtual bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const = 0;
+    // Whether any boundary crossing has tmin < t < tmax (shadow rays).
+    virtual bool occluded(const Ray& r, double tmin, double tmax) const {
+        Crossing c;
+        return intersect(r, tmin, tmax, c);
+    }
+    // Appends the intervals of the whole line r.o + t r.d, t in (-inf, inf), inside the solid:
+    // sorted, disjoint and non-empty. Used by CSG.
+    virtual void spans(const Ray& r, SpanList& out) const = 0;
+    // Outward unit normal at a crossing this shape reported for ray r.
+    virtual Vec3 normal(const Ray& r, const Crossing& c) const = 0;
+    // The surface point of a crossing: on the ray for exact shapes; lattices return the point
+    // stored in their table, which lies near, not on, the ray.
+    virtual Vec3 position(const Ray& r, const Crossing& c) const { return r.at(c.t); }
+    // Whether p is inside the solid (boundary counts as either).
+    virtual bool inside(Vec3 p) const = 0;
+
+    // Shapes made of many parts (sphere/cylinder chains) expose them so the accelerator can
+    // build a hierarchy over them; by default the shape is one primitive.
+    virtual std::size_t primitive_count() const { return 1; }
+    virtual Bounds3 primitive_bounds(std::size_t) const { return bounds(); }
+    virtual bool intersect_primitive(std::size_t, const Ray& r, double tmin, double tmax,
+                                     Crossing& hit) const {
+        return intersect(r, tmin, tmax, hit);
+    }
+    virtual bool occluded_primitive(std::size_t, const Ray& r, double tmin, double tmax) const {
+        return occluded(r, tmin, tmax);
+    }
+
+    // CSG trees carry a material tag per leaf; other shapes answer with the fallback.
+    virtual std::uint32_t tag(const Crossing&, std::uint32_t fallback) const { return fallback; }
+};
+
+// The first crossing of a span list with tmin < t < tmax, if any.
+bool first_crossing(const SpanList& spans, double tmin, double tmax, Crossing& hit);
+
+}  // namespace lat

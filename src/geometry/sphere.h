@@ -1,0 +1,28 @@
+#pragma once
+#include "geometry/shape.h"
+
+namespace lat {
+
+class SphereShape final : public Shape {
+public:
+    SphereShape(Vec3 center, double radius) : c_(center), r_(radius) {}
+
+    Vec3 center() const { return c_; }
+    double radius() const { return r_; }
+
+    Bounds3 bounds() const override;
+    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
+    bool occluded(const Ray& r, double tmin, double tmax) const override;
+    void spans(const Ray& r, SpanList& out) const override;
+    Vec3 normal(const Ray& r, const Crossing& c) const override;
+    bool inside(Vec3 p) const override { return length_squared(p - c_) <= r_ * r_; }
+
+    // Both crossings t0 <= t1 of the ray's line, if it meets the sphere.
+    bool solve(const Ray& r, double& t0, double& t1) const;
+
+private:
+    Vec3 c_;
+    double r_;
+};
+
+}  // namespace lat

@@ -1,0 +1,25 @@
+#pragma once
+// The pinhole camera of the reference format (shared/reference/README.md): pixel (i, j), row 0
+// at the top, sample offset (sx, sy) in [0, 1) with (0.5, 0.5) the pixel centre.
+#include "math/ray.h"
+#include "scene/scene.h"
+
+namespace lat {
+
+class PinholeCamera {
+public:
+    explicit PinholeCamera(const Camera& c);
+
+    Ray ray(double i, double j, double sx = 0.5, double sy = 0.5) const {
+        const double px = (2.0 * (i + sx) / width_ - 1.0) * aspect_ * h_;
+        const double py = (1.0 - 2.0 * (j + sy) / height_) * h_;
+        return {eye_, normalize(w_ + u_ * px + v_ * py)};
+    }
+
+private:
+    Vec3 eye_, u_, v_, w_;
+    double h_, aspect_;
+    double width_, height_;
+};
+
+}  // namespace lat

@@ -1,0 +1,37 @@
+#include "render/render_scene.h"
+
+namespace lat {
+
+RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape)
+    : scene_(scene) {
+    shapes_.reserve(scene.objects.size());
+    for (const SceneObject& o : scene.objects) {
+        std::shared_ptr<const Shape> s = o.shape;
+        if (o.primitive >= 0 && instance_shape) s = instance_shape(o.primitive);
+        shapes_.push_back(std::move(s));
+    }
+    for (std::size_t i = 0; i < scene.objects.size(); ++i)
+        accel_objects_.push_back({shapes_[i].get(), &scene.objects[i].xf});
+    accel_ = std::make_unique<EmbreeAccel>(accel_objects_);
+}
+
+bool RenderScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const {
+    AccelHit h;
+    if (!accel_->intersect(r, tmin, tmax, h)) return false;
+    const SceneObject& o = scene_.objects[h.object];
+    const Shape& shape = *shapes_[h.object];
+    hit.t = h.t;
+    hit.object = h.object;
+    hit.material = shape.tag(h.crossing, o.material);
+    if (o.xf.is_identity()) {
+        hit.p = shape.position(r, h.crossing);
+        hit.n = shape.normal(r, h.crossing);
+    } else {
+        const Ray local = o.xf.inverse_ray(r);
+        hit.p = o.xf.point(shape.position(local, h.crossing));
+        hit.n = normalize(o.xf.normal(shape.normal(local, h.crossing)));
+    }
+    return true;
+}
+
+}  // namespace lat

@@ -1,0 +1,42 @@
+#pragma once
+// A scene made ready to trace: its objects' shapes behind the Embree accelerator, with the
+// closest-hit query (Intersect) and the cheaper any-hit query for shadow rays (Occluded).
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "accel/embree_accel.h"
+#include "scene/scene.h"
+
+namespace lat {
+
+struct SurfaceHit {
+    double t = 0;
+    Vec3 p;  // world position
+    Vec3 n;  // outward unit normal, world space
+    std::uint32_t material = 0;
+    std::uint32_t object = 0;
+};
+
+class RenderScene {
+public:
+    // `instance_shape`, when given, supplies the shape traced for instances of primitive i
+    // (e.g. its lattice); by default instances are traced exactly as their sphere/cylinder union.
+    using InstanceShapeFn = std::function<std::shared_ptr<const Shape>(int primitive)>;
+    explicit RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape = {});
+
+    bool intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const;
+    bool occluded(const Ray& r, double tmin, double tmax) const {
+        return accel_->occluded(r, tmin, tmax);
+    }
+
+    const Scene& scene() const { return scene_; }
+
+private:
+    const Scene& scene_;
+    std::vector<std::shared_ptr<const Shape>> shapes_;  // per object, as traced
+    std::vector<AccelObject> accel_objects_;
+    std::unique_ptr<EmbreeAccel> accel_;
+};
+
+}  // namespace lat

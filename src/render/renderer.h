@@ -1,0 +1,35 @@
+#pragma once
+// The tile renderer: oneTBB over image tiles on all cores. Every pixel depends only on its own
+// coordinates, so images are bit-identical for any thread count.
+#include <cstdint>
+#include <string>
+
+#include "io/image.h"
+#include "render/render_scene.h"
+
+namespace lat {
+
+struct RenderOptions {
+    int spp = 1;  // stratified samples per pixel; 1 is the pixel centre
+    bool progress = false;
+};
+
+struct RenderStats {
+    double render_ms = 0;
+    std::uint64_t primary_rays = 0;
+    std::uint64_t shadow_rays = 0;
+    int threads = 0;
+};
+
+struct RenderOutput {
+    ImageF radiance;  // mean of unclamped samples, for float formats
+    Image8 display;   // mean of clamped samples, as 8-bit
+    RenderStats stats;
+};
+
+RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt);
+
+// The sample grid for n samples: nx * ny = n with nx, ny as close as possible.
+void stratify(int n, int& nx, int& ny);
+
+}  // namespace lat

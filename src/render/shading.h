@@ -1,0 +1,20 @@
+#pragma once
+// Phong shading with shadows, exactly as shared/reference/README.md states it.
+#include <cstdint>
+
+#include "render/render_scene.h"
+
+namespace lat {
+
+struct ShadeCounters {
+    std::uint64_t shadow_rays = 0;
+};
+
+// Radiance (linear, unclamped) seen along `ray` at `hit`.
+Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters);
+
+// Start of shadow rays: far enough from the surface to skip its own crossing, which double
+// precision places within ~1e-12 relative of the true one, and small against any feature.
+double shadow_epsilon(Vec3 p);
+
+}  // namespace lat

@@ -1,0 +1,38 @@
+#pragma once
+// Reading the "objects" list: quartics by name, by coefficients or as text, instances of
+// primitives, and CSG trees over any of them.
+#include <map>
+#include <optional>
+#include <string>
+
+#include "csg/csg_shape.h"
+#include "scene/json_reader.h"
+#include "scene/scene.h"
+
+namespace lat {
+
+class ObjectParser {
+public:
+    ObjectParser(const std::map<std::string, std::uint32_t>& materials,
+                 const std::vector<Primitive>& primitives);
+
+    SceneObject parse(const JsonValue& v) const;
+
+private:
+    const std::map<std::string, std::uint32_t>& materials_;
+    const std::vector<Primitive>& primitives_;
+
+    std::uint32_t material(const JsonValue& v) const;
+    // A leaf's geometry in its own frame, with the placement that its parameters imply.
+    struct Leaf {
+        std::shared_ptr<const Shape> shape;
+        Transform placement;
+        int primitive = -1;
+    };
+    Leaf parse_leaf(const JsonValue& v, const std::string& type) const;
+    // Adds v's subtree to csg; `to_root` maps v's parent frame to the CSG root frame.
+    int add_csg(CsgShape& csg, const JsonValue& v, const Transform& to_root,
+                std::optional<std::uint32_t> override_material) const;
+};
+
+}  // namespace lat

@@ -1,0 +1,151 @@
+#include "scene/scene_loader.h"
+
+#include <cmath>
+#include <map>
+
+#include "scene/object_parser.h"
+#include "util/error.h"
+#include "util/file.h"
+
+namespace lat {
+namespace {
+
+constexpr int kMaxImageSide = 32768;
+
+Camera parse_camera(const JsonValue& v) {
+    v.allow_keys({"eye", "look_at", "up", "fov_y_deg", "width", "height"});
+    Camera c;
+    c.eye = v.at("eye").vec3();
+    c.look_at = v.at("look_at").vec3();
+    if (auto up = v.find("up")) c.up = up->direction();
+    const JsonValue fov = v.at("fov_y_deg");
+    c.fov_y_deg = fov.number();
+    if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180)) fov.fail("must be between 0 and 180 degrees");
+    for (const char* key : {"width", "height"}) {
+        const JsonValue s = v.at(key);
+        const int n = s.integer();
+        if (n < 1 || n > kMaxImageSide)
+            s.fail("must be between 1 and " + std::to_string(kMaxImageSide) + " pixels");
+        (key[0] == 'w' ? c.width : c.height) = n;
+    }
+    const Vec3 w = c.look_at - c.eye;
+    if (length_squared(w) == 0) v.fail("eye and look_at are the same point");
+    if (length_squared(cross(w, c.up)) <= 1e-12 * length_squared(w) * length_squared(c.up))
+        v.at("up").fail("up is parallel to the viewing direction");
+    return c;
+}
+
+Material parse_material(const JsonValue& v, const std::string& name) {
+    v.allow_keys({"color", "ka", "kd", "ks", "shininess"});
+    Material m;
+    m.name = name;
+    if (auto c = v.find("color")) m.color = c->colour();
+    if (auto x = v.find("ka")) m.ka = x->non_negative();
+    if (auto x = v.find("kd")) m.kd = x->non_negative();
+    if (auto x = v.find("ks")) m.ks = x->non_negative();
+    if (auto x = v.find("shininess")) m.shininess = x->non_negative();
+    return m;
+}
+
+}  // namespace
+
+Primitive parse_primitive(const JsonValue& v, const std::string& name) {
+    v.allow_keys({"spheres", "cylinders", "lattice"});
+    Primitive p;
+    p.name = name;
+    p.where = v.path();
+    std::vector<ChainSphere> spheres;
+    const JsonValue sv = v.at("spheres");
+    if (sv.size() == 0) sv.fail("a primitive needs at least one sphere");
+    for (std::size_t i = 0; i < sv.size(); ++i) {
+        const JsonValue s = sv[i];
+        if (!s.is_array() || s.size() != 4) s.fail("expected [x, y, z, radius]");
+        spheres.push_back({{s[0].number(), s[1].number(), s[2].number()}, s[3].positive()});
+    }
+    std::vector<ChainCylinder> cylinders;
+    if (auto cv = v.find("cylinders")) {
+        for (std::size_t i = 0; i < cv->size(); ++i) {
+            const JsonValue c = (*cv)[i];
+            if (!c.is_array() || c.size() != 3) c.fail("expected [sphere_i, sphere_j, radius]");
+            const int a = c[0].integer(), b = c[1].integer();
+            for (int k = 0; k < 2; ++k) {
+                const int idx = k == 0 ? a : b;
+                if (idx < 0 || idx >= static_cast<int>(spheres.size()))
+                    c[static_cast<std::size_t>(k)].fail(
+                        "sphere index " + std::to_string(idx) + " does not exist (the primitive has " +
+                        std::to_string(spheres.size()) + " spheres, numbered from 0)");
+            }
+            if (length_squared(spheres[static_cast<std::size_t>(a)].center -
+                               spheres[static_cast<std::size_t>(b)].center) == 0)
+                c.fail("the cylinder's two spheres have the same centre");
+            cylinders.push_back({a, b, c[2].positive()});
+        }
+    }
+    p.chain = std::make_shared<ChainShape>(std::move(spheres), std::move(cylinders));
+    if (auto lv = v.find("lattice")) {
+        lv->allow_keys({"sigma", "cells"});
+        LatticeSpec spec;
+        spec.sigma = lv->at("sigma").positive();
+        const JsonValue cells = lv->at("cells");
+        if (!cells.is_array() || cells.size() != 3) cells.fail("expected [nx, ny, nz]");
+        for (std::size_t a = 0; a < 3; ++a) {
+            const int n = cells[a].integer();
+            if (n < 1 || n > 4096) cells[a].fail("cell counts must be between 1 and 4096");
+            spec.cells[a] = n;
+        }
+        p.lattice = spec;
+    }
+    return p;
+}
+
+Scene load_scene_text(const std::string& text, const std::string& file) {
+    const nlohmann::json doc = parse_json_text(text, file);
+    const JsonValue root(doc, "", file);
+    if (!root.is_object()) root.fail("a scene file must hold a JSON object");
+    root.allow_keys({"format", "camera", "background", "ambient", "shadows", "lights",
+                     "materials", "primitives", "objects"});
+    Scene s;
+    s.file = file;
+    if (auto f = root.find("format")) {
+        s.format = f->string();
+        if (s.format != "lattice-reference/1" && s.format != "lattice/1")
+            f->fail("unknown format '" + s.format + "' (expected lattice/1 or lattice-reference/1)");
+    }
+    s.camera = parse_camera(root.at("camera"));
+    if (auto b = root.find("background")) s.background = b->colour();
+    if (auto a = root.find("ambient")) s.ambient = a->colour();
+    if (auto sh = root.find("shadows")) s.shadows = sh->boolean();
+    if (auto lights = root.find("lights")) {
+        for (std::size_t i = 0; i < lights->size(); ++i) {
+            const JsonValue l = (*lights)[i];
+            l.allow_keys({"position", "intensity"});
+            PointLight pl;
+            pl.position = l.at("position").vec3();
+            if (auto in = l.find("intensity")) pl.intensity = in->colour();
+            s.lights.push_back(pl);
+        }
+    }
+    std::map<std::string, std::uint32_t> material_index;
+    if (auto mats = root.find("materials")) {
+        if (!mats->is_object()) mats->fail("expected an object of named materials");
+        for (const std::string& name : mats->keys()) {
+            material_index[name] = static_cast<std::uint32_t>(s.materials.size());
+            s.materials.push_back(parse_material(mats->at(name), name));
+        }
+    }
+    if (auto prims = root.find("primitives")) {
+        if (!prims->is_object()) prims->fail("expected an object of named primitives");
+        for (const std::string& name : prims->keys())
+            s.primitives.push_back(parse_primitive(prims->at(name), name));
+    }
+    const JsonValue objects = root.at("objects");
+    const ObjectParser parser(material_index, s.primitives);
+    for (std::size_t i = 0; i < objects.size(); ++i) s.objects.push_back(parser.parse(objects[i]));
+    return s;
+}
+
+Scene load_scene(const std::string& path) {
+    return load_scene_text(read_text_file(path, "scene file"), path);
+}
+
+}  // namespace lat

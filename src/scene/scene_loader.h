@@ -1,0 +1,18 @@
+#pragma once
+// Reading scene files: "lattice/1" (docs/scene-format.md), a superset of the reference format
+// "lattice-reference/1". Every user error throws InputError naming the file and the place.
+#include <string>
+
+#include "scene/json_reader.h"
+#include "scene/scene.h"
+
+namespace lat {
+
+Scene load_scene(const std::string& path);
+Scene load_scene_text(const std::string& text, const std::string& file);
+
+// Parts of the loader that other readers (e.g. Table 1 files) reuse.
+Transform parse_transform(const JsonValue& v);
+Primitive parse_primitive(const JsonValue& v, const std::string& name);
+
+}  // namespace lat

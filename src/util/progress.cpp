@@ -1,0 +1,43 @@
+#include "util/progress.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+
+namespace lat {
+
+bool ProgressBar::stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
+
+ProgressBar::ProgressBar(std::string label, std::uint64_t total, bool enabled)
+    : label_(std::move(label)), total_(total == 0 ? 1 : total), enabled_(enabled) {
+    if (!enabled_) return;
+    thread_ = std::thread([this] {
+        while (!stop_.load()) {
+            draw(false);
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+    });
+}
+
+ProgressBar::~ProgressBar() { finish(); }
+
+void ProgressBar::finish() {
+    if (!enabled_ || stop_.exchange(true)) return;
+    thread_.join();
+    draw(true);
+}
+
+void ProgressBar::draw(bool final) const {
+    const double frac = final ? 1.0 : static_cast<double>(done_.load()) / static_cast<double>(total_);
+    constexpr int kWidth = 40;
+    const int filled = static_cast<int>(frac * kWidth);
+    char bar[kWidth + 1];
+    for (int i = 0; i < kWidth; ++i) bar[i] = i < filled ? '#' : '.';
+    bar[kWidth] = 0;
+    std::fprintf(stderr, "\r%s [%s] %3d%%%s", label_.c_str(), bar, static_cast<int>(frac * 100),
+                 final ? "\r\033[K" : "");
+    std::fflush(stderr);
+}
+
+}  // namespace lat

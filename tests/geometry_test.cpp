@@ -1,0 +1,148 @@
+// Leaf shapes against closed-form answers: spheres, flat-ended cylinders, chains, half-spaces.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "geometry/capped_cylinder.h"
+#include "geometry/chain.h"
+#include "geometry/halfspace.h"
+#include "geometry/sphere.h"
+#include "math/transform.h"
+
+namespace lat {
+namespace {
+
+TEST(Sphere, HitsFromOutsideAndInside) {
+    SphereShape s({1, 2, 3}, 2);
+    Crossing c;
+    ASSERT_TRUE(s.intersect({{1, 2, -10}, {0, 0, 1}}, 0, kInfinity, c));
+    EXPECT_DOUBLE_EQ(c.t, 11);
+    EXPECT_NEAR(length(s.normal({{1, 2, -10}, {0, 0, 1}}, c) - Vec3{0, 0, -1}), 0, 1e-15);
+    ASSERT_TRUE(s.intersect({{1, 2, 3}, {0, 0, 2}}, 0, kInfinity, c));  // from the centre
+    EXPECT_DOUBLE_EQ(c.t, 1);
+    EXPECT_FALSE(s.intersect({{1, 2, -10}, {0, 0, 1}}, 0, 10, c));
+    EXPECT_FALSE(s.intersect({{3.0001, 2, -10}, {0, 0, 1}}, 0, kInfinity, c));
+}
+
+TEST(Sphere, FarAwayRayIsAccurate) {
+    // From 1e6 away the naive quadratic loses ~6 digits; the stable form must not.
+    SphereShape s({0, 0, 0}, 1);
+    const Ray r{{0.5, 0, -1e6}, {0, 0, 1}};
+    Crossing c;
+    ASSERT_TRUE(s.intersect(r, 0, kInfinity, c));
+    EXPECT_NEAR(c.t, 1e6 - std::sqrt(0.75), 1e-9);
+}
+
+TEST(Sphere, SpansCoverTheChord) {
+    SphereShape s({0, 0, 0}, 1);
+    SpanList spans;
+    s.spans({{-5, 0, 0}, {1, 0, 0}}, spans);
+    ASSERT_EQ(spans.size(), 1u);
+    EXPECT_DOUBLE_EQ(spans[0].in.t, 4);
+    EXPECT_DOUBLE_EQ(spans[0].out.t, 6);
+}
+
+TEST(HalfSpace, SpansAndHits) {
+    HalfSpaceShape h({0, 0, 1}, {0, 0, 2});
+    SpanList spans;
+    h.spans({{0, 0, 5}, {0, 0, -1}}, spans);
+    ASSERT_EQ(spans.size(), 1u);
+    EXPECT_DOUBLE_EQ(spans[0].in.t, 4);
+    EXPECT_EQ(spans[0].out.t, kInfinity);
+    spans.clear();
+    h.spans({{0, 0, 0}, {1, 0, 0}}, spans);  // parallel, inside
+    ASSERT_EQ(spans.size(), 1u);
+    EXPECT_EQ(spans[0].in.t, -kInfinity);
+    spans.clear();
+    h.spans({{0, 0, 2}, {1, 0, 0}}, spans);  // parallel, outside
+    EXPECT_TRUE(spans.empty());
+    Crossing c;
+    EXPECT_TRUE(h.intersect({{0, 0, 5}, {0, 0, -1}}, 0, kInfinity, c));
+    EXPECT_DOUBLE_EQ(c.t, 4);
+    EXPECT_FALSE(h.intersect({{0, 0, 5}, {0, 0, 1}}, 0, kInfinity, c));
+}
+
+TEST(CappedCylinder, SideAndEnds) {
+    CappedCylinderShape cyl({0, 0, 0}, {0, 0, 10}, 1);
+    Crossing c;
+    // Side hit.
+    ASSERT_TRUE(cyl.intersect({{-5, 0, 5}, {1, 0, 0}}, 0, kInfinity, c));
+    EXPECT_DOUBLE_EQ(c.t, 4);
+    EXPECT_EQ(c.part, 0u);
+    EXPECT_NEAR(length(cyl.normal({{-5, 0, 5}, {1, 0, 0}}, c) - Vec3{-1, 0, 0}), 0, 1e-15);
+    // End hits, both ends, with axis normals.
+    ASSERT_TRUE(cyl.intersect({{0.5, 0, -3}, {0, 0, 1}}, 0, kInfinity, c));
+    EXPECT_DOUBLE_EQ(c.t, 3);
+    EXPECT_EQ(c.part, 1u);
+    EXPECT_EQ(cyl.normal({{0.5, 0, -3}, {0, 0, 1}}, c), (Vec3{0, 0, -1}));
+    ASSERT_TRUE(cyl.intersect({{0.5, 0, 13}, {0, 0, -1}}, 0, kInfinity, c));
+    EXPECT_DOUBLE_EQ(c.t, 3);
+    EXPECT_EQ(c.part, 2u);
+    // Misses past the ends (flat ends, no caps).
+    EXPECT_FALSE(cyl.intersect({{-5, 0, 10.5}, {1, 0, 0}}, 0, kInfinity, c));
+    EXPECT_FALSE(cyl.intersect({{1.01, 0, -3}, {0, 0, 1}}, 0, kInfinity, c));
+}
+
+TEST(CappedCylinder, BoundsAreTight) {
+    CappedCylinderShape cyl({0, 0, 0}, {3, 4, 0}, 1);
+    const Bounds3 b = cyl.bounds();
+    EXPECT_NEAR(b.lo.x, -0.8, 1e-12);
+    EXPECT_NEAR(b.hi.y, 4.6, 1e-12);
+    EXPECT_NEAR(b.hi.z, 1.0, 1e-12);
+}
+
+TEST(CappedCylinder, MatchesInsideTestOnRandomRays) {
+    // Every reported span's midpoint is inside, points just outside spans are outside.
+    CappedCylinderShape cyl({1, -1, 0.5}, {-2, 3, 4}, 0.7);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-6, 6);
+    int spans_seen = 0;
+    for (int n = 0; n < 20000; ++n) {
+        const Ray r{{u(rng), u(rng), u(rng)}, normalize(Vec3{u(rng), u(rng), u(rng)})};
+        SpanList spans;
+        cyl.spans(r, spans);
+        for (const Span& s : spans) {
+            ++spans_seen;
+            EXPECT_TRUE(cyl.inside(r.at(0.5 * (s.in.t + s.out.t))));
+            EXPECT_FALSE(cyl.inside(r.at(s.in.t - 1e-6)));
+            EXPECT_FALSE(cyl.inside(r.at(s.out.t + 1e-6)));
+        }
+        if (spans.empty()) {
+            // Sample the line: no point may be inside.
+            for (double t = -20; t <= 20; t += 0.05) ASSERT_FALSE(cyl.inside(r.at(t)));
+        }
+    }
+    EXPECT_GT(spans_seen, 1000);
+}
+
+TEST(Chain, UnionOfPartsMergesSpans) {
+    // Two spheres joined by a cylinder: a capsule along z from 0 to 4, radius 1.
+    ChainShape chain({{{0, 0, 0}, 1}, {{0, 0, 4}, 1}}, {{0, 1, 1}});
+    SpanList spans;
+    chain.spans({{0, 0, -10}, {0, 0, 1}}, spans);
+    ASSERT_EQ(spans.size(), 1u);
+    EXPECT_DOUBLE_EQ(spans[0].in.t, 9);
+    EXPECT_DOUBLE_EQ(spans[0].out.t, 15);
+    Crossing c;
+    ASSERT_TRUE(chain.intersect({{-10, 0, 2}, {1, 0, 0}}, 0, kInfinity, c));
+    EXPECT_DOUBLE_EQ(c.t, 9);
+    EXPECT_EQ(c.part >> 2, 2u);  // the cylinder, numbered after the two spheres
+    EXPECT_NEAR(length(chain.normal({{-10, 0, 2}, {1, 0, 0}}, c) - Vec3{-1, 0, 0}), 0, 1e-15);
+    EXPECT_EQ(chain.primitive_count(), 3u);
+    EXPECT_TRUE(chain.inside({0, 0, 4.9}));
+    EXPECT_FALSE(chain.inside({0.9, 0, 4.9}));
+}
+
+TEST(Transform, InverseAndNormals) {
+    const Transform t = Transform::translate({1, 2, 3}) * Transform::rotate({0, 0, 1}, 0.3) *
+                        Transform::scale({2, 1, 0.5});
+    const Vec3 p{0.3, -0.7, 1.1};
+    EXPECT_NEAR(length(t.inverse_point(t.point(p)) - p), 0, 1e-14);
+    // A normal stays perpendicular to a transformed tangent.
+    const Vec3 n{0, 0, 1}, tangent{1, 1, 0};
+    EXPECT_NEAR(dot(t.normal(n), t.vector(tangent)), 0, 1e-14);
+    EXPECT_FALSE(Transform::from_affine({Mat3::diagonal({1, 0, 1}), {}}).has_value());
+}
+
+}  // namespace
+}  // namespace lat
