@@ -17,7 +17,7 @@ struct Image8 {
     std::vector<std::uint8_t> rgb;  // row-major, row 0 at the top, 3 bytes per pixel
 };
 
-std::uint8_t to_byte(double c);  // round(255 * clamp(c, 0, 1))
+std::uint8_t to_byte(double c);  // round(255 * clamp(c, 0, 1)); NaN gives 0
 Image8 to_image8(const ImageF& img);
 
 // Writers go through a temporary file in the same directory and rename it into place, so a
@@ -25,14 +25,20 @@ Image8 to_image8(const ImageF& img);
 void write_png(const std::string& path, const Image8& img);
 void write_pfm(const std::string& path, const ImageF& img);
 void write_exr(const std::string& path, const ImageF& img);
+// Writes in the format image_format_for(path) names; PNG goes through to_image8.
+void write_image(const std::string& path, const ImageF& img);
 
-Image8 read_png(const std::string& path);  // any PNG colour type / bit depth, as 8-bit RGB
+// Any PNG colour type / bit depth, as 8-bit RGB. Samples are taken as stored (no gamma or colour
+// management), 16-bit ones scaled with rounding; alpha and tRNS transparency are dropped, not
+// composited. Missing, truncated or corrupt files throw InputError naming the path.
+Image8 read_png(const std::string& path);
 
 enum class ImageFormat { png, pfm, exr };
 // By extension (case-insensitive): .png, .pfm, .exr; throws InputError for anything else.
 ImageFormat image_format_for(const std::string& path);
 // Throws InputError if the file cannot be created there (missing directory, no permission,
-// a directory in the way), without leaving anything behind.
+// a directory in the way), without leaving anything behind. It creates and removes the same
+// temporary file the writers would use, so it checks exactly what they need.
 void check_writable(const std::string& path);
 
 }  // namespace lat
