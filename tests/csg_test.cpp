@@ -1,0 +1,132 @@
+// CSG: span-list merging by hand, and trees of real shapes against point-membership sampling.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+
+#include "csg/csg_shape.h"
+#include "geometry/halfspace.h"
+#include "geometry/named_shapes.h"
+#include "geometry/sphere.h"
+
+namespace lat {
+namespace {
+
+Span span(double a, double b, std::uint32_t leaf) { return {{a, 0, leaf}, {b, 0, leaf}}; }
+
+TEST(CsgMerge, UnionIntersectionDifference) {
+    const SpanList a{span(0, 2, 0), span(5, 7, 0)};
+    const SpanList b{span(1, 3, 1), span(6, 6.5, 1)};
+    SpanList out;
+    combine_spans(a, b, CsgOp::kUnion, out);
+    ASSERT_EQ(out.size(), 2u);
+    EXPECT_EQ(out[0].in.t, 0);
+    EXPECT_EQ(out[0].out.t, 3);
+    EXPECT_EQ(out[0].out.leaf, 1u);
+    EXPECT_EQ(out[1].in.t, 5);
+    EXPECT_EQ(out[1].out.t, 7);
+
+    combine_spans(a, b, CsgOp::kIntersection, out);
+    ASSERT_EQ(out.size(), 2u);
+    EXPECT_EQ(out[0].in.t, 1);
+    EXPECT_EQ(out[0].out.t, 2);
+    EXPECT_EQ(out[1].in.t, 6);
+    EXPECT_EQ(out[1].out.t, 6.5);
+
+    combine_spans(a, b, CsgOp::kDifference, out);
+    ASSERT_EQ(out.size(), 3u);
+    EXPECT_EQ(out[0].in.t, 0);
+    EXPECT_EQ(out[0].out.t, 1);
+    // The surface of the subtracted solid comes back flipped.
+    EXPECT_TRUE(out[0].out.flipped());
+    EXPECT_EQ(out[0].out.leaf_index(), 1u);
+    EXPECT_EQ(out[1].in.t, 5);
+    EXPECT_EQ(out[1].out.t, 6);
+    EXPECT_EQ(out[2].in.t, 6.5);
+    EXPECT_TRUE(out[2].in.flipped());
+    EXPECT_EQ(out[2].out.t, 7);
+    EXPECT_FALSE(out[2].out.flipped());
+}
+
+TEST(CsgMerge, InfiniteAndCoincidentSpans) {
+    const SpanList half{span(-kInfinity, 4, 0)};
+    const SpanList ball{span(2, 6, 1)};
+    SpanList out;
+    combine_spans(half, ball, CsgOp::kIntersection, out);
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(out[0].in.t, 2);
+    EXPECT_EQ(out[0].out.t, 4);
+    combine_spans(half, ball, CsgOp::kDifference, out);
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(out[0].in.t, -kInfinity);
+    EXPECT_EQ(out[0].out.t, 2);
+    // Touching spans subtract to nothing, not to a zero-length sliver.
+    const SpanList same{span(2, 4, 1)};
+    combine_spans(SpanList{span(2, 4, 0)}, same, CsgOp::kDifference, out);
+    EXPECT_TRUE(out.empty());
+}
+
+// Builds (sphere A - sphere B) intersected with a half-space, nested two levels deep.
+std::shared_ptr<CsgShape> sample_tree() {
+    auto csg = std::make_shared<CsgShape>();
+    const int a = csg->add_leaf({std::make_shared<SphereShape>(Vec3{0, 0, 0}, 1.0), {}, 1});
+    const int b = csg->add_leaf({std::make_shared<SphereShape>(Vec3{0.8, 0, 0}, 0.6), {}, 2});
+    const int h = csg->add_leaf({std::make_shared<HalfSpaceShape>(Vec3{0, 0, 0.5}, Vec3{0, 0, 1}),
+                                 {}, 3});
+    const int torus_leaf = [&] {
+        PlacedShape t = make_torus({0, 0, -0.2}, {1, 0, 0}, 0.7, 0.15);
+        return csg->add_leaf({t.shape, t.placement, 4});
+    }();
+    const int diff = csg->add_node(CsgOp::kDifference, {a, b});
+    const int cut = csg->add_node(CsgOp::kIntersection, {diff, h});
+    csg->set_root(csg->add_node(CsgOp::kUnion, {cut, torus_leaf}));
+    return csg;
+}
+
+TEST(CsgTree, SpansAgreeWithMembershipSampling) {
+    const auto csg = sample_tree();
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-2, 2);
+    int checked = 0;
+    for (int n = 0; n < 3000; ++n) {
+        const Ray r{{u(rng), u(rng), u(rng)}, normalize(Vec3{u(rng), u(rng), u(rng)})};
+        SpanList spans;
+        csg->spans(r, spans);
+        // Walk the line; membership must agree with the spans away from their ends.
+        for (double t = -6; t <= 6; t += 0.01) {
+            bool in_span = false, near_end = false;
+            for (const Span& s : spans) {
+                in_span = in_span || (t > s.in.t && t < s.out.t);
+                near_end = near_end || std::abs(t - s.in.t) < 1e-7 || std::abs(t - s.out.t) < 1e-7;
+            }
+            if (near_end) continue;
+            ASSERT_EQ(in_span, csg->inside(r.at(t))) << "ray " << n << " t " << t;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 100000);
+}
+
+TEST(CsgTree, SubtractedSurfaceNormalPointsOutOfTheResult) {
+    const auto csg = sample_tree();
+    // Along +x at y = z = 0: enter the big sphere at x = -1, leave the solid where the small
+    // sphere starts (x = 0.2); the normal there must point along +x (out of A - B).
+    const Ray r{{-3, 0, 0}, {1, 0, 0}};
+    Crossing c;
+    ASSERT_TRUE(csg->intersect(r, 2.5, kInfinity, c));
+    EXPECT_NEAR(c.t, 3.2, 1e-12);
+    EXPECT_TRUE(c.flipped());
+    EXPECT_EQ(csg->tag(c, 0), 2u);
+    EXPECT_NEAR(length(csg->normal(r, c) - Vec3{1, 0, 0}), 0, 1e-12);
+}
+
+TEST(CsgTree, BoundsFollowTheOperators) {
+    const auto csg = sample_tree();
+    const Bounds3 b = csg->bounds();
+    EXPECT_TRUE(b.finite());
+    EXPECT_NEAR(b.hi.z, 0.65, 1e-9);  // the torus reaches higher than the half-space cut
+    EXPECT_NEAR(b.lo.x, -1.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace lat
