@@ -6,7 +6,10 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numbers>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "geometry/name_suggestion.h"
@@ -29,10 +32,10 @@ struct Token {
     double value = 0.0;  // for numbers
 };
 
-inline void append(std::string& out, char c) {
+void append(std::string& out, char c) {
     out.push_back(c);
 }
-inline void append(std::string& out, std::string_view s) {
+void append(std::string& out, std::string_view s) {
     out.append(s);
 }
 
