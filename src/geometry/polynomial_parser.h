@@ -1,7 +1,7 @@
 #pragma once
 // Parses a polynomial in x, y, z written as text, e.g.
 //   "x^4 + y^4 + z^4 - 1"   or   "(x^2+y^2+z^2+R^2-r^2)^2 - 4*R^2*(x^2+y^2)"
-// with named constants. See docs/scene-format.md for the grammar.
+// with named constants. See docs/polynomial-syntax.md for the grammar.
 #include <map>
 #include <stdexcept>
 #include <string>
