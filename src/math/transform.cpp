@@ -84,12 +84,14 @@ Transform operator*(const Transform& a, const Transform& b) {
 }
 
 Bounds3 Transform::bounds(const Bounds3& b) const {
-    if (b.empty()) return b;
-    if (!b.finite()) return Bounds3::infinite();
-    // Arvo's method: per output axis, sum the extreme contributions of each input axis.
+    if (b.empty() || identity_) return b;
+    // Arvo's method: per output axis, sum the extreme contributions of each input axis. Zero
+    // entries are skipped so that half-infinite boxes (axis-aligned half-spaces) stay bounded
+    // where they can.
     Bounds3 out{fwd_.t, fwd_.t};
     for (std::size_t i = 0; i < 3; ++i) {
         for (std::size_t j = 0; j < 3; ++j) {
+            if (fwd_.m.r[i][j] == 0.0) continue;
             const double e = fwd_.m.r[i][j] * b.lo[j];
             const double f = fwd_.m.r[i][j] * b.hi[j];
             out.lo[i] += std::min(e, f);
