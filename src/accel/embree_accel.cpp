@@ -20,8 +20,8 @@ struct QueryContext {
     double tmin, tmax;
     AccelHit* hit;
     bool found = false;
-    // The last instance's object-space ray: consecutive parts of one instance reuse it.
-    unsigned cached_inst = RTC_INVALID_GEOMETRY_ID;
+    // The last object's object-space ray: consecutive parts of one object reuse it.
+    std::uint32_t cached_obj = ~0u;
     Ray cached_local;
 };
 
@@ -54,6 +54,11 @@ struct EmbreeAccel::Impl {
     std::vector<std::uint32_t> direct;       // primID -> object, for the top-level user geometry
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
     std::vector<std::uint32_t> inst_object;  // top-level geomID -> object, for instances
+    struct FlatPrim {
+        std::uint32_t object, part;
+    };
+    std::vector<FlatPrim> flat;  // parts of multi-part objects placed directly in world space
+    bool flatten = false;
     struct Prototype {
         const Shape* shape;
         RTCScene scene;
@@ -67,9 +72,9 @@ struct EmbreeAccel::Impl {
         if (device) rtcReleaseDevice(device);
     }
 
-    const Ray& local_ray(QueryContext* ctx, std::uint32_t obj, unsigned inst) const {
-        if (ctx->cached_inst != inst) {
-            ctx->cached_inst = inst;
+    const Ray& local_ray(QueryContext* ctx, std::uint32_t obj) const {
+        if (ctx->cached_obj != obj) {
+            ctx->cached_obj = obj;
             ctx->cached_local = objects[obj].xf->inverse_ray(ctx->ray);
         }
         return ctx->cached_local;
@@ -122,7 +127,7 @@ struct EmbreeAccel::Impl {
         const unsigned inst = args->context->instID[0];
         const std::uint32_t obj = self->inst_object[inst];
         const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
-        const Ray& local = self->local_ray(ctx, obj, inst);
+        const Ray& local = self->local_ray(ctx, obj);
         const double tmax = ctx->found ? ctx->hit->t : ctx->tmax;
         Crossing c;
         if (shape->intersect_primitive(args->primID, local, ctx->tmin, tmax, c))
@@ -136,11 +141,43 @@ struct EmbreeAccel::Impl {
         const Impl* self = ctx->accel;
         const unsigned inst = args->context->instID[0];
         const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
-        const Ray& local = self->local_ray(ctx, self->inst_object[inst], inst);
+        const Ray& local = self->local_ray(ctx, self->inst_object[inst]);
         if (shape->occluded_primitive(args->primID, local, ctx->tmin, ctx->tmax)) {
             ctx->found = true;
             reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
         }
+    }
+
+    static void flat_intersect(const RTCIntersectFunctionNArguments* args) {
+        if (!args->valid[0]) return;
+        auto* ctx = reinterpret_cast<QueryContext*>(args->context);
+        const Impl* self = ctx->accel;
+        const FlatPrim fp = self->flat[args->primID];
+        const Ray& local = self->local_ray(ctx, fp.object);
+        const double tmax = ctx->found ? ctx->hit->t : ctx->tmax;
+        Crossing c;
+        if (self->objects[fp.object].shape->intersect_primitive(fp.part, local, ctx->tmin, tmax, c))
+            self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), fp.object, c,
+                         args->geomID, args->primID, RTC_INVALID_GEOMETRY_ID);
+    }
+
+    static void flat_occluded(const RTCOccludedFunctionNArguments* args) {
+        if (!args->valid[0]) return;
+        auto* ctx = reinterpret_cast<QueryContext*>(args->context);
+        const Impl* self = ctx->accel;
+        const FlatPrim fp = self->flat[args->primID];
+        const Ray& local = self->local_ray(ctx, fp.object);
+        if (self->objects[fp.object].shape->occluded_primitive(fp.part, local, ctx->tmin, ctx->tmax)) {
+            ctx->found = true;
+            reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
+        }
+    }
+
+    static void bounds_flat(const RTCBoundsFunctionArguments* args) {
+        const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
+        const FlatPrim fp = self->flat[args->primID];
+        const AccelObject& o = self->objects[fp.object];
+        *args->bounds_o = to_rtc_bounds(o.shape->primitive_bounds(fp.part, *o.xf));
     }
 
     static void bounds_direct(const RTCBoundsFunctionArguments* args) {
@@ -178,7 +215,8 @@ static void on_embree_error(void* user, RTCError, const char* str) {
     static_cast<EmbreeAccel::Impl*>(user)->error = str ? str : "unknown Embree error";
 }
 
-EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects) : impl_(std::make_unique<Impl>()) {
+EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOptions& opt)
+    : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.objects.assign(objects.begin(), objects.end());
     m.device = rtcNewDevice(nullptr);
@@ -187,12 +225,20 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects) : impl_(std::make
     m.scene = rtcNewScene(m.device);
     rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_HIGH);
 
+    std::size_t parts = 0;
+    for (const AccelObject& o : m.objects)
+        if (o.shape->primitive_count() > 1) parts += o.shape->primitive_count();
+    m.flatten = opt.instancing == Instancing::kNever ||
+                (opt.instancing == Instancing::kAuto && parts <= opt.flatten_budget);
+
     for (std::uint32_t i = 0; i < m.objects.size(); ++i) {
         const AccelObject& o = m.objects[i];
         const Bounds3 wb = o.xf->bounds(o.shape->bounds());
         if (wb.empty()) continue;
         if (!wb.finite()) {
             m.unbounded.push_back(i);
+        } else if (o.shape->primitive_count() > 1 && m.flatten) {
+            for (std::uint32_t p = 0; p < o.shape->primitive_count(); ++p) m.flat.push_back({i, p});
         } else if (o.shape->primitive_count() > 1) {
             RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_INSTANCE);
             rtcSetGeometryInstancedScene(g, m.prototype_scene(o.shape));
@@ -224,11 +270,24 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects) : impl_(std::make
         rtcAttachGeometry(m.scene, g);
         rtcReleaseGeometry(g);
     }
+    if (!m.flat.empty()) {
+        RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(m.flat.size()));
+        rtcSetGeometryUserData(g, &m);
+        rtcSetGeometryBoundsFunction(g, Impl::bounds_flat, &m);
+        rtcSetGeometryIntersectFunction(g, Impl::flat_intersect);
+        rtcSetGeometryOccludedFunction(g, Impl::flat_occluded);
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(m.scene, g);
+        rtcReleaseGeometry(g);
+    }
     rtcCommitScene(m.scene);
     if (!m.error.empty()) throw std::runtime_error("Embree: " + m.error);
 }
 
 EmbreeAccel::~EmbreeAccel() = default;
+
+bool EmbreeAccel::flattened() const { return impl_->flatten; }
 
 bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hit) const {
     const Impl& m = *impl_;

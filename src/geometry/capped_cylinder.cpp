@@ -18,6 +18,18 @@ Bounds3 CappedCylinderShape::bounds() const {
     return {min(a_, b_) - e, max(a_, b_) + e};
 }
 
+Bounds3 CappedCylinderShape::placed_bounds(const Transform& xf) const {
+    // Each end disc maps to an ellipse with half-extent r sqrt(|row_i|^2 - (row_i . axis)^2).
+    const Affine& a = xf.forward();
+    Vec3 e;
+    for (std::size_t i = 0; i < 3; ++i) {
+        const double ra = dot(a.m.r[i], axis_);
+        e[i] = r_ * std::sqrt(std::max(0.0, length_squared(a.m.r[i]) - ra * ra));
+    }
+    const Vec3 pa = xf.point(a_), pb = xf.point(b_);
+    return {min(pa, pb) - e, max(pa, pb) + e};
+}
+
 bool CappedCylinderShape::solve(const Ray& r, Crossing& in, Crossing& out) const {
     const Vec3 w = r.o - a_;
     const double wa = dot(w, axis_), da = dot(r.d, axis_);

@@ -10,6 +10,7 @@ public:
     CappedCylinderShape(Vec3 a, Vec3 b, double radius);
 
     Bounds3 bounds() const override;
+    Bounds3 placed_bounds(const Transform& xf) const override;
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;

@@ -36,8 +36,14 @@ public:
 
     std::size_t primitive_count() const override { return sphere_parts_.size() + cyl_parts_.size(); }
     Bounds3 primitive_bounds(std::size_t i) const override;
+    Bounds3 primitive_bounds(std::size_t i, const Transform& xf) const override {
+        return part(i).placed_bounds(xf);
+    }
     bool intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
                              Crossing& hit) const override;
+    bool occluded_primitive(std::size_t i, const Ray& r, double tmin, double tmax) const override {
+        return part(i).occluded(r, tmin, tmax);
+    }
 
 private:
     std::vector<ChainSphere> spheres_;

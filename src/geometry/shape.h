@@ -7,6 +7,7 @@
 
 #include "math/bounds.h"
 #include "math/ray.h"
+#include "math/transform.h"
 
 namespace lat {
 
@@ -60,6 +61,13 @@ public:
     // build a hierarchy over them; by default the shape is one primitive.
     virtual std::size_t primitive_count() const { return 1; }
     virtual Bounds3 primitive_bounds(std::size_t) const { return bounds(); }
+    // The bounds of a primitive placed by xf.
+    virtual Bounds3 primitive_bounds(std::size_t, const Transform& xf) const {
+        return placed_bounds(xf);
+    }
+    // The bounds of the shape placed by xf; round shapes override this to be tighter than the
+    // box around the transformed box.
+    virtual Bounds3 placed_bounds(const Transform& xf) const { return xf.bounds(bounds()); }
     virtual bool intersect_primitive(std::size_t, const Ray& r, double tmin, double tmax,
                                      Crossing& hit) const {
         return intersect(r, tmin, tmax, hit);

@@ -9,6 +9,14 @@ Bounds3 SphereShape::bounds() const {
     return {c_ - e, c_ + e};
 }
 
+Bounds3 SphereShape::placed_bounds(const Transform& xf) const {
+    // An ellipsoid's half-extent along world axis i is r |row_i(M)|.
+    const Affine& a = xf.forward();
+    const Vec3 e{r_ * length(a.m.r[0]), r_ * length(a.m.r[1]), r_ * length(a.m.r[2])};
+    const Vec3 c = xf.point(c_);
+    return {c - e, c + e};
+}
+
 bool SphereShape::solve(const Ray& r, double& t0, double& t1) const {
     // Hearn & Baker's form: the discriminant from the squared distance of the line to the
     // centre, which stays accurate for far origins and grazing rays (Ray Tracing Gems, ch. 7).

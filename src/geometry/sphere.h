@@ -11,6 +11,7 @@ public:
     double radius() const { return r_; }
 
     Bounds3 bounds() const override;
+    Bounds3 placed_bounds(const Transform& xf) const override;
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     bool occluded(const Ray& r, double tmin, double tmax) const override;
     void spans(const Ray& r, SpanList& out) const override;

@@ -2,7 +2,8 @@
 
 namespace lat {
 
-RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape)
+RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape,
+                         const AccelOptions& accel)
     : scene_(scene) {
     shapes_.reserve(scene.objects.size());
     for (const SceneObject& o : scene.objects) {
@@ -12,7 +13,7 @@ RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_sha
     }
     for (std::size_t i = 0; i < scene.objects.size(); ++i)
         accel_objects_.push_back({shapes_[i].get(), &scene.objects[i].xf});
-    accel_ = std::make_unique<EmbreeAccel>(accel_objects_);
+    accel_ = std::make_unique<EmbreeAccel>(accel_objects_, accel);
 }
 
 bool RenderScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const {

@@ -23,7 +23,8 @@ public:
     // `instance_shape`, when given, supplies the shape traced for instances of primitive i
     // (e.g. its lattice); by default instances are traced exactly as their sphere/cylinder union.
     using InstanceShapeFn = std::function<std::shared_ptr<const Shape>(int primitive)>;
-    explicit RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape = {});
+    explicit RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape = {},
+                         const AccelOptions& accel = {});
 
     bool intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const;
     bool occluded(const Ray& r, double tmin, double tmax) const {
