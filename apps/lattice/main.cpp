@@ -17,9 +17,16 @@ int main(int argc, char** argv) {
 
     try {
         app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        const int code = app.exit(e);
-        return code == 0 ? 0 : 2;  // usage errors are user errors
+        // Usage errors are user errors: one line, exit code 2.
+        std::fprintf(stderr, "lattice: error: %s (see lattice --help)\n", e.what());
+        return 2;
     }
     try {
         for (auto& c : commands)

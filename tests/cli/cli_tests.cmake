@@ -1,0 +1,52 @@
+# Command-line tests: every class of bad input exits with 2, prints one message naming the file
+# and the place, and writes no image. Also: 1 and 2 threads give identical bytes.
+set(BAD ${CMAKE_CURRENT_SOURCE_DIR}/data/bad)
+set(CLI_OUT ${CMAKE_CURRENT_BINARY_DIR}/cli-out)
+file(MAKE_DIRECTORY ${CLI_OUT})
+
+function(lattice_cli_error name scene pattern)
+  add_test(NAME cli.${name}
+    COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;${scene};-o;${CLI_OUT}/${name}.png"
+            -DEXIT=2 "-DPATTERN=${pattern}" -DNO_FILE=${CLI_OUT}/${name}.png
+            -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+endfunction()
+
+lattice_cli_error(syntax_error ${BAD}/syntax-error.json "syntax-error.json:87:[0-9]+: invalid JSON")
+lattice_cli_error(wrong_type ${BAD}/wrong-type.json "wrong-type.json: objects\\[0\\]\\.radius: expected a number, found a string")
+lattice_cli_error(missing_field ${BAD}/missing-field.json "missing-field.json: objects\\[0\\]: missing field 'radius'")
+lattice_cli_error(unknown_material ${BAD}/unknown-material.json "objects\\[0\\]\\.material: unknown material 'blue'")
+lattice_cli_error(unknown_primitive ${BAD}/unknown-primitive.json "objects\\[2\\]\\.primitive: unknown primitive 'fur'")
+lattice_cli_error(unknown_type ${BAD}/unknown-type.json "objects\\[0\\]\\.type: unknown object type 'blob'")
+lattice_cli_error(singular_transform ${BAD}/singular-transform.json "objects\\[2\\]\\.transform: matrix is singular")
+lattice_cli_error(negative_radius ${BAD}/negative-radius.json "objects\\[0\\]\\.radius: must be positive, found -2")
+lattice_cli_error(bad_polynomial ${BAD}/bad-polynomial.json "objects\\[1\\]\\.polynomial: column 7: unexpected")
+lattice_cli_error(degree_five ${BAD}/degree-five.json "objects\\[1\\]\\.polynomial: .*degree 5")
+lattice_cli_error(missing_sphere ${BAD}/missing-sphere.json "primitives\\.hair\\.cylinders\\[0\\]\\[1\\]: sphere index 5 does not exist")
+lattice_cli_error(impossible_size ${BAD}/impossible-size.json "camera\\.width: must be between 1 and 32768")
+lattice_cli_error(missing_scene ${BAD}/no-such-file.json "no-such-file.json: cannot open scene file: No such file or directory")
+
+add_test(NAME cli.unwritable_output
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;${BAD}/good.json;-o;${CLI_OUT}/no/such/dir/x.png"
+          -DEXIT=2 "-DPATTERN=no/such/dir/x.png: cannot write" -DWORKDIR=${CLI_OUT}
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.unknown_extension
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;${BAD}/good.json;-o;${CLI_OUT}/x.jpg"
+          -DEXIT=2 "-DPATTERN=x.jpg: unsupported image format '.jpg'" -DNO_FILE=${CLI_OUT}/x.jpg
+          -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.usage_error
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--spp;0;${BAD}/good.json;-o;${CLI_OUT}/u.png"
+          -DEXIT=2 "-DPATTERN=--spp" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.good_scene_renders
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;-q;${BAD}/good.json;-o;${CLI_OUT}/good.png"
+          -DEXIT=0 -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+
+# Same bytes for 1 and 2 threads, through the real command line (PNG and PFM).
+set(P4 ${PROJECT_SOURCE_DIR}/examples/plate4-fuzzy-sphere-1000.json)
+foreach(n 1 2)
+  add_test(NAME cli.threads_${n}
+    COMMAND $<TARGET_FILE:lattice> render -q ${P4} -o ${CLI_OUT}/threads${n}.png --threads ${n})
+  set_tests_properties(cli.threads_${n} PROPERTIES FIXTURES_SETUP threads_${n})
+endforeach()
+add_test(NAME cli.threads_identical
+  COMMAND ${CMAKE_COMMAND} -E compare_files ${CLI_OUT}/threads1.png ${CLI_OUT}/threads2.png)
+set_tests_properties(cli.threads_identical PROPERTIES FIXTURES_REQUIRED "threads_1;threads_2")
