@@ -7,7 +7,7 @@ DEMO_SCENE ?= examples/demo-torus-cut.json
 DEMO_OUT ?= out/demo.png
 
 PACKAGES := cmake make g++ pkg-config libembree-dev libtbb-dev libpng-dev nlohmann-json3-dev \
-            libcli11-dev libopenexr-dev libgtest-dev libgmock-dev libbenchmark-dev
+            libcli11-dev libopenexr-dev libgtest-dev libgmock-dev libbenchmark-dev python3
 
 .PHONY: all deps configure build demo test bench clean format
 

@@ -54,8 +54,9 @@ bool CappedCylinderShape::solve(const Ray& r, Crossing& in, Crossing& out) const
     const double A = length_squared(dp);
     if (A > 0.0) {
         const double b = -dot(wp, dp) / A;
-        const double disc = r_ * r_ - length_squared(wp + dp * b);
-        if (disc < 0.0) return false;
+        double disc = r_ * r_ - length_squared(wp + dp * b);
+        if (disc < -kTouchTolerance * r_ * r_) return false;  // closed solid, as for spheres
+        disc = std::max(disc, 0.0);
         const double h = std::sqrt(disc / A);
         const double c = (length_squared(wp) - r_ * r_) / A;
         const double q = b + std::copysign(h, b);
@@ -72,7 +73,7 @@ bool CappedCylinderShape::solve(const Ray& r, Crossing& in, Crossing& out) const
 
     in = c0 > s0 ? Crossing{c0, 0, 0} : Crossing{s0, s0part, 0};
     out = c1 < s1 ? Crossing{c1, 0, 0} : Crossing{s1, s1part, 0};
-    return in.t < out.t;
+    return in.t <= out.t;  // equal: the ray touches the side or the rim of an end
 }
 
 bool CappedCylinderShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
@@ -91,7 +92,7 @@ bool CappedCylinderShape::intersect(const Ray& r, double tmin, double tmax, Cros
 
 void CappedCylinderShape::spans(const Ray& r, SpanList& spans) const {
     Crossing in, out;
-    if (solve(r, in, out)) spans.push_back({in, out});
+    if (solve(r, in, out) && in.t < out.t) spans.push_back({in, out});
 }
 
 Vec3 CappedCylinderShape::normal(const Ray& r, const Crossing& c) const {

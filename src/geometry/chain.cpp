@@ -1,6 +1,7 @@
 #include "geometry/chain.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace lat {
 
@@ -25,6 +26,23 @@ bool ChainShape::intersect_primitive(std::size_t i, const Ray& r, double tmin, d
     if (!part(i).intersect(r, tmin, tmax, hit)) return false;
     hit.part = static_cast<std::uint32_t>(i << 2) | hit.part;
     return true;
+}
+
+void ChainShape::primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
+    if (i < sphere_parts_.size()) {
+        out.push_back({sphere_parts_[i].center(), sphere_parts_[i].radius()});
+        return;
+    }
+    // A cylinder of length L and radius r as n slices of length L/n, each inside a sphere of
+    // radius sqrt(r^2 + (L/2n)^2); slices about as long as the diameter keep that near r.
+    const ChainCylinder& c = cylinders_[i - sphere_parts_.size()];
+    const Vec3 a = spheres_[static_cast<std::size_t>(c.from)].center;
+    const Vec3 b = spheres_[static_cast<std::size_t>(c.to)].center;
+    const double len = length(b - a);
+    const int n = std::max(1, static_cast<int>(std::ceil(len / (1.5 * c.radius))));
+    const double half = 0.5 * len / n;
+    const double rad = std::sqrt(c.radius * c.radius + half * half);
+    for (int k = 0; k < n; ++k) out.push_back({lerp(a, b, (k + 0.5) / n), rad});
 }
 
 bool ChainShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {

@@ -41,6 +41,7 @@ public:
     }
     bool intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
                              Crossing& hit) const override;
+    void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
     bool occluded_primitive(std::size_t i, const Ray& r, double tmin, double tmax) const override {
         return part(i).occluded(r, tmin, tmax);
     }

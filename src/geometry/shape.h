@@ -11,6 +11,15 @@
 
 namespace lat {
 
+// Relative slack (of r^2) with which a ray counts as touching a round surface, so that exact
+// tangencies (common on lattice grids) count as hits despite rounding.
+inline constexpr double kTouchTolerance = 1e-9;
+
+struct BoundingSphere {
+    Vec3 center;
+    double radius;
+};
+
 // A point where a ray crosses a shape's boundary. `part` tells the shape which surface it was
 // (so the normal can be computed later, only for the hit that is shaded); `leaf` names the
 // CSG leaf, with kFlipBit set when the surface belongs to a subtracted solid.
@@ -74,6 +83,13 @@ public:
     }
     virtual bool occluded_primitive(std::size_t, const Ray& r, double tmin, double tmax) const {
         return occluded(r, tmin, tmax);
+    }
+
+    // Spheres that together enclose primitive i (for culling by cones, as rasterization does);
+    // by default the sphere around its box. Long parts give several smaller spheres.
+    virtual void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
+        const Bounds3 b = primitive_bounds(i);
+        out.push_back({b.center(), 0.5 * length(b.extent())});
     }
 
     // CSG trees carry a material tag per leaf; other shapes answer with the fallback.

@@ -25,8 +25,11 @@ bool SphereShape::solve(const Ray& r, double& t0, double& t1) const {
     const Vec3 f = r.o - c_;
     const double b = -dot(f, r.d) / dd;  // parameter of the point closest to the centre
     const Vec3 perp = f + r.d * b;
-    const double disc = r_ * r_ - length_squared(perp);
-    if (disc < 0.0) return false;
+    // Solids are closed: a ray that touches the surface hits it (the paper's counts of Table 1
+    // depend on it); the tolerance absorbs the rounding of exact tangencies.
+    double disc = r_ * r_ - length_squared(perp);
+    if (disc < -kTouchTolerance * r_ * r_) return false;
+    disc = std::max(disc, 0.0);
     const double h = std::sqrt(disc / dd);
     // Stable pair: the larger-magnitude root directly, the other from the product c/a.
     const double c = (length_squared(f) - r_ * r_) / dd;

@@ -1,0 +1,66 @@
+#include "lattice/boundary_grid.h"
+
+#include <cassert>
+
+namespace lat {
+
+BoundaryGrid::BoundaryGrid(std::array<int, 3> cells) : n_(cells) {
+    assert(n_[0] >= 1 && n_[1] >= 1 && n_[2] >= 1);
+    full_ = static_cast<std::uint32_t>((n_[0] + 1) * (n_[1] + 1));
+    ring_ = static_cast<std::uint32_t>(2 * (n_[0] + 1) + 2 * (n_[1] - 1));
+    count_ = 2 * full_ + static_cast<std::uint32_t>(n_[2] - 1) * ring_;
+}
+
+// Layout: the z = 0 layer in full, then the rings of the inner layers, then z = nz in full.
+std::uint32_t BoundaryGrid::id(const GridPoint& p) const {
+    const auto nx = static_cast<std::uint32_t>(n_[0]), ny = static_cast<std::uint32_t>(n_[1]);
+    const auto x = static_cast<std::uint32_t>(p.x), y = static_cast<std::uint32_t>(p.y);
+    if (p.z == 0) return y * (nx + 1) + x;
+    if (p.z == n_[2]) return full_ + static_cast<std::uint32_t>(n_[2] - 1) * ring_ + y * (nx + 1) + x;
+    const std::uint32_t base = full_ + static_cast<std::uint32_t>(p.z - 1) * ring_;
+    if (y == 0) return base + x;
+    if (y == ny) return base + (nx + 1) + x;
+    assert(x == 0 || x == nx);
+    return base + 2 * (nx + 1) + 2 * (y - 1) + (x == 0 ? 0 : 1);
+}
+
+GridPoint BoundaryGrid::point(std::uint32_t id) const {
+    const auto nx = static_cast<std::uint32_t>(n_[0]), ny = static_cast<std::uint32_t>(n_[1]);
+    if (id < full_) return {static_cast<int>(id % (nx + 1)), static_cast<int>(id / (nx + 1)), 0};
+    id -= full_;
+    const std::uint32_t inner = static_cast<std::uint32_t>(n_[2] - 1) * ring_;
+    if (id >= inner) {
+        id -= inner;
+        return {static_cast<int>(id % (nx + 1)), static_cast<int>(id / (nx + 1)), n_[2]};
+    }
+    const int z = static_cast<int>(id / ring_) + 1;
+    std::uint32_t r = id % ring_;
+    if (r < nx + 1) return {static_cast<int>(r), 0, z};
+    r -= nx + 1;
+    if (r < nx + 1) return {static_cast<int>(r), static_cast<int>(ny), z};
+    r -= nx + 1;
+    return {(r & 1) ? static_cast<int>(nx) : 0, static_cast<int>(r / 2 + 1), z};
+}
+
+std::uint8_t BoundaryGrid::faces(const GridPoint& p) const {
+    std::uint8_t m = 0;
+    for (int a = 0; a < 3; ++a) {
+        if (p[a] == 0) m |= static_cast<std::uint8_t>(1u << (2 * a));
+        if (p[a] == n_[static_cast<std::size_t>(a)]) m |= static_cast<std::uint8_t>(1u << (2 * a + 1));
+    }
+    return m;
+}
+
+std::uint64_t BoundaryGrid::face_points(int face) const {
+    const int a = face_axis(face);
+    return static_cast<std::uint64_t>(n_[static_cast<std::size_t>((a + 1) % 3)] + 1) *
+           static_cast<std::uint64_t>(n_[static_cast<std::size_t>((a + 2) % 3)] + 1);
+}
+
+std::uint64_t BoundaryGrid::pairs_eq2() const {
+    // Paper eq. (2): 8 (xy yz + yz zx + zx xy) + 2 (xy² + yz² + zx²) = S² - sum of N_f².
+    const std::uint64_t yz = face_points(0), zx = face_points(2), xy = face_points(4);
+    return 8 * (xy * yz + yz * zx + zx * xy) + 2 * (xy * xy + yz * yz + zx * zx);
+}
+
+}  // namespace lat

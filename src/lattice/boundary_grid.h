@@ -1,0 +1,58 @@
+#pragma once
+// The grid points on the faces of a lattice box [0, nx] x [0, ny] x [0, nz] (lattice units:
+// one cell is sigma). Each distinct point gets a dense id; a point on an edge or corner lies on
+// two or three faces and still has one id. Faces are numbered 0..5: x = 0, x = nx, y = 0,
+// y = ny, z = 0, z = nz.
+#include <array>
+#include <cstdint>
+
+namespace lat {
+
+struct GridPoint {
+    int x = 0, y = 0, z = 0;
+    int operator[](int a) const { return a == 0 ? x : (a == 1 ? y : z); }
+    int& operator[](int a) { return a == 0 ? x : (a == 1 ? y : z); }
+    bool operator==(const GridPoint&) const = default;
+};
+
+class BoundaryGrid {
+public:
+    explicit BoundaryGrid(std::array<int, 3> cells);
+
+    const std::array<int, 3>& cells() const { return n_; }
+    std::uint32_t count() const { return count_; }
+
+    // Id of a point on the boundary (at least one coordinate at 0 or n).
+    std::uint32_t id(const GridPoint& p) const;
+    GridPoint point(std::uint32_t id) const;
+    // Bit f set when the point lies on face f.
+    std::uint8_t faces(const GridPoint& p) const;
+
+    static int face_axis(int face) { return face >> 1; }
+    static bool face_is_high(int face) { return (face & 1) != 0; }
+    // The face's plane coordinate along its axis.
+    int face_level(int face) const { return face_is_high(face) ? n_[face_axis(face)] : 0; }
+    // Points on face f: (n_u + 1) * (n_v + 1) with u = axis+1, v = axis+2 (mod 3).
+    std::uint64_t face_points(int face) const;
+    // Ordered pairs of face points on different faces, counted as the paper's eq. (2) does.
+    std::uint64_t pairs_eq2() const;
+
+    // A pair of boundary points can carry a ray through the lattice only if they are on
+    // different faces: not both on the same single face.
+    static bool valid_pair(std::uint8_t fa, std::uint8_t fb) {
+        const std::uint8_t u = fa | fb;
+        return (u & (u - 1)) != 0;
+    }
+    // How many (face of a, face of b) choices with different faces the pair stands for.
+    static int multiplicity(std::uint8_t fa, std::uint8_t fb) {
+        return __builtin_popcount(fa) * __builtin_popcount(fb) - __builtin_popcount(fa & fb);
+    }
+
+private:
+    std::array<int, 3> n_;
+    std::uint32_t full_ = 0;  // points in a full z layer, (nx+1)(ny+1)
+    std::uint32_t ring_ = 0;  // points in an inner z layer, 2(nx+1) + 2(ny-1)
+    std::uint32_t count_ = 0;
+};
+
+}  // namespace lat

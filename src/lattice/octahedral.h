@@ -1,0 +1,74 @@
+#pragma once
+// Unit vectors in two small integers by the octahedral map (Meyer et al. 2010; Cigolle et al.
+// 2014): the sphere is folded onto the octahedron |x|+|y|+|z| = 1 and flattened to a square.
+#include <cmath>
+#include <cstdint>
+
+#include "math/vec.h"
+
+namespace lat {
+
+struct Oct {
+    std::uint32_t u = 0, v = 0;  // each in [0, 2^bits - 1]
+};
+
+inline double sign_not_zero(double v) { return v >= 0 ? 1.0 : -1.0; }
+
+inline Oct oct_encode(Vec3 n, int bits) {
+    const double l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
+    double px = n.x / l1, py = n.y / l1;
+    if (n.z < 0) {
+        const double ox = (1 - std::abs(py)) * sign_not_zero(px);
+        const double oy = (1 - std::abs(px)) * sign_not_zero(py);
+        px = ox;
+        py = oy;
+    }
+    const double scale = static_cast<double>((1u << bits) - 1);
+    return {static_cast<std::uint32_t>(std::lround((px * 0.5 + 0.5) * scale)),
+            static_cast<std::uint32_t>(std::lround((py * 0.5 + 0.5) * scale))};
+}
+
+inline Vec3 oct_decode(Oct o, int bits) {
+    const double scale = static_cast<double>((1u << bits) - 1);
+    const double px = o.u / scale * 2 - 1, py = o.v / scale * 2 - 1;
+    Vec3 n{px, py, 1 - std::abs(px) - std::abs(py)};
+    if (n.z < 0) {
+        const double ox = (1 - std::abs(n.y)) * sign_not_zero(n.x);
+        const double oy = (1 - std::abs(n.x)) * sign_not_zero(n.y);
+        n.x = ox;
+        n.y = oy;
+    }
+    return normalize(n);
+}
+
+// The code among the four nearest grid points that decodes closest to n: the rounding above
+// is not optimal on the folded map, and this halves the worst angle error for the same bits.
+inline Oct oct_encode_precise(Vec3 n, int bits) {
+    const Oct r = oct_encode(n, bits);
+    const double l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
+    double px = n.x / l1, py = n.y / l1;
+    if (n.z < 0) {
+        const double ox = (1 - std::abs(py)) * sign_not_zero(px);
+        const double oy = (1 - std::abs(px)) * sign_not_zero(py);
+        px = ox;
+        py = oy;
+    }
+    const double scale = static_cast<double>((1u << bits) - 1);
+    const auto u0 = static_cast<std::uint32_t>(std::floor((px * 0.5 + 0.5) * scale));
+    const auto v0 = static_cast<std::uint32_t>(std::floor((py * 0.5 + 0.5) * scale));
+    Oct best = r;
+    double best_dot = dot(oct_decode(r, bits), n);
+    const std::uint32_t top = (1u << bits) - 1;
+    for (std::uint32_t du = 0; du < 2; ++du)
+        for (std::uint32_t dv = 0; dv < 2; ++dv) {
+            const Oct c{std::min(u0 + du, top), std::min(v0 + dv, top)};
+            const double d = dot(oct_decode(c, bits), n);
+            if (d > best_dot) {
+                best_dot = d;
+                best = c;
+            }
+        }
+    return best;
+}
+
+}  // namespace lat

@@ -1,0 +1,39 @@
+#pragma once
+// Rasterization (paper 2.1): for every ordered pair (p_i, p_o) of grid points on different
+// faces of the lattice box, the intersection of the segment p_i -> p_o with the primitive that
+// is closest to p_i. Parallel over entry points; the result does not depend on thread count.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "geometry/shape.h"
+#include "lattice/table.h"
+
+namespace lat {
+
+struct LatticeGrid {
+    std::array<int, 3> cells{1, 1, 1};  // at the chosen refinement
+    double cell = 1;                    // cell size in the primitive's units (sigma / K)
+};
+
+struct RasterizeOptions {
+    bool keep_hits = true;  // false: only count (Table 1)
+    bool progress = false;
+};
+
+struct RasterizeResult {
+    LatticeGrid grid;
+    std::uint64_t pairs_eq2 = 0;         // N_lp by the paper's eq. (2)
+    std::uint64_t pairs_enumerated = 0;  // N_lp by enumeration, counted as eq. (2) counts
+    std::uint64_t pairs_traced = 0;      // distinct (p_i, p_o) segments considered
+    std::uint64_t hits = 0;              // distinct segments that hit (table entries)
+    std::uint64_t hits_counted = 0;      // N_ix, counted as the paper counts N_lp
+    std::uint64_t tests = 0;             // exact segment-part tests performed
+    double seconds = 0;
+    std::vector<RawHit> raw;  // sorted by (a, b) when keep_hits
+};
+
+RasterizeResult rasterize(const Shape& primitive, const LatticeGrid& grid,
+                          const RasterizeOptions& opt = {});
+
+}  // namespace lat

@@ -1,0 +1,39 @@
+#pragma once
+// The Lattice Hash Table interface (paper 2.3): for an ordered pair (p_i, p_o) of boundary grid
+// points, the intersection closest to p_i of the segment p_i -> p_o with the primitive, if any.
+// The renderer only sees this interface; encodings (the paper's 14-byte hash table, and others
+// later) live behind it.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "math/vec.h"
+
+namespace lat {
+
+struct TableHit {
+    double t = 0;  // the hit is p_i + t (p_o - p_i), 0 <= t <= 1
+    Vec3 normal;   // unit outward normal, lattice (= primitive) orientation
+};
+
+// One rasterized intersection, before encoding: what every encoding is built from.
+struct RawHit {
+    std::uint32_t a = 0, b = 0;  // boundary point ids of p_i and p_o
+    float t = 0;
+    std::uint16_t nu = 0, nv = 0;  // octahedral normal, 16 bits each
+};
+inline constexpr int kRawNormalBits = 16;
+
+class LatticeTable {
+public:
+    virtual ~LatticeTable() = default;
+
+    virtual bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const = 0;
+
+    virtual std::string encoding() const = 0;
+    // Stored hits, and every byte the table occupies (payload, indices, headers).
+    virtual std::uint64_t entries() const = 0;
+    virtual std::uint64_t bytes() const = 0;
+};
+
+}  // namespace lat
