@@ -63,6 +63,9 @@ public:
     // The surface point of a crossing: on the ray for exact shapes; lattices return the point
     // stored in their table, which lies near, not on, the ray.
     virtual Vec3 position(const Ray& r, const Crossing& c) const { return r.at(c.t); }
+    // Shadow rays leaving a surface point of this shape ignore this shape's crossings closer
+    // than this (object units): zero for exact shapes, the table error for lattices.
+    virtual double surface_tolerance() const { return 0.0; }
     // Whether p is inside the solid (boundary counts as either).
     virtual bool inside(Vec3 p) const = 0;
 

@@ -1,0 +1,125 @@
+#include "lattice/lattice_shape.h"
+
+#include <cmath>
+
+namespace lat {
+
+LatticeShape::LatticeShape(std::shared_ptr<const LatticeTable> table, std::array<int, 3> cells,
+                           double cell)
+    : table_(std::move(table)),
+      grid_(cells),
+      cell_(cell),
+      box_{{0, 0, 0}, Vec3{double(cells[0]), double(cells[1]), double(cells[2])} * cell} {}
+
+bool LatticeShape::snap(const Ray& r, std::uint32_t& a, std::uint32_t& b, GridPoint& pa,
+                        GridPoint& pb) const {
+    const Vec3 o = r.o / cell_, d = r.d / cell_;
+    const auto& n = grid_.cells();
+    double t0 = -kInfinity, t1 = kInfinity;
+    int ax0 = -1, ax1 = -1;
+    for (int k = 0; k < 3; ++k) {
+        const auto uk = static_cast<std::size_t>(k);
+        if (d[uk] == 0) {
+            if (o[uk] < 0 || o[uk] > n[uk]) return false;
+            continue;
+        }
+        double tn = -o[uk] / d[uk], tf = (n[uk] - o[uk]) / d[uk];
+        if (tn > tf) std::swap(tn, tf);
+        if (tn > t0) t0 = tn, ax0 = k;
+        if (tf < t1) t1 = tf, ax1 = k;
+    }
+    if (!(t0 <= t1) || ax0 < 0 || ax1 < 0) return false;
+    // Round the entry and exit points to the nearest grid points on their faces.
+    auto on_face = [&](double t, int axis, bool high) {
+        GridPoint g;
+        const Vec3 x = o + d * t;
+        for (int k = 0; k < 3; ++k) {
+            const auto uk = static_cast<std::size_t>(k);
+            g[k] = k == axis ? (high ? n[uk] : 0)
+                             : static_cast<int>(std::clamp(std::nearbyint(x[uk]), 0.0, double(n[uk])));
+        }
+        return g;
+    };
+    pa = on_face(t0, ax0, d[static_cast<std::size_t>(ax0)] < 0);
+    pb = on_face(t1, ax1, d[static_cast<std::size_t>(ax1)] > 0);
+    a = grid_.id(pa);
+    b = grid_.id(pb);
+    return a != b;
+}
+
+namespace {
+
+Vec3 to_vec(const GridPoint& g) { return {double(g.x), double(g.y), double(g.z)}; }
+
+}  // namespace
+
+LatticeShape::LineHits LatticeShape::line_hits(const Ray& r) const {
+    LineHits lh;
+    std::uint32_t a, b;
+    GridPoint pa, pb;
+    if (!snap(r, a, b, pa, pb)) return lh;
+    TableHit fwd, rev;
+    if (!table_->lookup(a, b, fwd)) return lh;
+    const Vec3 va = to_vec(pa), vb = to_vec(pb);
+    const Vec3 o = r.o / cell_, d = r.d / cell_;
+    const double dd = dot(d, d);
+    const Vec3 pf = lerp(va, vb, fwd.t);
+    lh.hit = true;
+    lh.t_first = dot(pf - o, d) / dd;
+    lh.p_first = pf * cell_;
+    lh.n_first = fwd.normal;
+    if (table_->lookup(b, a, rev)) {
+        const Vec3 pl = lerp(vb, va, rev.t);
+        lh.t_last = std::max(lh.t_first, dot(pl - o, d) / dd);
+        lh.p_last = pl * cell_;
+        lh.n_last = rev.normal;
+    } else {  // only from a table built with a different closed-ness convention
+        lh.t_last = lh.t_first;
+        lh.p_last = lh.p_first;
+        lh.n_last = -lh.n_first;
+    }
+    return lh;
+}
+
+bool LatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    const LineHits lh = line_hits(r);
+    if (!lh.hit) return false;
+    if (lh.t_first > tmin && lh.t_first < tmax) {
+        hit = {lh.t_first, 0, 0};
+        return true;
+    }
+    if (lh.t_last > tmin && lh.t_last < tmax) {
+        hit = {lh.t_last, 1, 0};
+        return true;
+    }
+    return false;
+}
+
+bool LatticeShape::occluded(const Ray& r, double tmin, double tmax) const {
+    // The table knows the line's first and last crossings; between them it counts as solid.
+    const LineHits lh = line_hits(r);
+    return lh.hit && lh.t_last > tmin && lh.t_first < tmax;
+}
+
+void LatticeShape::spans(const Ray& r, SpanList& out) const {
+    const LineHits lh = line_hits(r);
+    if (lh.hit && lh.t_first < lh.t_last) out.push_back({{lh.t_first, 0, 0}, {lh.t_last, 1, 0}});
+}
+
+Vec3 LatticeShape::normal(const Ray& r, const Crossing& c) const {
+    const LineHits lh = line_hits(r);
+    return c.part == 0 ? lh.n_first : lh.n_last;
+}
+
+Vec3 LatticeShape::position(const Ray& r, const Crossing& c) const {
+    const LineHits lh = line_hits(r);
+    return c.part == 0 ? lh.p_first : lh.p_last;
+}
+
+bool LatticeShape::inside(Vec3 p) const {
+    // As the table sees it: p lies between the first and last crossing of the vertical line.
+    const LineHits lh = line_hits({p, {0, 0, 1}});
+    return lh.hit && lh.t_first <= 0 && lh.t_last >= 0;
+}
+
+}  // namespace lat

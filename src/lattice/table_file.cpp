@@ -1,0 +1,219 @@
+#include "lattice/table_file.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <bit>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+#include "lattice/hash14_table.h"
+#include "util/error.h"
+#include "util/hash.h"
+
+namespace lat {
+namespace {
+
+constexpr char kMagic[8] = {'L', 'A', 'T', 'T', 'I', 'C', 'E', '\x1a'};
+
+// Little-endian field writer/reader over the fixed header (x86-64 and ARM are little-endian;
+// the static_assert below keeps it honest).
+static_assert(std::endian::native == std::endian::little, "table files are little-endian");
+
+struct Fields {
+    std::uint8_t* p;
+    std::size_t off = 0;
+    template <class T>
+    void put(const T& v) {
+        std::memcpy(p + off, &v, sizeof v);
+        off += sizeof v;
+    }
+};
+struct Reader {
+    const std::uint8_t* p;
+    std::size_t off = 0;
+    template <class T>
+    T get() {
+        T v;
+        std::memcpy(&v, p + off, sizeof v);
+        off += sizeof v;
+        return v;
+    }
+};
+
+std::array<std::uint8_t, kTableHeaderBytes> encode_header(const TableHeader& h,
+                                                          std::uint64_t payload_checksum) {
+    std::array<std::uint8_t, kTableHeaderBytes> b{};
+    Fields f{b.data()};
+    for (char c : kMagic) f.put(c);
+    f.put(kTableFormatVersion);
+    f.put(static_cast<std::uint32_t>(kTableHeaderBytes));
+    char enc[16] = {};
+    std::strncpy(enc, h.encoding.c_str(), sizeof enc - 1);
+    for (char c : enc) f.put(c);
+    for (int c : h.cells) f.put(static_cast<std::int32_t>(c));
+    f.put(static_cast<std::int32_t>(h.sigma_inv));
+    f.put(h.sigma);
+    f.put(h.cell);
+    f.put(h.fingerprint);
+    f.put(h.pairs);
+    f.put(h.entries);
+    f.put(h.payload_bytes);
+    f.put(payload_checksum);
+    const std::uint64_t header_checksum = hash_bytes(b.data(), f.off);
+    f.put(header_checksum);
+    return b;
+}
+
+std::string describe(const TableHeader& h) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s, %d x %d x %d cells (sigma %g, sigma^-1 %d)",
+                  h.encoding.c_str(), h.cells[0], h.cells[1], h.cells[2], h.sigma, h.sigma_inv);
+    return buf;
+}
+
+TableHeader decode_header(const std::uint8_t* b, std::size_t file_size, const std::string& path,
+                          std::uint64_t& payload_checksum) {
+    auto bad = [&](const std::string& what) -> InputError {
+        return InputError(path + ": not a valid lattice table: " + what);
+    };
+    if (file_size < kTableHeaderBytes) throw bad("file is too short for a header (truncated?)");
+    if (std::memcmp(b, kMagic, sizeof kMagic) != 0) throw bad("wrong magic number");
+    Reader r{b, sizeof kMagic};
+    const auto version = r.get<std::uint32_t>();
+    if (version != kTableFormatVersion)
+        throw InputError(path + ": lattice table format version " + std::to_string(version) +
+                         ", this program reads version " + std::to_string(kTableFormatVersion) +
+                         " (rebuild it with lattice rasterize)");
+    if (r.get<std::uint32_t>() != kTableHeaderBytes) throw bad("unexpected header size");
+    char enc[16];
+    for (char& c : enc) c = r.get<char>();
+    enc[15] = 0;
+    TableHeader h;
+    h.encoding = enc;
+    for (int& c : h.cells) c = r.get<std::int32_t>();
+    h.sigma_inv = r.get<std::int32_t>();
+    h.sigma = r.get<double>();
+    h.cell = r.get<double>();
+    h.fingerprint = r.get<std::uint64_t>();
+    h.pairs = r.get<std::uint64_t>();
+    h.entries = r.get<std::uint64_t>();
+    h.payload_bytes = r.get<std::uint64_t>();
+    payload_checksum = r.get<std::uint64_t>();
+    const std::size_t covered = r.off;
+    if (r.get<std::uint64_t>() != hash_bytes(b, covered)) throw bad("header checksum mismatch (corrupt)");
+    if (h.payload_bytes != file_size - kTableHeaderBytes)
+        throw bad("payload is " + std::to_string(file_size - kTableHeaderBytes) + " bytes, header says " +
+                  std::to_string(h.payload_bytes) + " (truncated?)");
+    return h;
+}
+
+// A read-only mapping of a whole file, shared by the table made over it.
+struct Mapping {
+    void* addr = nullptr;
+    std::size_t size = 0;
+    ~Mapping() {
+        if (addr && addr != MAP_FAILED) ::munmap(addr, size);
+    }
+};
+
+class MappedTable final : public LatticeTable {
+public:
+    MappedTable(std::shared_ptr<Mapping> m, std::unique_ptr<LatticeTable> t)
+        : mapping_(std::move(m)), table_(std::move(t)) {}
+    bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const override {
+        return table_->lookup(a, b, hit);
+    }
+    std::string encoding() const override { return table_->encoding(); }
+    std::uint64_t entries() const override { return table_->entries(); }
+    std::uint64_t bytes() const override { return table_->bytes() + kTableHeaderBytes; }
+
+private:
+    std::shared_ptr<Mapping> mapping_;
+    std::unique_ptr<LatticeTable> table_;
+};
+
+}  // namespace
+
+std::unique_ptr<LatticeTable> make_table(const std::string& encoding, const std::uint8_t* payload,
+                                         std::size_t size, std::uint64_t entries) {
+    if (encoding == "hash14") return std::make_unique<Hash14Table>(payload, size, entries);
+    throw std::runtime_error("unknown table encoding '" + encoding + "'");
+}
+
+void write_table_file(const std::string& path, const TableHeader& h0,
+                      const std::vector<std::uint8_t>& payload) {
+    TableHeader h = h0;
+    h.payload_bytes = payload.size();
+    const auto header = encode_header(h, hash_bytes(payload.data(), payload.size()));
+    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw InputError(path + ": cannot write lattice table: " + std::strerror(errno));
+    bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size() &&
+              std::fwrite(payload.data(), 1, payload.size(), f) == payload.size();
+    const int err = errno;
+    ok = (std::fclose(f) == 0) && ok;
+    if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+        const int e = ok ? errno : err;
+        std::remove(tmp.c_str());
+        throw InputError(path + ": cannot write lattice table: " + std::strerror(e));
+    }
+}
+
+TableHeader read_table_header(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY);
+    if (fd < 0) throw InputError(path + ": cannot open lattice table: " + std::strerror(errno));
+    struct stat st {};
+    std::uint8_t buf[kTableHeaderBytes] = {};
+    const bool ok = ::fstat(fd, &st) == 0;
+    const ssize_t got = ::pread(fd, buf, sizeof buf, 0);
+    ::close(fd);
+    if (!ok || got < 0) throw InputError(path + ": cannot read lattice table");
+    std::uint64_t checksum;
+    return decode_header(buf, static_cast<std::size_t>(st.st_size), path, checksum);
+}
+
+LoadedTable load_table_file(const std::string& path, const TableHeader* expected) {
+    const int fd = ::open(path.c_str(), O_RDONLY);
+    if (fd < 0) throw InputError(path + ": cannot open lattice table: " + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        ::close(fd);
+        throw InputError(path + ": cannot open lattice table: not a regular file");
+    }
+    auto m = std::make_shared<Mapping>();
+    m->size = static_cast<std::size_t>(st.st_size);
+    if (m->size > 0) m->addr = ::mmap(nullptr, m->size, PROT_READ, MAP_PRIVATE, fd, 0);
+    ::close(fd);
+    if (m->size > 0 && m->addr == MAP_FAILED)
+        throw InputError(path + ": cannot map lattice table: " + std::strerror(errno));
+    const auto* bytes = static_cast<const std::uint8_t*>(m->addr);
+    std::uint64_t checksum = 0;
+    LoadedTable out;
+    out.header = decode_header(bytes, m->size, path, checksum);
+    const TableHeader& h = out.header;
+    if (expected) {
+        if (h.encoding != expected->encoding || h.cells != expected->cells ||
+            h.sigma_inv != expected->sigma_inv || h.cell != expected->cell)
+            throw InputError(path + ": lattice table is for " + describe(h) + ", expected " +
+                             describe(*expected));
+        if (h.fingerprint != expected->fingerprint)
+            throw InputError(path + ": lattice table was built for another primitive "
+                             "(its geometry fingerprint differs); rebuild it");
+    }
+    const std::uint8_t* payload = bytes + kTableHeaderBytes;
+    if (hash_bytes(payload, h.payload_bytes) != checksum)
+        throw InputError(path + ": not a valid lattice table: payload checksum mismatch (corrupt)");
+    try {
+        out.table = std::make_shared<MappedTable>(m, make_table(h.encoding, payload, h.payload_bytes, h.entries));
+    } catch (const std::exception& e) {
+        throw InputError(path + ": not a valid lattice table: " + e.what());
+    }
+    return out;
+}
+
+}  // namespace lat

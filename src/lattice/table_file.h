@@ -1,0 +1,54 @@
+#pragma once
+// The lattice table file (.lht), documented in docs/lattice-tables.md:
+//   a 128-byte little-endian header — magic "LATTICE\x1a", format version, header size,
+//   encoding name, lattice geometry (cells at the refinement, sigma, sigma^-1, cell size), the
+//   fingerprint of the primitive it was built for, counts (N_lp, stored hits), payload size,
+//   payload checksum, header checksum — followed by the encoding's payload.
+// Loading checks all of it and rejects a truncated, corrupt or mismatched file with a message
+// naming the file and what is wrong. The payload is memory-mapped, not copied.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lattice/table.h"
+
+namespace lat {
+
+struct TableHeader {
+    std::string encoding;
+    std::array<int, 3> cells{};  // at the refinement
+    int sigma_inv = 1;
+    double sigma = 1;  // the primitive's own grid spacing
+    double cell = 1;   // sigma / sigma_inv
+    std::uint64_t fingerprint = 0;
+    std::uint64_t pairs = 0;    // N_lp by eq. (2)
+    std::uint64_t entries = 0;  // stored hits
+    std::uint64_t payload_bytes = 0;
+};
+
+inline constexpr std::uint32_t kTableFormatVersion = 1;
+inline constexpr std::size_t kTableHeaderBytes = 128;
+
+// Writes atomically (temporary file + rename); throws InputError naming the path.
+void write_table_file(const std::string& path, const TableHeader& h,
+                      const std::vector<std::uint8_t>& payload);
+
+// A table loaded from disk, with the mapping that holds its payload.
+struct LoadedTable {
+    TableHeader header;
+    std::shared_ptr<const LatticeTable> table;
+};
+
+// Reads just the header (validated); throws InputError.
+TableHeader read_table_header(const std::string& path);
+// Loads and validates a whole file; `expected`, when given, must match its encoding,
+// geometry and fingerprint (a table built for another primitive is rejected).
+LoadedTable load_table_file(const std::string& path, const TableHeader* expected = nullptr);
+
+// The table object for an encoding's payload (which must outlive it).
+std::unique_ptr<LatticeTable> make_table(const std::string& encoding, const std::uint8_t* payload,
+                                         std::size_t size, std::uint64_t entries);
+
+}  // namespace lat
