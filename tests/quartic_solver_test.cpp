@@ -1,0 +1,313 @@
+// Accuracy of the closed-form polynomial solvers against a __float128 reference (see
+// quartic_harness.h for the scoring rules and docs/solver.md for the measured table).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "geometry/quartic_solver.h"
+#include "math/vec.h"
+#include "quartic_harness.h"
+
+namespace lat::test {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+class Rng {
+  public:
+    explicit Rng(unsigned long long seed) : g_(seed) {}
+    double uni(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(g_); }
+    double log_uni(double lo_exp, double hi_exp) { return std::pow(10.0, uni(lo_exp, hi_exp)); }
+    double sign() { return uni(0, 1) < 0.5 ? -1.0 : 1.0; }
+    Vec3 unit() {
+        for (;;) {
+            const Vec3 v{uni(-1, 1), uni(-1, 1), uni(-1, 1)};
+            const double l = length(v);
+            if (l > 0.1 && l <= 1) return v / l;
+        }
+    }
+
+  private:
+    std::mt19937_64 g_;
+};
+
+// Coefficients of lead * prod (x - real_i) * prod (x^2 - 2 re_j x + re_j^2 + im_j^2), in T.
+template <typename T>
+int poly_from_roots(T lead, const double* real, int nreal, const double* re, const double* im,
+                    int npairs, T* c) {
+    int n = 0;
+    c[0] = lead;
+    for (int k = 1; k < 5; ++k) c[k] = 0;
+    const auto mul = [&](T q0, T q1, T q2, int deg) {
+        for (int k = n + deg; k >= 0; --k) {
+            T v = k <= n ? c[k] * q0 : T(0);
+            if (k >= 1 && k - 1 <= n) v += c[k - 1] * q1;
+            if (deg == 2 && k >= 2) v += c[k - 2] * q2;
+            c[k] = v;
+        }
+        n += deg;
+    };
+    for (int i = 0; i < nreal; ++i) mul(-T(real[i]), T(1), T(0), 1);
+    for (int j = 0; j < npairs; ++j)
+        mul(T(re[j]) * T(re[j]) + T(im[j]) * T(im[j]), -2 * T(re[j]), T(1), 2);
+    return n;
+}
+
+// A ray as the caller prepares it: direction normalised, origin moved to the ray point closest
+// to the object's centre (the origin). Both are then exact inputs of the double and __float128
+// coefficient computations.
+struct PreparedRay {
+    double o[3], d[3];
+};
+inline PreparedRay prepare(Vec3 origin, Vec3 dir) {
+    const Vec3 d = normalize(dir);
+    const Vec3 o = origin - d * dot(origin, d);
+    return {{o.x, o.y, o.z}, {d.x, d.y, d.z}};
+}
+
+// Torus (|p|^2 + R^2 - r^2)^2 - 4 R^2 (x^2 + y^2) along o + t d.
+template <typename T>
+void torus_coeffs(const PreparedRay& ray, double R_, double r_, T* c) {
+    const T ox = ray.o[0], oy = ray.o[1], oz = ray.o[2], dx = ray.d[0], dy = ray.d[1],
+            dz = ray.d[2], R = R_, r = r_;
+    const T dd = dx * dx + dy * dy + dz * dz, od = ox * dx + oy * dy + oz * dz;
+    const T k = ox * ox + oy * oy + oz * oz + R * R - r * r;
+    const T e = dx * dx + dy * dy, f = ox * dx + oy * dy, g = ox * ox + oy * oy;
+    c[4] = dd * dd;
+    c[3] = 4 * dd * od;
+    c[2] = 2 * dd * k + 4 * od * od - 4 * R * R * e;
+    c[1] = 4 * od * k - 8 * R * R * f;
+    c[0] = k * k - 4 * R * R * g;
+}
+
+// Spheres as a quartic: (|p|^2 - a)(|p|^2 - b) along o + t d.
+template <typename T>
+void spheres_coeffs(const PreparedRay& ray, double a_, double b_, T* c) {
+    const T ox = ray.o[0], oy = ray.o[1], oz = ray.o[2], dx = ray.d[0], dy = ray.d[1],
+            dz = ray.d[2], a = a_, b = b_;
+    const T dd = dx * dx + dy * dy + dz * dz, od = ox * dx + oy * dy + oz * dz,
+            oo = ox * ox + oy * oy + oz * oz;
+    c[4] = dd * dd;
+    c[3] = 4 * dd * od;
+    c[2] = 4 * od * od + 2 * dd * oo - (a + b) * dd;
+    c[1] = 4 * od * oo - 2 * (a + b) * od;
+    c[0] = oo * oo - (a + b) * oo + a * b;
+}
+
+// x^4 + y^4 + z^4 - 1 along o + t d.
+template <typename T>
+void superellipsoid_coeffs(const PreparedRay& ray, T* c) {
+    for (int k = 0; k < 5; ++k) c[k] = 0;
+    for (int i = 0; i < 3; ++i) {
+        const T o = ray.o[i], d = ray.d[i];
+        c[4] += d * d * d * d;
+        c[3] += 4 * o * d * d * d;
+        c[2] += 6 * o * o * d * d;
+        c[1] += 4 * o * o * o * d;
+        c[0] += o * o * o * o;
+    }
+    c[0] -= 1;
+}
+
+template <typename Coeffs>
+void check_ray(const PreparedRay& ray, Coeffs coeffs, Stats& a, Stats& b) {
+    double c[5];
+    f128 cref[5];
+    coeffs(ray, c);
+    coeffs(ray, cref);
+    check(c, 4, cref, a, b);
+}
+
+struct Pair {
+    Stats a, b;
+    explicit Pair(const char* name, double floor) {
+        a.name = b.name = name;
+        a.floor = b.floor = floor;
+    }
+    void print() const {
+        a.print("A");
+        b.print("B");
+    }
+};
+
+void print_header() {
+    std::printf("| %-36s | r | %5s | %5s | %4s | %4s | %4s | %7s | %7s | %7s | %5s |\n", "case",
+                "polys", "roots", "miss", "spur", "pair", "max sep", "max err", "mean", "cond");
+}
+
+// Checks the bounds every case must meet; the error bounds are the measured ones with margin.
+void expect_ok(const Pair& p, double max_sep_err) {
+    EXPECT_EQ(p.a.missed, 0) << p.a.name << ": " << p.a.first_bad;
+    EXPECT_EQ(p.a.spurious, 0) << p.a.name << ": " << p.a.first_bad;
+    EXPECT_EQ(p.b.missed, 0) << p.b.name << ": " << p.b.first_bad;
+    EXPECT_EQ(p.b.spurious, 0) << p.b.name << ": " << p.b.first_bad;
+    EXPECT_LE(p.a.max_err_sep, max_sep_err) << p.a.name << ": " << p.a.worst;
+    // Against the exact roots of its own input the solver is within a few rounding errors of
+    // the best possible (error / (eps * condition number)).
+    EXPECT_LE(p.b.max_cond, 20.0) << p.b.name << ": " << p.b.worst;
+}
+
+// ---- (1) polynomials from known roots ----------------------------------------------------
+
+TEST(QuarticKnownRoots, Accuracy) {
+    Rng rng(1);
+    print_header();
+    const int N = 2000;
+    const auto run = [&](Pair& p, int nreal, auto make) {
+        for (int i = 0; i < N; ++i) {
+            double real[4] = {}, re[2] = {}, im[2] = {};
+            make(real, re, im);
+            const double lead = rng.sign() * rng.log_uni(-20, 20);
+            double c[5];
+            f128 cref[5];
+            poly_from_roots<double>(lead, real, nreal, re, im, (4 - nreal) / 2, c);
+            poly_from_roots<f128>(lead, real, nreal, re, im, (4 - nreal) / 2, cref);
+            check(c, 4, cref, p.a, p.b);
+        }
+        p.print();
+    };
+    Pair sep("4 real, uniform [-10,10]", 0.0);
+    run(sep, 4, [&](double* x, double*, double*) {
+        for (int k = 0; k < 4; ++k) x[k] = rng.uni(-10, 10);
+    });
+    expect_ok(sep, 1e-12);
+    Pair clus("4 real, cluster gaps 1e-5..1e-2 rel", 0.0);
+    run(clus, 4, [&](double* x, double*, double*) {
+        const double m = rng.uni(-10, 10);
+        for (int k = 0; k < 4; ++k) x[k] = m * (1 + rng.sign() * rng.log_uni(-5, -2));
+    });
+    expect_ok(clus, 1e-12);
+    Pair mult("multiple roots (2,1,1 / 2,2 / 3,1)", 0.0);
+    run(mult, 4, [&](double* x, double*, double*) {
+        const double u = rng.uni(-10, 10), v = rng.uni(-10, 10), w = rng.uni(-10, 10);
+        const int kind = static_cast<int>(rng.uni(0, 3));
+        x[0] = x[1] = u;
+        x[2] = kind == 2 ? u : v;
+        x[3] = kind == 1 ? v : w;
+    });
+    expect_ok(mult, 1e-12);
+    Pair spread("4 real, |x| in 1e-3..1e3", 0.0);
+    run(spread, 4, [&](double* x, double*, double*) {
+        for (int k = 0; k < 4; ++k) x[k] = rng.sign() * rng.log_uni(-3, 3);
+    });
+    expect_ok(spread, 1e-12);
+    Pair cplx("2 real + complex pair", 0.0);
+    run(cplx, 2, [&](double* x, double* re, double* im) {
+        x[0] = rng.uni(-10, 10);
+        x[1] = rng.uni(-10, 10);
+        re[0] = rng.uni(-10, 10);
+        im[0] = rng.log_uni(-3, 1);
+    });
+    expect_ok(cplx, 1e-12);
+    Pair none("2 complex pairs", 0.0);
+    run(none, 0, [&](double*, double* re, double* im) {
+        for (int k = 0; k < 2; ++k) re[k] = rng.uni(-10, 10), im[k] = rng.log_uni(-3, 1);
+    });
+    expect_ok(none, 1e-12);
+    Pair near("2 real + near-real pair im 1e-9..1e-4", 0.0);
+    run(near, 2, [&](double* x, double* re, double* im) {
+        x[0] = rng.uni(-10, 10);
+        x[1] = rng.uni(-10, 10);
+        re[0] = rng.uni(-10, 10);
+        im[0] = std::abs(re[0]) * rng.log_uni(-9, -4);
+    });
+    expect_ok(near, 1e-12);
+}
+
+// ---- (2) random rays against tori --------------------------------------------------------
+
+TEST(QuarticTorus, RandomRays) {
+    Rng rng(2);
+    Pair p("torus, random rays", 1.0);
+    for (int i = 0; i < 4000; ++i) {
+        const double R = rng.uni(1, 5), r = rng.uni(0.1, 0.99 * R);
+        const Vec3 origin = rng.unit() * (rng.uni(1.5, 20) * (R + r));
+        const Vec3 target{rng.uni(-R - r, R + r), rng.uni(-R - r, R + r), rng.uni(-r, r)};
+        check_ray(
+            prepare(origin, target - origin),
+            [&](const PreparedRay& ray, auto* c) { torus_coeffs(ray, R, r, c); }, p.a, p.b);
+    }
+    p.print();
+    expect_ok(p, 1e-12);
+}
+
+// ---- (3) grazing rays --------------------------------------------------------------------
+
+TEST(QuarticGrazing, Torus) {
+    Rng rng(3);
+    const auto offset = [&](double scale) { return rng.sign() * scale * rng.log_uni(-15, -2); };
+    Pair outer("torus outer equator, edge-on 1000R", 1.0);
+    Pair inner("torus inner equator, edge-on 1000R", 1.0);
+    Pair top("torus top plane z=r (2 tangencies)", 1.0);
+    Pair surf("torus, tangent at random point", 1.0);
+    for (int i = 0; i < 1000; ++i) {
+        const double R = rng.uni(1, 5), r = rng.uni(0.1, 0.99 * R), phi = rng.uni(0, 6.3);
+        const Vec3 radial{std::cos(phi), std::sin(phi), 0}, along{-std::sin(phi), std::cos(phi), 0};
+        const auto torus = [&](const PreparedRay& ray, auto* c) { torus_coeffs(ray, R, r, c); };
+        const double far = 1000 * R;
+        check_ray(prepare(radial * (R + r + offset(r)) - along * far, along), torus, outer.a,
+                  outer.b);
+        check_ray(prepare(radial * (R - r + offset(r)) - along * far, along), torus, inner.a,
+                  inner.b);
+        const Vec3 foot = radial * rng.uni(0, R) + Vec3{0, 0, r + offset(r)};
+        check_ray(prepare(foot - along * rng.uni(0, far), along), torus, top.a, top.b);
+        // A point on the tube, its normal, a random tangent direction, an offset along n.
+        const double th = rng.uni(0, 6.3);
+        const Vec3 centre = radial * R;
+        const Vec3 n = radial * std::cos(th) + Vec3{0, 0, std::sin(th)};
+        const Vec3 point = centre + n * r;
+        Vec3 t1, t2;
+        orthonormal_basis(n, t1, t2);
+        const double a = rng.uni(0, 6.3);
+        const Vec3 d = t1 * std::cos(a) + t2 * std::sin(a);
+        check_ray(prepare(point + n * offset(r) - d * rng.uni(0, far), d), torus, surf.a, surf.b);
+    }
+    for (const Pair* p : {&outer, &inner, &top, &surf}) {
+        p->print();
+        expect_ok(*p, 1e-12);
+    }
+}
+
+TEST(QuarticGrazing, SpheresAndSuperellipsoid) {
+    Rng rng(4);
+    const auto offset = [&]() { return rng.sign() * rng.log_uni(-15, -2); };
+    Pair two("(|p|^2-1)(|p|^2-4), tangent to either", 1.0);
+    Pair one("|p|^4-1, tangent", 1.0);
+    Pair sup("x^4+y^4+z^4-1, tangent", 1.0);
+    for (int i = 0; i < 1000; ++i) {
+        const Vec3 n = rng.unit();
+        Vec3 t1, t2;
+        orthonormal_basis(n, t1, t2);
+        const double far = rng.uni(0, 1000);
+        const double rad = rng.uni(0, 1) < 0.5 ? 1.0 : 2.0;
+        check_ray(
+            prepare(n * (rad + offset()) - t1 * far, t1),
+            [](const PreparedRay& ray, auto* c) { spheres_coeffs(ray, 1.0, 4.0, c); }, two.a,
+            two.b);
+        check_ray(
+            prepare(n * (1 + offset()) - t1 * far, t1),
+            [](const PreparedRay& ray, auto* c) { spheres_coeffs(ray, 1.0, -1.0, c); }, one.a,
+            one.b);
+        // Point on x^4+y^4+z^4 = 1, its normal (x^3, y^3, z^3), a tangent direction.
+        const Vec3 u = rng.unit();
+        const Vec3 pt =
+            u /
+            std::pow(u.x * u.x * u.x * u.x + u.y * u.y * u.y * u.y + u.z * u.z * u.z * u.z, 0.25);
+        const Vec3 nn = normalize(Vec3{pt.x * pt.x * pt.x, pt.y * pt.y * pt.y, pt.z * pt.z * pt.z});
+        orthonormal_basis(nn, t1, t2);
+        const double a = rng.uni(0, 6.3);
+        const Vec3 d = t1 * std::cos(a) + t2 * std::sin(a);
+        check_ray(
+            prepare(pt + nn * offset() - d * far, d),
+            [](const PreparedRay& ray, auto* c) { superellipsoid_coeffs(ray, c); }, sup.a, sup.b);
+    }
+    for (const Pair* p : {&two, &one, &sup}) {
+        p->print();
+        expect_ok(*p, 1e-12);
+    }
+}
+
+}  // namespace
+}  // namespace lat::test
