@@ -35,19 +35,24 @@ struct Stats {
     std::string name;
     double floor = 1.0;  // errors are |x - x_ref| / max(|x_ref|, floor)
     long polys = 0, ref_roots = 0, found = 0, missed = 0, spurious = 0, exempt = 0, touches = 0;
+    long lost = 0;  // exempt roots with no reported root near them (a pair lost, not merged)
     double max_err = 0, sum_err = 0, max_err_sep = 0;
     long n_err = 0;
     double max_cond = 0;  // max error / (eps * max(1, kappa))
-    std::string worst, first_bad;
+    std::string worst, worst_cond, first_bad, first_lost;
 
     double mean_err() const { return n_err ? sum_err / static_cast<double>(n_err) : 0.0; }
     void print(const char* ref) const {
         std::printf(
-            "| %-36s | %s | %5ld | %5ld | %4ld | %4ld | %4ld | %7.1e | %7.1e | %7.1e | %5.1f |\n",
-            name.c_str(), ref, polys, ref_roots, missed, spurious, exempt, max_err_sep, max_err,
-            mean_err(), *ref == 'B' ? max_cond : 0.0);
+            "| %-36s | %s | %5ld | %5ld | %4ld | %4ld | %4ld | %4ld | %7.1e | %7.1e | %7.1e | "
+            "%5.1f |\n",
+            name.c_str(), ref, polys, ref_roots, missed, spurious, exempt, lost, max_err_sep,
+            max_err, mean_err(), *ref == 'B' ? max_cond : 0.0);
         if (!first_bad.empty()) std::printf("    first miss/spurious: %s\n", first_bad.c_str());
+        if (!first_lost.empty()) std::printf("    first lost pair: %s\n", first_lost.c_str());
         if (!worst.empty()) std::printf("    worst error: %s\n", worst.c_str());
+        if (*ref == 'B' && !worst_cond.empty())
+            std::printf("    worst error / condition: %s\n", worst_cond.c_str());
     }
 };
 
@@ -147,7 +152,11 @@ inline void compare(const double* c, int n, const double* roots, int nr, const f
                 }
                 if (gap[best] > kSeparated * scale(r))
                     st.max_err_sep = std::fmax(st.max_err_sep, err);
-                st.max_cond = std::fmax(st.max_cond, err / (kEps * std::fmax(kappa[best], 1.0)));
+                const double ratio = err / (kEps * std::fmax(kappa[best], 1.0));
+                if (ratio > st.max_cond) {
+                    st.max_cond = ratio;
+                    st.worst_cond = describe(c, n, roots, nr);
+                }
             }
             used[best] = true;
             continue;
@@ -175,6 +184,11 @@ inline void compare(const double* c, int n, const double* roots, int nr, const f
         if (used[j] || abs128(ref.real[j]) > far) continue;
         if (close[j]) {
             ++st.exempt;
+            bool near = false;
+            for (int i = 0; i < nr; ++i)
+                near = near || static_cast<double>(abs128(roots[i] - ref.real[j])) <= tol[j];
+            st.lost += !near;
+            if (!near && st.first_lost.empty()) st.first_lost = describe(c, n, roots, nr);
         } else {
             ++st.missed;
             bad = true;

@@ -53,8 +53,9 @@ inline f128 refine128(const f128* c, int n, f128 lo, f128 hi) {
             hi = x;
         f128 nx = d != 0 ? x - p / d : lo / 2 + hi / 2;
         if (!(nx > lo && nx < hi)) nx = lo / 2 + hi / 2;
-        const f128 tol = 1e-32 * max128(abs128(lo), abs128(hi));
-        if (abs128(nx - x) <= tol || hi - lo <= tol) return nx;
+        if (abs128(nx - x) <= 1e-32 * abs128(nx) ||
+            hi - lo <= 1e-32 * max128(abs128(lo), abs128(hi)))
+            return nx;
         x = nx;
     }
     return x;
@@ -74,9 +75,12 @@ inline RefRoots reference_roots(const f128* c, int n) {
     f128 dc[4];
     for (int k = 1; k <= n; ++k) dc[k - 1] = k * c[k];
     const RefRoots crit = reference_roots(dc, n - 1);
-    f128 bound = 0;
-    for (int k = 0; k < n; ++k) bound = max128(bound, abs128(c[k] / c[n]));
-    bound = 2 * (bound + 1);
+    // Fujiwara's bound 2 max |c_k / c_n|^(1/(n-k)): of the order of the largest root, so that
+    // the refinement starts close (a Cauchy bound can be 1e100 times too large).
+    double fb = 0;
+    for (int k = 0; k < n; ++k)
+        fb = std::fmax(fb, std::pow(static_cast<double>(abs128(c[k] / c[n])), 1.0 / (n - k)));
+    const f128 bound = 2 * static_cast<f128>(fb) * (1 + 1e-10) + 1e-300;
     // Breakpoints: -bound, critical points, +bound. At a critical point p is "zero" when it is
     // at the level of the f128 rounding of evaluating p there.
     f128 pts[5];

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <type_traits>
+#include <vector>
 
 #include "geometry/quartic_solver.h"
 #include "math/vec.h"
@@ -133,20 +135,25 @@ struct Pair {
 };
 
 void print_header() {
-    std::printf("| %-36s | r | %5s | %5s | %4s | %4s | %4s | %7s | %7s | %7s | %5s |\n", "case",
-                "polys", "roots", "miss", "spur", "pair", "max sep", "max err", "mean", "cond");
+    std::printf("| %-36s | r | %5s | %5s | %4s | %4s | %4s | %4s | %7s | %7s | %7s | %5s |\n",
+                "case", "polys", "roots", "miss", "spur", "pair", "lost", "max sep", "max err",
+                "mean", "cond");
 }
 
-// Checks the bounds every case must meet; the error bounds are the measured ones with margin.
-void expect_ok(const Pair& p, double max_sep_err) {
+// Checks the bounds every case must meet. The bounds are the measured values (docs/solver.md)
+// with a margin of about 3: no missed or spurious root, no pair lost entirely (beyond
+// max_lost: clusters of 3+ roots inside their rounding radius), the largest error on roots
+// separated from the others by 1% (reference A), and the largest error divided by the
+// condition number against the solver's own input (reference B).
+void expect_ok(const Pair& p, double max_sep_err, double max_cond, long max_lost = 0) {
     EXPECT_EQ(p.a.missed, 0) << p.a.name << ": " << p.a.first_bad;
     EXPECT_EQ(p.a.spurious, 0) << p.a.name << ": " << p.a.first_bad;
     EXPECT_EQ(p.b.missed, 0) << p.b.name << ": " << p.b.first_bad;
     EXPECT_EQ(p.b.spurious, 0) << p.b.name << ": " << p.b.first_bad;
+    EXPECT_LE(p.a.lost, max_lost) << p.a.name << ": " << p.a.first_lost;
+    EXPECT_LE(p.b.lost, max_lost) << p.b.name << ": " << p.b.first_lost;
     EXPECT_LE(p.a.max_err_sep, max_sep_err) << p.a.name << ": " << p.a.worst;
-    // Against the exact roots of its own input the solver is within a few rounding errors of
-    // the best possible (error / (eps * condition number)).
-    EXPECT_LE(p.b.max_cond, 20.0) << p.b.name << ": " << p.b.worst;
+    EXPECT_LE(p.b.max_cond, max_cond) << p.b.name << ": " << p.b.worst_cond;
 }
 
 // ---- (1) polynomials from known roots ----------------------------------------------------
@@ -154,7 +161,7 @@ void expect_ok(const Pair& p, double max_sep_err) {
 TEST(QuarticKnownRoots, Accuracy) {
     Rng rng(1);
     print_header();
-    const int N = 2000;
+    const int N = 1200;
     const auto run = [&](Pair& p, int nreal, auto make) {
         for (int i = 0; i < N; ++i) {
             double real[4] = {}, re[2] = {}, im[2] = {};
@@ -172,13 +179,13 @@ TEST(QuarticKnownRoots, Accuracy) {
     run(sep, 4, [&](double* x, double*, double*) {
         for (int k = 0; k < 4; ++k) x[k] = rng.uni(-10, 10);
     });
-    expect_ok(sep, 1e-12);
+    expect_ok(sep, 2e-11, 4);
     Pair clus("4 real, cluster gaps 1e-5..1e-2 rel", 0.0);
     run(clus, 4, [&](double* x, double*, double*) {
         const double m = rng.uni(-10, 10);
         for (int k = 0; k < 4; ++k) x[k] = m * (1 + rng.sign() * rng.log_uni(-5, -2));
     });
-    expect_ok(clus, 1e-12);
+    expect_ok(clus, 2e-9, 32, 200);
     Pair mult("multiple roots (2,1,1 / 2,2 / 3,1)", 0.0);
     run(mult, 4, [&](double* x, double*, double*) {
         const double u = rng.uni(-10, 10), v = rng.uni(-10, 10), w = rng.uni(-10, 10);
@@ -187,12 +194,12 @@ TEST(QuarticKnownRoots, Accuracy) {
         x[2] = kind == 2 ? u : v;
         x[3] = kind == 1 ? v : w;
     });
-    expect_ok(mult, 1e-12);
+    expect_ok(mult, 1e-9, 8, 10);
     Pair spread("4 real, |x| in 1e-3..1e3", 0.0);
     run(spread, 4, [&](double* x, double*, double*) {
         for (int k = 0; k < 4; ++k) x[k] = rng.sign() * rng.log_uni(-3, 3);
     });
-    expect_ok(spread, 1e-12);
+    expect_ok(spread, 5e-13, 4);
     Pair cplx("2 real + complex pair", 0.0);
     run(cplx, 2, [&](double* x, double* re, double* im) {
         x[0] = rng.uni(-10, 10);
@@ -200,12 +207,12 @@ TEST(QuarticKnownRoots, Accuracy) {
         re[0] = rng.uni(-10, 10);
         im[0] = rng.log_uni(-3, 1);
     });
-    expect_ok(cplx, 1e-12);
+    expect_ok(cplx, 1e-9, 4);
     Pair none("2 complex pairs", 0.0);
     run(none, 0, [&](double*, double* re, double* im) {
         for (int k = 0; k < 2; ++k) re[k] = rng.uni(-10, 10), im[k] = rng.log_uni(-3, 1);
     });
-    expect_ok(none, 1e-12);
+    expect_ok(none, 0, 4);
     Pair near("2 real + near-real pair im 1e-9..1e-4", 0.0);
     run(near, 2, [&](double* x, double* re, double* im) {
         x[0] = rng.uni(-10, 10);
@@ -213,7 +220,7 @@ TEST(QuarticKnownRoots, Accuracy) {
         re[0] = rng.uni(-10, 10);
         im[0] = std::abs(re[0]) * rng.log_uni(-9, -4);
     });
-    expect_ok(near, 1e-12);
+    expect_ok(near, 1e-9, 4);
 }
 
 // ---- (2) random rays against tori --------------------------------------------------------
@@ -230,7 +237,7 @@ TEST(QuarticTorus, RandomRays) {
             [&](const PreparedRay& ray, auto* c) { torus_coeffs(ray, R, r, c); }, p.a, p.b);
     }
     p.print();
-    expect_ok(p, 1e-12);
+    expect_ok(p, 3e-13, 4);
 }
 
 // ---- (3) grazing rays --------------------------------------------------------------------
@@ -264,10 +271,11 @@ TEST(QuarticGrazing, Torus) {
         const Vec3 d = t1 * std::cos(a) + t2 * std::sin(a);
         check_ray(prepare(point + n * offset(r) - d * rng.uni(0, far), d), torus, surf.a, surf.b);
     }
-    for (const Pair* p : {&outer, &inner, &top, &surf}) {
-        p->print();
-        expect_ok(*p, 1e-12);
-    }
+    for (const Pair* p : {&outer, &inner, &top, &surf}) p->print();
+    expect_ok(outer, 3e-11, 4);
+    expect_ok(inner, 1e-11, 4);
+    expect_ok(top, 1e-11, 20);
+    expect_ok(surf, 5e-11, 20);
 }
 
 TEST(QuarticGrazing, SpheresAndSuperellipsoid) {
@@ -303,9 +311,201 @@ TEST(QuarticGrazing, SpheresAndSuperellipsoid) {
             prepare(pt + nn * offset() - d * far, d),
             [](const PreparedRay& ray, auto* c) { superellipsoid_coeffs(ray, c); }, sup.a, sup.b);
     }
-    for (const Pair* p : {&two, &one, &sup}) {
+    for (const Pair* p : {&two, &one, &sup}) p->print();
+    expect_ok(two, 1e-13, 4);
+    expect_ok(one, 3e-14, 4);
+    expect_ok(sup, 5e-13, 4);
+}
+
+// ---- (4) degenerate leading coefficients ---------------------------------------------------
+
+TEST(QuarticDegenerate, LeadingCoefficients) {
+    Rng rng(5);
+    Pair quadric("sphere |p|^2-1 as quartic (c4=c3=0)", 1.0);
+    Pair cubic("cubic as quartic (c4=0)", 1.0);
+    Pair tiny("cubic + c4 1e-30..1e-20 rel (dropped)", 1.0);
+    Pair small("cubic + c4 1e-14..1e-3 rel (kept)", 0.0);
+    Pair quad2("quadratic + c4,c3 ~1e-20 rel", 1.0);
+    long far_reported = 0;
+    for (int i = 0; i < 700; ++i) {
+        const Vec3 n = rng.unit();
+        Vec3 t1, t2;
+        orthonormal_basis(n, t1, t2);
+        check_ray(
+            prepare(n * rng.uni(0, 1.5) - t1 * rng.uni(0, 1000), t1),
+            [](const PreparedRay& ray, auto* c) {
+                // The quadric |p|^2 - 1 given to the quartic solver: c4 = c3 = 0.
+                using T = std::remove_reference_t<decltype(*c)>;
+                const T ox = ray.o[0], oy = ray.o[1], oz = ray.o[2], dx = ray.d[0], dy = ray.d[1],
+                        dz = ray.d[2];
+                c[4] = c[3] = 0;
+                c[2] = dx * dx + dy * dy + dz * dz;
+                c[1] = 2 * (ox * dx + oy * dy + oz * dz);
+                c[0] = ox * ox + oy * oy + oz * oz - 1;
+            },
+            quadric.a, quadric.b);
+        double x[3] = {rng.uni(-10, 10), rng.uni(-10, 10), rng.uni(-10, 10)};
+        const double re = rng.uni(-10, 10), im = rng.log_uni(-3, 1);
+        const bool pair = rng.uni(0, 1) < 0.3;
+        const double lead = rng.sign() * rng.log_uni(-5, 5);
+        double c[5];
+        f128 cref[5];
+        poly_from_roots<double>(lead, x, pair ? 1 : 3, &re, &im, pair ? 1 : 0, c);
+        poly_from_roots<f128>(lead, x, pair ? 1 : 3, &re, &im, pair ? 1 : 0, cref);
+        check(c, 4, cref, cubic.a, cubic.b);
+        const double big = std::fmax(std::abs(c[3]), std::fmax(std::abs(c[2]), std::abs(c[0])));
+        c[4] = cref[4] = rng.sign() * big * rng.log_uni(-30, -20);
+        double roots[4];
+        const int nr = solve_quartic(c, roots);
+        for (int k = 0; k < nr; ++k) far_reported += std::abs(roots[k]) > 1e15;
+        check(c, 4, cref, tiny.a, tiny.b, 1e15);
+        c[4] = cref[4] = rng.sign() * big * rng.log_uni(-14, -3);
+        check(c, 4, cref, small.a, small.b);
+        // A quadratic with rounding-level c3, c4.
+        double q[5];
+        f128 qref[5];
+        poly_from_roots<double>(lead, x, 2, &re, &im, 0, q);
+        poly_from_roots<f128>(lead, x, 2, &re, &im, 0, qref);
+        const double qbig = std::fmax(std::abs(q[2]), std::abs(q[0]));
+        q[3] = qref[3] = rng.sign() * qbig * rng.log_uni(-22, -18);
+        q[4] = qref[4] = rng.sign() * qbig * rng.log_uni(-22, -18);
+        check(q, 4, qref, quad2.a, quad2.b, 1e6);
+    }
+    for (const Pair* p : {&quadric, &cubic, &tiny, &small, &quad2}) p->print();
+    expect_ok(quadric, 3e-15, 4);
+    expect_ok(cubic, 5e-12, 4);
+    expect_ok(tiny, 5e-12, 4);
+    expect_ok(small, 3e-12, 4);
+    expect_ok(quad2, 3e-13, 8);
+    EXPECT_EQ(far_reported, 0);
+}
+
+// ---- (5) quadratics and cubics directly ------------------------------------------------------
+
+TEST(QuarticLowDegree, QuadraticsAndCubics) {
+    Rng rng(6);
+    Pair q_real("quadratic, 2 real, scales 1e+-60", 0.0);
+    Pair q_wide("quadratic, |x1/x2| 1e-15..1e-5", 0.0);
+    Pair q_near("quadratic, gap 1e-12..1e-3 rel", 0.0);
+    Pair q_cplx("quadratic, complex im 1e-10..1 rel", 0.0);
+    Pair c_real("cubic, 3 real, scales 1e+-60", 0.0);
+    Pair c_cplx("cubic, 1 real + complex pair", 0.0);
+    Pair c_near("cubic, near-double gap 1e-12..1e-3", 0.0);
+    Pair c_wide("cubic, |x| in 1e-4..1e4", 0.0);
+    for (int i = 0; i < 1200; ++i) {
+        const double s = rng.log_uni(-60, 60), lead = rng.sign() * rng.log_uni(-60, 60);
+        const double u = s * rng.uni(-1, 1), v = s * rng.uni(-1, 1), w = s * rng.uni(-1, 1);
+        const auto real_only = [&](Pair& p, std::initializer_list<double> xs) {
+            double x[3] = {0, 0, 0}, c[5];
+            f128 cref[5];
+            int k = 0;
+            for (double e : xs) x[k++] = e;
+            const int n = poly_from_roots<double>(lead, x, k, nullptr, nullptr, 0, c);
+            poly_from_roots<f128>(lead, x, k, nullptr, nullptr, 0, cref);
+            check(c, n, cref, p.a, p.b);
+        };
+        const auto with_pair = [&](Pair& p, std::initializer_list<double> xs, double re,
+                                   double im) {
+            double x[3] = {0, 0, 0}, c[5];
+            f128 cref[5];
+            int k = 0;
+            for (double e : xs) x[k++] = e;
+            const int n = poly_from_roots<double>(lead, x, k, &re, &im, 1, c);
+            poly_from_roots<f128>(lead, x, k, &re, &im, 1, cref);
+            check(c, n, cref, p.a, p.b);
+        };
+        real_only(q_real, {u, v});
+        real_only(q_wide, {u, u * rng.sign() * rng.log_uni(-15, -5)});
+        real_only(q_near, {u, u * (1 + rng.sign() * rng.log_uni(-12, -3))});
+        with_pair(q_cplx, {}, u, std::abs(u) * rng.log_uni(-10, 0));
+        real_only(c_real, {u, v, w});
+        with_pair(c_cplx, {u}, v, std::abs(v) * rng.log_uni(-3, 0));
+        real_only(c_near, {u, v, v * (1 + rng.sign() * rng.log_uni(-12, -3))});
+        real_only(c_wide, {rng.sign() * rng.log_uni(-4, 4), rng.sign() * rng.log_uni(-4, 4),
+                           rng.sign() * rng.log_uni(-4, 4)});
+    }
+    for (const Pair* p : {&q_real, &q_wide, &q_near, &q_cplx, &c_real, &c_cplx, &c_near, &c_wide})
         p->print();
-        expect_ok(*p, 1e-12);
+    expect_ok(q_real, 1e-13, 4);
+    expect_ok(q_wide, 2e-15, 4);
+    expect_ok(q_near, 0, 4);
+    expect_ok(q_cplx, 0, 4);
+    expect_ok(c_real, 3e-12, 4);
+    expect_ok(c_cplx, 2e-11, 4);
+    expect_ok(c_near, 2e-11, 20);
+    expect_ok(c_wide, 1e-13, 4);
+}
+
+// ---- edge cases ------------------------------------------------------------------------------
+
+std::vector<double> quartic(std::initializer_list<double> coeffs) {
+    double c[5] = {0, 0, 0, 0, 0}, r[4];
+    int k = 0;
+    for (double v : coeffs) c[k++] = v;
+    const int n = solve_quartic(c, r);
+    return std::vector<double>(r, r + n);
+}
+
+TEST(QuarticEdgeCases, DegenerateInputs) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    double r[4];
+    const double zeros[5] = {0, 0, 0, 0, 0};
+    EXPECT_EQ(solve_quadratic(zeros, r), 0);
+    EXPECT_EQ(solve_cubic(zeros, r), 0);
+    EXPECT_EQ(solve_quartic(zeros, r), 0);
+    EXPECT_TRUE(quartic({3}).empty());                 // non-zero constant
+    EXPECT_TRUE(quartic({-1, 0, 0, 0, nan}).empty());  // non-finite input
+    EXPECT_TRUE(quartic({-1, kInf, 0, 0, 1}).empty());
+    EXPECT_EQ(quartic({0, 0, 0, 0, 1}), std::vector<double>{0.0});  // x^4: one distinct root
+    EXPECT_EQ(quartic({0, 0, 1}), std::vector<double>{0.0});
+    EXPECT_EQ(quartic({2, -4}), std::vector<double>{0.5});  // linear
+    EXPECT_EQ(quartic({-1, 0, 0, 0, 1}), (std::vector<double>{-1, 1}));
+    EXPECT_EQ(quartic({4, 0, -5, 0, 1}), (std::vector<double>{-2, -1, 1, 2}));  // biquadratic
+    EXPECT_EQ(quartic({24, -50, 35, -10, 1}), (std::vector<double>{1, 2, 3, 4}));
+    EXPECT_EQ(quartic({0, -6, 11, -6, 1}), (std::vector<double>{0, 1, 2, 3}));  // exact 0
+    EXPECT_EQ(quartic({1, -2, 1}), std::vector<double>{1.0});                   // double root
+    EXPECT_TRUE(quartic({1, 0, 1}).empty());                                    // complex pair
+    EXPECT_TRUE(quartic({1, 0, 0, 0, 1e-20}).empty());  // x^4 = -1e20: no real root
+    EXPECT_EQ(quartic({-1, 0, 0, 0, 1e-20}), (std::vector<double>{-1e5, 1e5}));
+    const double cubic[4] = {-6, 11, -6, 1};
+    ASSERT_EQ(solve_cubic(cubic, r), 3);
+    EXPECT_EQ(r[0], 1.0);
+    EXPECT_EQ(r[1], 2.0);
+    EXPECT_EQ(r[2], 3.0);
+    const double quad[3] = {-1e300, 0, 1e-300};  // x^2 = 1e600
+    ASSERT_EQ(solve_quadratic(quad, r), 2);
+    EXPECT_DOUBLE_EQ(r[0], -1e300);
+    EXPECT_DOUBLE_EQ(r[1], 1e300);
+}
+
+TEST(QuarticEdgeCases, ScaleInvariance) {
+    // Scaling the coefficients or the variable by powers of two scales the roots exactly.
+    const double base[5] = {24, -50, 35, -10, 1};  // roots 1, 2, 3, 4
+    for (int e : {-300, -200, -64, 0, 64, 200, 300}) {
+        double c[5], r[4];
+        for (int k = 0; k < 5; ++k) c[k] = std::ldexp(base[k], e);
+        ASSERT_EQ(solve_quartic(c, r), 4) << e;
+        for (int k = 0; k < 4; ++k) EXPECT_EQ(r[k], k + 1.0) << e;
+        const int s = e / 5;  // roots 2^s (1, 2, 3, 4)
+        for (int k = 0; k < 5; ++k) c[k] = std::ldexp(base[k], -s * k);
+        ASSERT_EQ(solve_quartic(c, r), 4) << e;
+        for (int k = 0; k < 4; ++k) EXPECT_EQ(r[k], std::ldexp(k + 1.0, s)) << e;
+    }
+}
+
+TEST(QuarticEdgeCases, QuadruplesAndTriples) {
+    // (x - 1)^4, (x - 1)^3 (x + 2): roots within eps^(1/m) of 1, no spurious far roots.
+    for (const auto& c : {std::vector<double>{1, -4, 6, -4, 1}, {-2, 5, -3, -1, 1}}) {
+        double r[4];
+        const int n = solve_quartic(c.data(), r);
+        ASSERT_GE(n, 1);
+        int near_one = 0;
+        for (int k = 0; k < n; ++k) {
+            const bool one = std::abs(r[k] - 1) < 1e-3, minus_two = std::abs(r[k] + 2) < 1e-15;
+            EXPECT_TRUE(one || minus_two) << r[k];
+            near_one += one;
+        }
+        EXPECT_GE(near_one, 1);
     }
 }
 

@@ -1,9 +1,11 @@
 // Closed-form real roots of polynomials of degree <= 4, made robust (see docs/solver.md).
 //
 // Pipeline shared by the three entry points:
-//   1. reject non-finite input; drop negligible leading coefficients (roots "at infinity");
-//      an exactly zero constant term gives the exact root 0 and is divided out;
-//   2. scale x = 2^e y (exact) so the monic polynomial in y has coefficients of order one;
+//   1. reject non-finite input; an exactly zero constant term gives the exact root 0; the
+//      Newton polygon of the coefficients splits the roots into groups of different
+//      magnitude, solved separately; the largest group is dropped when its leading
+//      coefficients are negligible (roots "at infinity");
+//   2. scale x = 2^e y (exact) so each group's monic polynomial has coefficients of order one;
 //   3. closed form in y: stable quadratic formula; cubic = isolated root (trigonometric or
 //      Cardano) + deflated quadratic; quartic = Descartes factorisation into two quadratics
 //      from the largest root of the resolvent cubic;
@@ -14,8 +16,12 @@
 //      the residual, sorting and removal of duplicates.
 #include "geometry/quartic_solver.h"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <utility>
 
 namespace lat {
 namespace {
@@ -26,15 +32,20 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // |p(x)| <= kResidual * eps * sum_k |c_k x^k| means p(x) = 0 up to the rounding of evaluating
 // p at x (Horner for degree 4 is within about 8 eps * sum, half an ulp of x adds <= 2 eps * sum).
 constexpr double kResidual = 32.0;
-// A leading coefficient is dropped when the roots it adds lie beyond 2^kFarLog2 (~1.3e8) times
-// the root radius of the remaining polynomial: they are "at infinity" for the caller, and the
-// remaining roots move by less than 2^-kFarLog2 relative before being polished on the full input.
-constexpr double kFarLog2 = 27.0;
-// Quadratic factors of the cubic/quartic whose discriminant is within kPairDisc of its terms
-// (alpha^2 + 4|beta|) are near-double pairs, settled on the input polynomial: the discriminant's
-// own rounding is far below, and pairs that wide (gap ~ 2e-6 relative) are still far closer
-// than any other root in practice.
-constexpr double kPairDisc = 1e-12;
+// The group of largest roots is dropped ("at infinity") when the leading coefficient is below
+// eps times the largest one and the dropped coefficients change the other roots by less than
+// 2^-kDropLog2 relative, i.e. below the rounding of the coefficients (see solve()).
+constexpr double kDropLog2 = 52.0;
+// A quadratic factor (of a cubic or quartic, scaled so its roots are of order one) whose
+// discriminant is within kPairDisc * (alpha^2 + 4|beta| + |alpha| + 1) of zero is a near-double
+// pair, settled on the input polynomial. The "+ |alpha| + 1" is the absolute rounding of the
+// factorisation (errors ~ eps in the scaled coefficients), which dominates for a pair of roots
+// much smaller than the others. The settlement is exact for any gap, so erring wide is safe.
+constexpr double kPairDisc = 256 * std::numeric_limits<double>::epsilon();
+// Polynomials whose roots span more than 2^kSpreadLog2 in magnitude (Newton polygon) are
+// first split into two factors at the widest gap: a shifted closed form rounds the small
+// roots' information away (the constant term enters the depressed quartic at spread^-4).
+constexpr double kSpreadLog2 = 12.0;
 // A critical point where |p| <= kDouble * eps * sum |c_k x^k| is a double root: the rounding
 // of p there is within that. Pairs further apart are split (see resolve_pair).
 constexpr double kDouble = 8.0;
@@ -43,6 +54,22 @@ constexpr double kCloseGap = 1e-6;
 // Polished roots closer than this (relative) are the same root found twice.
 constexpr double kSameRoot = 1e-13;
 constexpr int kMaxNewton = 16;
+
+// floor(log2 |x|) for finite non-zero x (exact; std::logb is a library call).
+inline int exponent_of(double x) {
+    const int biased = static_cast<int>((std::bit_cast<std::uint64_t>(x) >> 52) & 0x7ff);
+    return biased != 0 ? biased - 1023 : std::ilogb(x);  // subnormals: rare, slow path
+}
+
+// x * 2^e, exact while the result is a normal number (std::ldexp is a library call).
+inline double scale2(double x, int e) {
+    if (e > -1022 && e < 1023) {
+        const double s = std::bit_cast<double>(static_cast<std::uint64_t>(e + 1023) << 52);
+        const double r = x * s;
+        if (r == 0.0 || std::abs(r) >= 0x1p-1022) return r;  // not subnormal: exact
+    }
+    return std::ldexp(x, e);
+}
 
 struct Candidate {
     double x;
@@ -124,7 +151,7 @@ int resolve_pair(const double* c, int n, double m, double lo, double hi, double*
         return 1;
     }
     eval_derivs(c, n, x, dp, ddp);
-    if (!(p * ddp < 0.0)) return 0;
+    if (ddp == 0.0 || (p < 0.0) == (ddp < 0.0)) return 0;  // signs: the product may underflow
     // Two real roots near x -/+ h (quadratic model of p around its critical point).
     const double h = std::sqrt(-2.0 * p / ddp);
     double left = x - h, right = x + h;
@@ -138,28 +165,38 @@ int resolve_pair(const double* c, int n, double m, double lo, double hi, double*
     return k;
 }
 
-// Discriminant b^2 - 4c with the rounding error of b^2 recovered by an FMA.
+// Discriminant b^2 - 4c with the rounding error of b^2 recovered exactly (Dekker's product;
+// std::fma is a slow library call on targets without an FMA instruction).
 inline double discriminant(double b, double c) {
+    constexpr double kSplit = 134217729.0;  // 2^27 + 1
     const double bb = b * b;
-    return (bb - 4.0 * c) + std::fma(b, b, -bb);
+    if (!(std::abs(b) < 1e150)) return bb - 4.0 * c;  // splitting would overflow
+    const double t = kSplit * b, hi = t - (t - b), lo = b - hi;
+    const double err = ((hi * hi - bb) + 2.0 * hi * lo) + lo * lo;
+    return (bb - 4.0 * c) + err;
 }
 
 // Roots of y^2 + b y + c: stable formula (no cancellation: q = -(b + sign(b) sqrt(D)) / 2,
-// roots q and c / q). A discriminant within tol of zero makes a pair centre.
-int quadratic_candidates(double b, double c, double tol, Candidate* out) {
+// roots q and c / q). A discriminant in [-neg_tol, pos_tol] makes a pair centre.
+int quadratic_candidates(double b, double c, double neg_tol, double pos_tol, Candidate* out) {
     const double disc = discriminant(b, c);
-    const double terms = b * b + 4.0 * std::abs(c);
-    if (disc > tol * terms) {
+    if (disc > pos_tol) {
         const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
         out[0] = {q, false};
         out[1] = {q != 0.0 ? c / q : 0.0, false};
         return 2;
     }
-    if (disc >= -tol * terms) {
+    if (disc >= -neg_tol) {
         out[0] = {-0.5 * b, true};
         return 1;
     }
     return 0;
+}
+
+// A quadratic factor y^2 + b y + c of a scaled cubic or quartic (see kPairDisc).
+inline int factor_candidates(double b, double c, Candidate* out) {
+    const double tol = kPairDisc * (b * b + 4.0 * std::abs(c) + std::abs(b) + 1.0);
+    return quadratic_candidates(b, c, tol, tol, out);
 }
 
 // Newton on the monic cubic y^3 + a y^2 + b y + c; stops when the step stops shrinking.
@@ -198,7 +235,7 @@ double cubic_root(double a, double b, double c, bool largest) {
         // the farthest from the others when h <= 0 (otherwise take the mirrored smallest).
         const double m = std::sqrt(-g);
         const double sh = largest ? h : -std::abs(h);
-        const double cos3 = std::fmax(-1.0, std::fmin(1.0, -sh / (m * m * m)));
+        const double cos3 = std::max(-1.0, std::min(1.0, -sh / (m * m * m)));
         z = 2.0 * m * std::cos(std::acos(cos3) / 3.0);
         if (!largest && h > 0.0) z = -z;
     } else {
@@ -216,7 +253,7 @@ int cubic_candidates(double a, double b, double c, Candidate* out) {
     const double e = a + y0;
     const double f = y0 != 0.0 ? -c / y0 : b + e * y0;
     out[0] = {y0, false};
-    return 1 + quadratic_candidates(e, f, kPairDisc, out + 1);
+    return 1 + factor_candidates(e, f, out + 1);
 }
 
 // Candidates of the monic quartic y^4 + a y^3 + b y^2 + c y + d (coefficients of order one).
@@ -245,7 +282,7 @@ int quartic_candidates(double a, double b, double c, double d, Candidate* out) {
     const double terms = s * s + 4.0 * std::abs(r);
     const double diff = std::abs(q) < U * terms
                             ? q / u
-                            : std::copysign(std::sqrt(std::fmax(0.0, s * s - 4.0 * r)), q);
+                            : std::copysign(std::sqrt(std::max(0.0, s * s - 4.0 * r)), q);
     double v = 0.5 * (s - diff), w = 0.5 * (s + diff);
     // v w = r: compute the smaller from the larger (cancellation-free).
     if (std::abs(v) > std::abs(w)) {
@@ -261,32 +298,152 @@ int quartic_candidates(double a, double b, double c, double d, Candidate* out) {
     } else if (be2 != 0.0) {
         be1 = d / be2;
     }
-    int k = quadratic_candidates(al1, be1, kPairDisc, out);
-    k += quadratic_candidates(al2, be2, kPairDisc, out + k);
+    int k = factor_candidates(al1, be1, out);
+    k += factor_candidates(al2, be2, out + k);
     return k;
 }
 
-// Degree after dropping leading coefficients that are zero or negligible (see kFarLog2).
-int effective_degree(const double* c, int n) {
-    while (n > 0) {
-        if (c[n] == 0.0) {
-            --n;
-            continue;
-        }
-        int m = n - 1;
-        while (m >= 0 && c[m] == 0.0) --m;
-        if (m <= 0) return n;  // c_n x^n (+ c_0): nothing to compare the roots with
-        // log2 of the root radius of c_0 + ... + c_m x^m, and of the roots c_n adds.
-        double log_r = -kInf;
-        const double lm = std::logb(std::abs(c[m]));
-        for (int k = 0; k < m; ++k)
-            if (c[k] != 0.0) log_r = std::fmax(log_r, (std::logb(std::abs(c[k])) - lm) / (m - k));
-        if (log_r == -kInf) return n;  // c_n x^n + c_m x^m: same
-        const double log_far = (lm - std::logb(std::abs(c[n]))) / (n - m);
-        if (log_far - log_r < kFarLog2) return n;
-        n = m;
+// Upper convex hull of the points (k, log2 |c_k|) over the non-zero coefficients: its edges
+// (v[i], v[i+1]) give v[i+1] - v[i] roots of magnitude about 2^-slope_i, slopes decreasing.
+int newton_polygon(const double* c, int n, int* v, double* l) {
+    int h = 0;
+    for (int k = 0; k <= n; ++k) {
+        if (c[k] == 0.0) continue;
+        l[k] = static_cast<double>(exponent_of(c[k]));
+        // Pop the last vertex while it lies on or below the chord from the one before to k.
+        while (h >= 2 && (l[v[h - 1]] - l[v[h - 2]]) * (k - v[h - 2]) <=
+                             (l[k] - l[v[h - 2]]) * (v[h - 1] - v[h - 2]))
+            --h;
+        v[h++] = k;
     }
-    return n;
+    return h;
+}
+
+// Closed-form candidates for the roots of c[0] + ... + c[m] x^m (c[0], c[m] != 0), scaled so
+// its root radius is near one. `exact`: the coefficients are the caller's (not a factor's).
+int closed_form(const double* c, int m, bool exact, Candidate* out) {
+    // x = 2^e y with 2^e near the root radius; a[k] = c_k 2^(e k) / (c_m 2^(e m)).
+    static constexpr double kInv[5] = {0.0, 1.0, 0.5, 1.0 / 3.0, 0.25};
+    double log_r = -kInf;
+    const int lm = exponent_of(c[m]);
+    for (int k = 0; k < m; ++k)
+        if (c[k] != 0.0) log_r = std::max(log_r, (exponent_of(c[k]) - lm) * kInv[m - k]);
+    const int e = static_cast<int>(std::floor(log_r + 0.5));
+    const int g = lm + e * m;
+    double a[5] = {0, 0, 0, 0, 0};
+    for (int k = 0; k <= m; ++k) a[k] = scale2(c[k], e * k - g);
+    const double inv = 1.0 / a[m];  // one division; the extra rounding is polished away
+    for (int k = 0; k < m; ++k) a[k] *= inv;
+    int ny = 0;
+    if (m == 1) {
+        out[ny++] = {-a[0], false};
+    } else if (m == 2 && exact) {
+        // Exact coefficients: two roots whenever D > 0; a double root when D is zero up to the
+        // rounding of the scaled coefficients.
+        ny = quadratic_candidates(a[1], a[0], 2.0 * kEps * (a[1] * a[1] + 4.0 * std::abs(a[0])),
+                                  0.0, out);
+    } else if (m == 2) {
+        ny = factor_candidates(a[1], a[0], out);
+    } else if (m == 3) {
+        ny = cubic_candidates(a[2], a[1], a[0], out);
+    } else {
+        ny = quartic_candidates(a[3], a[2], a[1], a[0], out);
+    }
+    for (int k = 0; k < ny; ++k) out[k].x = scale2(out[k].x, e);
+    return ny;
+}
+
+// Solves m x = b in place (size n <= 5) by Gaussian elimination with partial pivoting.
+bool solve_linear(double m[5][5], double* b, int n) {
+    for (int col = 0; col < n; ++col) {
+        int piv = col;
+        for (int r = col + 1; r < n; ++r)
+            if (std::abs(m[r][col]) > std::abs(m[piv][col])) piv = r;
+        if (m[piv][col] == 0.0) return false;
+        for (int k = 0; k < n; ++k) std::swap(m[col][k], m[piv][k]);
+        std::swap(b[col], b[piv]);
+        for (int r = col + 1; r < n; ++r) {
+            const double f = m[r][col] / m[col][col];
+            for (int k = col; k < n; ++k) m[r][k] -= f * m[col][k];
+            b[r] -= f * b[col];
+        }
+    }
+    for (int r = n - 1; r >= 0; --r) {
+        for (int k = r + 1; k < n; ++k) b[r] -= m[r][k] * b[k];
+        b[r] /= m[r][r];
+    }
+    return true;
+}
+
+// Refines p = f q (p of degree n, f monic of degree k holding the k smallest roots, q of degree
+// n - k) by Newton's method on the n + 1 coefficient equations, starting from the two Newton
+// polygon groups. Well conditioned when the groups are far apart (their resultant is large).
+// p is scaled so the gap between the groups is around |x| = 1.
+bool split_factor(const double* p, int n, int k, double* f, double* q) {
+    for (int i = 0; i < k; ++i) f[i] = p[i] / p[k];
+    f[k] = 1.0;
+    for (int l = 0; l <= n - k; ++l) q[l] = p[k + l];
+    double scale = 0.0;
+    for (int j = 0; j <= n; ++j) scale = std::max(scale, std::abs(p[j]));
+    double best = kInf, bf[5], bq[5];
+    for (int it = 0; it < 12; ++it) {
+        double r[5], res = 0.0;
+        for (int j = 0; j <= n; ++j) {
+            double fq = 0.0;
+            for (int i = 0; i <= k; ++i)
+                if (j - i >= 0 && j - i <= n - k) fq += f[i] * q[j - i];
+            r[j] = p[j] - fq;
+            res = std::max(res, std::abs(r[j]));
+        }
+        if (!(res < best)) break;  // stopped improving: keep the best iterate
+        best = res;
+        for (int i = 0; i <= k; ++i) bf[i] = f[i];
+        for (int l = 0; l <= n - k; ++l) bq[l] = q[l];
+        if (res <= kEps * scale) break;
+        double m[5][5] = {};
+        for (int j = 0; j <= n; ++j) {
+            for (int i = 0; i < k; ++i)
+                if (j - i >= 0 && j - i <= n - k) m[j][i] = q[j - i];
+            for (int l = 0; l <= n - k; ++l)
+                if (j - l >= 0 && j - l <= k) m[j][k + l] = f[j - l];
+        }
+        if (!solve_linear(m, r, n + 1)) break;
+        for (int i = 0; i < k; ++i) f[i] += r[i];
+        for (int l = 0; l <= n - k; ++l) q[l] += r[k + l];
+    }
+    for (int i = 0; i <= k; ++i) f[i] = bf[i];
+    for (int l = 0; l <= n - k; ++l) q[l] = bq[l];
+    return best <= 64.0 * kEps * scale && f[0] != 0.0 && q[0] != 0.0 && q[n - k] != 0.0;
+}
+
+// Candidates for the roots of c[0] + ... + c[n] x^n (c[0], c[n] != 0): closed form, after
+// splitting the polynomial into factors when its roots span many orders of magnitude.
+int candidates(const double* c, int n, bool exact, Candidate* out, int depth) {
+    if (n <= 2) return closed_form(c, n, exact, out);  // the stable formula has no spread limit
+    int v[5];
+    double l[5];
+    const int h = newton_polygon(c, n, v, l);
+    const auto slope = [&](int i) { return (l[v[i + 1]] - l[v[i]]) / (v[i + 1] - v[i]); };
+    if (h >= 3 && depth < 3 && slope(0) - slope(h - 2) >= kSpreadLog2) {
+        int best = 1;  // vertex at the widest gap between consecutive magnitude groups
+        for (int i = 2; i + 1 < h; ++i)
+            if (slope(i - 1) - slope(i) > slope(best - 1) - slope(best)) best = i;
+        const int k = v[best];
+        // Scale x = 2^e y with 2^e in the middle of the gap, and normalise the coefficients.
+        const int e = static_cast<int>(std::floor(0.5 - 0.5 * (slope(best - 1) + slope(best))));
+        double a[5] = {0, 0, 0, 0, 0}, f[5] = {0, 0, 0, 0, 0}, q[5] = {0, 0, 0, 0, 0};
+        int g = -100000;
+        for (int j = 0; j <= n; ++j)
+            if (c[j] != 0.0) g = std::max(g, static_cast<int>(l[j]) + e * j);
+        for (int j = 0; j <= n; ++j) a[j] = scale2(c[j], e * j - g);
+        if (split_factor(a, n, k, f, q)) {
+            int nf = candidates(f, k, false, out, depth + 1);
+            nf += candidates(q, n - k, false, out + nf, depth + 1);
+            for (int i = 0; i < nf; ++i) out[i].x = scale2(out[i].x, e);
+            return nf;
+        }
+    }
+    return closed_form(c, n, exact, out);
 }
 
 // Sorts a few values ascending (insertion sort, at most 6 entries).
@@ -300,47 +457,65 @@ void sort_small(T* v, int n, Key key) {
         }
 }
 
+// c0 + c1 x + c2 x^2 with all |c_k| in (1e-150, 1e150) (or zero for c1): no over/underflow in
+// the discriminant, so the stable formula applies directly; Newton checks each root.
+int quadratic_direct(const double* c, double* roots) {
+    const double a = c[2], b = c[1];
+    const double ac4 = 4.0 * a * c[0];
+    const double disc = discriminant(b, 0.25 * ac4);
+    if (disc > 0.0) {
+        const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+        double r0 = q / a, r1 = c[0] / q;
+        if (r1 < r0) std::swap(r0, r1);
+        const double mid = 0.5 * (r0 + r1);
+        roots[0] = polish(c, 2, r0, -kInf, mid);
+        roots[1] = polish(c, 2, r1, mid, kInf);
+        return roots[1] > roots[0] ? 2 : 1;
+    }
+    if (disc >= -2.0 * kEps * (b * b + std::abs(ac4))) {
+        roots[0] = -0.5 * b / a;  // double root: zero discriminant up to rounding
+        return 1;
+    }
+    return 0;
+}
+
 int solve(const double* c, int n_in, double* roots) {
     for (int k = 0; k <= n_in; ++k)
         if (!std::isfinite(c[k])) return 0;
     int top = n_in;  // the polynomial we polish on: the full input
     while (top > 0 && c[top] == 0.0) --top;
-    const int n = effective_degree(c, n_in);
-    if (n <= 0) return 0;
+    if (top <= 0) return 0;
 
     int nr = 0;
     double found[8];
-    int z = 0;  // exact roots at 0, divided out
-    while (c[z] == 0.0) ++z;
-    if (z > 0) found[nr++] = 0.0;
+    int low = 0;  // exact roots at 0 are divided out
+    while (c[low] == 0.0) ++low;
+    if (low > 0) found[nr++] = 0.0;
+    int high = top;
+    // Roots "at infinity": the largest root group is dropped when its leading coefficient is
+    // negligible against the largest coefficient and the gap below it times its root count
+    // reaches kDropLog2 (the dropped coefficients then move the other roots below rounding).
+    double cmax = 0.0;
+    for (int k = 0; k <= top; ++k) cmax = std::max(cmax, std::abs(c[k]));
+    if (std::abs(c[top]) <= kEps * cmax) {
+        int v[5];
+        double l[5];
+        const int h = newton_polygon(c, top, v, l);
+        const auto slope = [&](int i) { return (l[v[i + 1]] - l[v[i]]) / (v[i + 1] - v[i]); };
+        for (int i = 1; i + 1 < h; ++i) {
+            if ((slope(i - 1) - slope(i)) * (v[h - 1] - v[i]) >= kDropLog2) {
+                high = v[i];
+                break;
+            }
+        }
+    }
+    if (high == 2 && low == 0 && std::abs(c[2]) > kEps * cmax && cmax < 1e150 &&
+        std::abs(c[2]) > 1e-150 && std::abs(c[0]) > 1e-150)
+        return quadratic_direct(c, roots);  // the common quadric case, no scaling needed
     Candidate cand[4];
     int nc = 0;
-    const int m = n - z;
-    const double* cz = c + z;
-    if (m >= 1) {
-        // x = 2^e y with 2^e near the root radius; a[k] = c_k 2^(e k) / (c_m 2^(e m)).
-        double log_r = -kInf;
-        const double lm = std::logb(std::abs(cz[m]));
-        for (int k = 0; k < m; ++k)
-            if (cz[k] != 0.0) log_r = std::fmax(log_r, (std::logb(std::abs(cz[k])) - lm) / (m - k));
-        const int e = static_cast<int>(std::lround(log_r));
-        const int g = static_cast<int>(lm) + e * m;
-        double a[5];
-        for (int k = 0; k <= m; ++k) a[k] = std::ldexp(cz[k], e * k - g);
-        for (int k = 0; k < m; ++k) a[k] /= a[m];
-        Candidate y[4];
-        int ny = 0;
-        if (m == 1) {
-            y[ny++] = {-a[0], false};
-        } else if (m == 2) {
-            ny = quadratic_candidates(a[1], a[0], 2.0 * kEps, y);
-        } else if (m == 3) {
-            ny = cubic_candidates(a[2], a[1], a[0], y);
-        } else {
-            ny = quartic_candidates(a[3], a[2], a[1], a[0], y);
-        }
-        for (int k = 0; k < ny; ++k) cand[nc++] = {std::ldexp(y[k].x, e), y[k].pair};
-    }
+    if (high > low) nc = candidates(c + low, high - low, true, cand, 0);
+    const int m = high - low;  // degree of what was solved
     sort_small(cand, nc, [](const Candidate& cd) { return cd.x; });
 
     // Candidates this close are one cluster (a near-double pair, or a triple root split by
@@ -353,7 +528,7 @@ int solve(const double* c, int n_in, double* roots) {
         const int w = cand[i].pair ? 2 : 1;
         if (ncl > 0 && m >= 3 &&
             cand[i].x - cand[i - 1].x <=
-                kCloseGap * std::fmax(std::abs(cand[i].x), std::abs(cand[i - 1].x))) {
+                kCloseGap * std::max(std::abs(cand[i].x), std::abs(cand[i - 1].x))) {
             const int k = mult[ncl - 1];
             centre[ncl - 1] = (centre[ncl - 1] * k + cand[i].x * w) / (k + w);
             mult[ncl - 1] += w;
@@ -372,11 +547,11 @@ int solve(const double* c, int n_in, double* roots) {
             if (is_root(c, top, x)) found[nr++] = x;
         }
     }
-    sort_small(found, nr, [](double v) { return v; });
+    sort_small(found, nr, [](double x) { return x; });
     int out = 0;
     for (int i = 0; i < nr; ++i) {
         if (out > 0 && found[i] - roots[out - 1] <=
-                           kSameRoot * std::fmax(std::abs(found[i]), std::abs(roots[out - 1])))
+                           kSameRoot * std::max(std::abs(found[i]), std::abs(roots[out - 1])))
             continue;  // the same root reached twice
         if (out == n_in) break;
         roots[out++] = found[i];
