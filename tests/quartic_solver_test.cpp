@@ -54,7 +54,7 @@ TEST(QuarticKnownRoots, Accuracy) {
         x[2] = kind == 2 ? u : v;
         x[3] = kind == 1 ? v : w;
     });
-    expect_ok(mult, 1e-9, 8, 10);
+    expect_ok(mult, 1e-9, 8, 30);
     Pair spread("4 real, |x| in 1e-3..1e3", 0.0);
     run(spread, 4, [&](double* x, double*, double*) {
         for (int k = 0; k < 4; ++k) x[k] = rng.sign() * rng.log_uni(-3, 3);
