@@ -25,9 +25,9 @@ namespace {
 using detail::Candidate;
 using detail::candidates;
 using detail::discriminant;
-using detail::newton_polygon;
 using detail::kEps;
 using detail::kInf;
+using detail::newton_polygon;
 
 // |p(x)| <= kResidual * eps * sum_k |c_k x^k| means p(x) = 0 up to the rounding of evaluating
 // p at x (Horner for degree 4 is within about 8 eps * sum, half an ulp of x adds <= 2 eps * sum).
