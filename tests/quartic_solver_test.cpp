@@ -332,6 +332,9 @@ TEST(QuarticEdgeCases, DegenerateInputs) {
     EXPECT_EQ(r[0], 1.0);
     EXPECT_EQ(r[1], 2.0);
     EXPECT_EQ(r[2], 3.0);
+    // Roots beyond the range of doubles are not reported (and do not hide the others).
+    EXPECT_TRUE(quartic({3.4e266, 1.6e-293}).empty());
+    EXPECT_EQ(quartic({0, 0, 0, 1.77e136, 3.5e-264}), std::vector<double>{0.0});
     const double quad[3] = {-1e300, 0, 1e-300};  // x^2 = 1e600
     ASSERT_EQ(solve_quadratic(quad, r), 2);
     EXPECT_DOUBLE_EQ(r[0], -1e300);

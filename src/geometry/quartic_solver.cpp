@@ -238,6 +238,7 @@ int solve(const double* c, int n_in, double* roots) {
     sort_small(found, nr, [](double x) { return x; });
     int out = 0;
     for (int i = 0; i < nr; ++i) {
+        if (!std::isfinite(found[i])) continue;  // beyond the range of doubles
         if (out > 0 && found[i] - roots[out - 1] <=
                            kSameRoot * std::max(std::abs(found[i]), std::abs(roots[out - 1])))
             continue;  // the same root reached twice
