@@ -93,7 +93,9 @@ inline double double_root_radius(const f128* c, int n, double x) {
 // a polynomial within rounding of ref_c, hence valid (used against the solver's own input).
 inline void compare(const double* c, int n, const double* roots, int nr, const f128* ref_c,
                     const RefRoots& ref, Stats& st, double far, bool backward) {
-    const auto scale = [&](double x) { return std::fmax(std::abs(x), st.floor); };
+    const auto scale = [&](double x) {
+        return std::fmax(std::fmax(std::abs(x), st.floor), std::numeric_limits<double>::min());
+    };
     // Pair radius at x: pairs closer than this may be reported once or missed.
     const auto pair_radius = [&](double x) {
         return std::fmax(kPairGap * scale(x), double_root_radius(ref_c, n, x));

@@ -296,6 +296,38 @@ TEST(QuarticLowDegree, QuadraticsAndCubics) {
     expect_ok(c_wide, 1e-13, 4);
 }
 
+// ---- random coefficients of wildly different magnitudes ------------------------------------
+
+TEST(QuarticRandom, WildCoefficients) {
+    // Coefficients u * 10^(-20..20), some exactly zero: root spreads up to ~1e40, the splitting
+    // path (Newton polygon + factor refinement). Against the exact roots of the input only (B);
+    // polynomials where the drop rule may apply (|c_top| <= eps max|c_k|) are skipped.
+    Rng rng(7);
+    Stats b;
+    b.name = "random coefficients 1e+-20";
+    b.floor = 0.0;
+    for (int i = 0; i < 20000; ++i) {
+        double c[5];
+        for (int k = 0; k < 5; ++k)
+            c[k] = rng.uni(0, 1) < 0.05 ? 0.0 : rng.uni(-1, 1) * rng.log_uni(-20, 20);
+        const int n = 2 + i % 3;
+        double cmax = 0.0;
+        for (int k = 0; k <= n; ++k) cmax = std::fmax(cmax, std::abs(c[k]));
+        if (c[n] == 0.0 || std::abs(c[n]) <= kEps * cmax) continue;
+        double roots[4];
+        const int nr = run_solver(c, n, roots);
+        f128 c128[5];
+        for (int k = 0; k <= n; ++k) c128[k] = c[k];
+        ++b.polys;
+        compare(c, n, roots, nr, c128, reference_roots(c128, n), b, kInf, true);
+    }
+    b.print("B");
+    EXPECT_EQ(b.missed, 0) << b.first_bad;
+    EXPECT_EQ(b.spurious, 0) << b.first_bad;
+    EXPECT_EQ(b.lost, 0) << b.first_lost;
+    EXPECT_LE(b.max_cond, 4.0) << b.worst_cond;
+}
+
 // ---- edge cases ------------------------------------------------------------------------------
 
 std::vector<double> quartic(std::initializer_list<double> coeffs) {
