@@ -3,7 +3,7 @@
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
-DEMO_SCENE ?= examples/demo-torus-cut.json
+DEMO_SCENE ?= examples/torus-bite.json
 DEMO_OUT ?= out/demo.png
 
 PACKAGES := cmake make g++ pkg-config libembree-dev libtbb-dev libpng-dev nlohmann-json3-dev \
