@@ -61,7 +61,7 @@ TEST(SceneLoader, ValidSceneLoads) {
     EXPECT_EQ(s.camera.width, 32);
     EXPECT_EQ(s.objects.size(), 5u);
     EXPECT_EQ(s.objects[3].primitive, 0);
-    EXPECT_EQ(s.primitives[0].chain->primitive_count(), 3u);
+    EXPECT_EQ(s.primitives[0].shape->primitive_count(), 3u);
     ASSERT_TRUE(s.primitives[0].lattice.has_value());
     EXPECT_EQ(s.primitives[0].lattice->cells[2], 3);
 }

@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "io/image.h"
 #include "render/renderer.h"
+#include "scene/lattice_tables.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -24,6 +25,10 @@ struct RenderArgs {
     int spp = 1;
     std::string stats;
     std::string mode = "exact";
+    std::string lattice_dir;
+    int sigma_inv = 1;
+    std::string encoding = "hash14";
+    std::string instancing = "auto";
     bool quiet = false;
 };
 
@@ -53,13 +58,27 @@ int run_render(const RenderArgs& a) {
     if (a.threads > 0)
         limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                       static_cast<std::size_t>(a.threads));
+    const bool progress = !a.quiet && ProgressBar::stderr_is_terminal();
     const auto t1 = clock::now();
-    const RenderScene rs(scene);
+    SceneLattices lattices;
+    RenderScene::InstanceShapeFn instance_shape;
+    if (a.mode == "lattice") {
+        const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
+                               !a.lattice_dir.empty());
+        lattices = scene_lattices(scene, cache, a.sigma_inv, a.encoding, progress);
+        instance_shape = [&lattices](int prim) { return lattices.shapes[static_cast<std::size_t>(prim)]; };
+    }
+    const auto t1b = clock::now();
+    AccelOptions accel;
+    accel.instancing = a.instancing == "always"  ? Instancing::kAlways
+                       : a.instancing == "never" ? Instancing::kNever
+                                                 : Instancing::kAuto;
+    const RenderScene rs(scene, instance_shape, accel);
     const auto t2 = clock::now();
 
     RenderOptions opt;
     opt.spp = a.spp;
-    opt.progress = !a.quiet && ProgressBar::stderr_is_terminal();
+    opt.progress = progress;
     const RenderOutput out = render_image(rs, opt);
 
     switch (format) {
@@ -71,11 +90,18 @@ int run_render(const RenderArgs& a) {
 
     const RenderStats& st = out.stats;
     const double load_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
-    const double build_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+    const double tables_ms = std::chrono::duration<double, std::milli>(t1b - t1).count();
+    const double build_ms = std::chrono::duration<double, std::milli>(t2 - t1b).count();
     const double total_ms = std::chrono::duration<double, std::milli>(t3 - t0).count();
     const std::uint64_t rays = st.primary_rays + st.shadow_rays;
     const double mrays = st.render_ms > 0 ? rays / (st.render_ms * 1e3) : 0.0;
     const std::size_t peak = peak_rss_bytes();
+    if (!a.quiet && a.mode == "lattice")
+        std::fprintf(stderr, "lattice: %zu table%s (%s, %s hits), %d built in %.1f s\n",
+                     lattices.paths.size(), lattices.paths.size() == 1 ? "" : "s",
+                     human_bytes(static_cast<double>(lattices.table_bytes)).c_str(),
+                     std::to_string(lattices.table_entries).c_str(), lattices.built,
+                     lattices.build_seconds);
     if (!a.quiet)
         std::fprintf(stderr,
                      "lattice: %s %dx%d, %d spp, %s mode: render %.1f ms on %d threads, "
@@ -96,6 +122,15 @@ int run_render(const RenderArgs& a) {
         j["threads"] = st.threads;
         j["load_ms"] = load_ms;
         j["build_ms"] = build_ms;
+        if (a.mode == "lattice") {
+            j["sigma_inv"] = a.sigma_inv;
+            j["encoding"] = a.encoding;
+            j["tables_ms"] = tables_ms;
+            j["tables_built"] = lattices.built;
+            j["table_bytes"] = lattices.table_bytes;
+            j["table_entries"] = lattices.table_entries;
+            j["table_files"] = lattices.paths;
+        }
         j["render_ms"] = st.render_ms;
         j["total_ms"] = total_ms;
         j["primary_rays"] = st.primary_rays;
@@ -120,8 +155,21 @@ Command add_render_command(CLI::App& parent) {
     c.app->add_option("--spp", args->spp, "Stratified samples per pixel (1 = pixel centre)")
         ->check(CLI::Range(1, 65536));
     c.app->add_option("--stats", args->stats, "Write timing and ray counts as JSON");
-    c.app->add_option("--mode", args->mode, "exact: full ray trace of every primitive")
-        ->check(CLI::IsMember({"exact"}));
+    c.app->add_option("--mode", args->mode,
+                      "exact: full ray trace of every primitive; lattice: instances through their "
+                      "lattice tables (built on first use and cached)")
+        ->check(CLI::IsMember({"exact", "lattice"}));
+    c.app->add_option("--lattice-dir", args->lattice_dir,
+                      "Directory of cached lattice tables (default: $LATTICE_CACHE_DIR, "
+                      "$XDG_CACHE_HOME/lattice or ~/.cache/lattice)");
+    c.app->add_option("--sigma-inv", args->sigma_inv,
+                      "Refine every lattice K times (K x the cells at sigma / K)")
+        ->check(CLI::Range(1, 1 << 20));
+    c.app->add_option("--encoding", args->encoding, "Lattice table encoding (hash14)");
+    c.app->add_option("--instancing", args->instancing,
+                      "Multi-part objects as Embree instances (always), flattened into one "
+                      "hierarchy (never), or flattened unless that would be huge (auto)")
+        ->check(CLI::IsMember({"auto", "always", "never"}));
     c.app->add_flag("-q,--quiet", args->quiet, "No progress bar or summary line");
     c.run = [args] { return run_render(*args); };
     return c;

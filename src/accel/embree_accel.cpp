@@ -20,6 +20,7 @@ struct QueryContext {
     double tmin, tmax;
     AccelHit* hit;
     bool found = false;
+    std::uint32_t self = EmbreeAccel::kNoObject;  // occlusion: the object the ray leaves
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;
@@ -72,6 +73,13 @@ struct EmbreeAccel::Impl {
         if (device) rtcReleaseDevice(device);
     }
 
+    // The start of an occlusion test against object obj (see EmbreeAccel::occluded).
+    double occlusion_tmin(const QueryContext* ctx, std::uint32_t obj, const Ray& local) const {
+        if (obj != ctx->self) return ctx->tmin;
+        const double tol = objects[obj].shape->surface_tolerance();
+        return tol > 0 ? ctx->tmin + tol / length(local.d) : ctx->tmin;
+    }
+
     const Ray& local_ray(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->cached_obj != obj) {
             ctx->cached_obj = obj;
@@ -112,9 +120,10 @@ struct EmbreeAccel::Impl {
         if (!args->valid[0]) return;
         auto* ctx = reinterpret_cast<QueryContext*>(args->context);
         const Impl* self = ctx->accel;
-        const AccelObject& o = self->objects[self->direct[args->primID]];
+        const std::uint32_t obj = self->direct[args->primID];
+        const AccelObject& o = self->objects[obj];
         const Ray local = o.xf->is_identity() ? ctx->ray : o.xf->inverse_ray(ctx->ray);
-        if (o.shape->occluded(local, ctx->tmin, ctx->tmax)) {
+        if (o.shape->occluded(local, self->occlusion_tmin(ctx, obj, local), ctx->tmax)) {
             ctx->found = true;
             reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
         }
@@ -141,8 +150,10 @@ struct EmbreeAccel::Impl {
         const Impl* self = ctx->accel;
         const unsigned inst = args->context->instID[0];
         const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
-        const Ray& local = self->local_ray(ctx, self->inst_object[inst]);
-        if (shape->occluded_primitive(args->primID, local, ctx->tmin, ctx->tmax)) {
+        const std::uint32_t obj = self->inst_object[inst];
+        const Ray& local = self->local_ray(ctx, obj);
+        if (shape->occluded_primitive(args->primID, local, self->occlusion_tmin(ctx, obj, local),
+                                      ctx->tmax)) {
             ctx->found = true;
             reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
         }
@@ -167,7 +178,8 @@ struct EmbreeAccel::Impl {
         const Impl* self = ctx->accel;
         const FlatPrim fp = self->flat[args->primID];
         const Ray& local = self->local_ray(ctx, fp.object);
-        if (self->objects[fp.object].shape->occluded_primitive(fp.part, local, ctx->tmin, ctx->tmax)) {
+        if (self->objects[fp.object].shape->occluded_primitive(
+                fp.part, local, self->occlusion_tmin(ctx, fp.object, local), ctx->tmax)) {
             ctx->found = true;
             reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
         }
@@ -329,13 +341,8 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
     return ctx.found;
 }
 
-bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax) const {
+bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t self) const {
     const Impl& m = *impl_;
-    for (const std::uint32_t i : m.unbounded) {
-        const AccelObject& o = m.objects[i];
-        const Ray local = o.xf->is_identity() ? r : o.xf->inverse_ray(r);
-        if (o.shape->occluded(local, tmin, tmax)) return true;
-    }
     AccelHit unused;
     QueryContext ctx;
     rtcInitIntersectContext(&ctx.rtc);
@@ -344,6 +351,12 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax) const {
     ctx.tmin = tmin;
     ctx.tmax = tmax;
     ctx.hit = &unused;
+    ctx.self = self;
+    for (const std::uint32_t i : m.unbounded) {
+        const AccelObject& o = m.objects[i];
+        const Ray local = o.xf->is_identity() ? r : o.xf->inverse_ray(r);
+        if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) return true;
+    }
 
     alignas(16) RTCRay ray;
     ray.org_x = static_cast<float>(r.o.x);

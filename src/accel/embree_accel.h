@@ -48,8 +48,10 @@ public:
 
     // Closest crossing with tmin < t < tmax, over all objects.
     bool intersect(const Ray& r, double tmin, double tmax, AccelHit& hit) const;
-    // Whether anything is crossed with tmin < t < tmax.
-    bool occluded(const Ray& r, double tmin, double tmax) const;
+    // Whether anything is crossed with tmin < t < tmax. A ray leaving a surface of object
+    // `self` also skips that object's crossings within its surface_tolerance().
+    static constexpr std::uint32_t kNoObject = 0xFFFFFFFFu;
+    bool occluded(const Ray& r, double tmin, double tmax, std::uint32_t self = kNoObject) const;
 
     struct Impl;
 

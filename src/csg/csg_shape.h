@@ -12,6 +12,9 @@ namespace lat {
 
 enum class CsgOp { kUnion, kIntersection, kDifference };
 
+// A leaf tag meaning "no material of its own": the object's material applies.
+inline constexpr std::uint32_t kNoMaterial = 0xFFFFFFFFu;
+
 struct CsgLeaf {
     std::shared_ptr<const Shape> shape;
     Transform xf;           // leaf coordinates -> the CSG object's coordinates
@@ -34,8 +37,9 @@ public:
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
     bool inside(Vec3 p) const override { return inside(root_, p); }
-    std::uint32_t tag(const Crossing& c, std::uint32_t) const override {
-        return leaves_[c.leaf_index()].leaf.tag;
+    std::uint32_t tag(const Crossing& c, std::uint32_t fallback) const override {
+        const std::uint32_t t = leaves_[c.leaf_index()].leaf.tag;
+        return t == kNoMaterial ? fallback : t;
     }
 
 private:

@@ -150,6 +150,7 @@ RasterizeResult rasterize(const Shape& shape, const LatticeGrid& lg, const Raste
         std::vector<RawHit> out;
         const std::uint32_t a_end = std::min(npoints, (blk + 1) * kBlock);
         for (std::uint32_t a = blk * kBlock; a < a_end; ++a) {
+            if (a % opt.entry_stride != 0) continue;
             const GridPoint gp = grid.point(a);
             const std::uint8_t fa = grid.faces(gp);
             const Vec3 p{double(gp.x), double(gp.y), double(gp.z)};

@@ -19,6 +19,8 @@ struct LatticeGrid {
 struct RasterizeOptions {
     bool keep_hits = true;  // false: only count (Table 1)
     bool progress = false;
+    // Trace only every n-th entry point (to estimate a table's size before building it).
+    std::uint32_t entry_stride = 1;
 };
 
 struct RasterizeResult {

@@ -11,7 +11,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "lattice/hash14_table.h"
+#include "lattice/encodings.h"
 #include "util/error.h"
 #include "util/hash.h"
 
@@ -139,12 +139,6 @@ private:
 
 }  // namespace
 
-std::unique_ptr<LatticeTable> make_table(const std::string& encoding, const std::uint8_t* payload,
-                                         std::size_t size, std::uint64_t entries) {
-    if (encoding == "hash14") return std::make_unique<Hash14Table>(payload, size, entries);
-    throw std::runtime_error("unknown table encoding '" + encoding + "'");
-}
-
 void write_table_file(const std::string& path, const TableHeader& h0,
                       const std::vector<std::uint8_t>& payload) {
     TableHeader h = h0;
@@ -209,7 +203,7 @@ LoadedTable load_table_file(const std::string& path, const TableHeader* expected
     if (hash_bytes(payload, h.payload_bytes) != checksum)
         throw InputError(path + ": not a valid lattice table: payload checksum mismatch (corrupt)");
     try {
-        out.table = std::make_shared<MappedTable>(m, make_table(h.encoding, payload, h.payload_bytes, h.entries));
+        out.table = std::make_shared<MappedTable>(m, open_table(h.encoding, payload, h.payload_bytes, h.entries));
     } catch (const std::exception& e) {
         throw InputError(path + ": not a valid lattice table: " + e.what());
     }

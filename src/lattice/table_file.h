@@ -47,8 +47,4 @@ TableHeader read_table_header(const std::string& path);
 // geometry and fingerprint (a table built for another primitive is rejected).
 LoadedTable load_table_file(const std::string& path, const TableHeader* expected = nullptr);
 
-// The table object for an encoding's payload (which must outlive it).
-std::unique_ptr<LatticeTable> make_table(const std::string& encoding, const std::uint8_t* payload,
-                                         std::size_t size, std::uint64_t entries);
-
 }  // namespace lat

@@ -27,8 +27,10 @@ public:
                          const AccelOptions& accel = {});
 
     bool intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const;
-    bool occluded(const Ray& r, double tmin, double tmax) const {
-        return accel_->occluded(r, tmin, tmax);
+    // `self`: the object whose surface the ray leaves (see EmbreeAccel::occluded).
+    bool occluded(const Ray& r, double tmin, double tmax,
+                  std::uint32_t self = EmbreeAccel::kNoObject) const {
+        return accel_->occluded(r, tmin, tmax, self);
     }
 
     const Scene& scene() const { return scene_; }

@@ -22,7 +22,7 @@ Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCo
         const Vec3 l = to_light / dist;
         if (s.shadows) {
             ++counters.shadow_rays;
-            if (rs.occluded({hit.p, l}, eps, dist * (1 - 1e-12))) continue;
+            if (rs.occluded({hit.p, l}, eps, dist * (1 - 1e-12), hit.object)) continue;
         }
         const double nl = dot(n, l);
         const Vec3 r = 2 * nl * n - l;

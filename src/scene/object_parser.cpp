@@ -139,7 +139,7 @@ ObjectParser::Leaf ObjectParser::parse_leaf(const JsonValue& v, const std::strin
         const std::string name = p.string();
         for (std::size_t i = 0; i < primitives_.size(); ++i)
             if (primitives_[i].name == name)
-                return {primitives_[i].chain, Transform{}, static_cast<int>(i)};
+                return {primitives_[i].shape, Transform{}, static_cast<int>(i)};
         std::string known;
         for (const Primitive& q : primitives_) known += (known.empty() ? "" : ", ") + q.name;
         p.fail("unknown primitive '" + name + "'" +
@@ -176,6 +176,8 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
         return csg.add_node(cop, std::move(refs));
     }
 
+    if (type == "instance" && override_material == kNoMaterial)
+        v.at("type").fail("a primitive cannot contain instances");
     Leaf leaf = parse_leaf(v, type);
     std::uint32_t mat;
     if (override_material) {
@@ -187,6 +189,13 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
     }
     if (override_material && v.has("material")) (void)material(v.at("material"));  // still check
     return csg.add_leaf({leaf.shape, xf * leaf.placement, mat});
+}
+
+std::shared_ptr<const Shape> ObjectParser::parse_shape(const JsonValue& v) const {
+    if (!v.is_object()) v.fail("expected an object");
+    auto csg = std::make_shared<CsgShape>();
+    csg->set_root(add_csg(*csg, v, Transform{}, kNoMaterial));
+    return csg;
 }
 
 SceneObject ObjectParser::parse(const JsonValue& v) const {

@@ -17,6 +17,9 @@ public:
                  const std::vector<Primitive>& primitives);
 
     SceneObject parse(const JsonValue& v) const;
+    // The solid alone, materials ignored (for primitives given as an object; instances of
+    // them take the instance's material).
+    std::shared_ptr<const Shape> parse_shape(const JsonValue& v) const;
 
 private:
     const std::map<std::string, std::uint32_t>& materials_;

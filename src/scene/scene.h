@@ -35,11 +35,13 @@ struct LatticeSpec {
     std::array<int, 3> cells{1, 1, 1};
 };
 
-// A named small object that instances refer to (paper: the lattice primitive).
+// A named small object that instances refer to (paper: the lattice primitive): a chain of
+// spheres and cylinders, or any object (quartic, CSG) given as "object".
 struct Primitive {
     std::string name;
     std::string where;  // e.g. "primitives.hair", for messages
-    std::shared_ptr<const ChainShape> chain;
+    std::shared_ptr<const Shape> shape;
+    std::uint64_t fingerprint = 0;  // of the geometry as written, to key lattice tables
     std::optional<LatticeSpec> lattice;
 };
 

@@ -6,6 +6,7 @@
 #include "scene/object_parser.h"
 #include "util/error.h"
 #include "util/file.h"
+#include "util/hash.h"
 
 namespace lat {
 namespace {
@@ -49,11 +50,9 @@ Material parse_material(const JsonValue& v, const std::string& name) {
 
 }  // namespace
 
-Primitive parse_primitive(const JsonValue& v, const std::string& name) {
-    v.allow_keys({"spheres", "cylinders", "lattice"});
-    Primitive p;
-    p.name = name;
-    p.where = v.path();
+namespace {
+
+std::shared_ptr<const Shape> parse_chain(const JsonValue& v) {
     std::vector<ChainSphere> spheres;
     const JsonValue sv = v.at("spheres");
     if (sv.size() == 0) sv.fail("a primitive needs at least one sphere");
@@ -81,7 +80,29 @@ Primitive parse_primitive(const JsonValue& v, const std::string& name) {
             cylinders.push_back({a, b, c[2].positive()});
         }
     }
-    p.chain = std::make_shared<ChainShape>(std::move(spheres), std::move(cylinders));
+    return std::make_shared<ChainShape>(std::move(spheres), std::move(cylinders));
+}
+
+}  // namespace
+
+Primitive parse_primitive(const JsonValue& v, const std::string& name, const ObjectParser* objects) {
+    v.allow_keys({"spheres", "cylinders", "object", "lattice"});
+    Primitive p;
+    p.name = name;
+    p.where = v.path();
+    Fingerprint fp;
+    if (auto obj = v.find("object")) {
+        if (v.has("spheres") || v.has("cylinders"))
+            v.fail("a primitive is either spheres and cylinders or an object, not both");
+        if (!objects) obj->fail("objects are not allowed as primitives here");
+        p.shape = objects->parse_shape(*obj);
+        fp.add("object").add(obj->raw().dump());
+    } else {
+        p.shape = parse_chain(v);
+        fp.add("chain").add(v.at("spheres").raw().dump());
+        if (auto c = v.find("cylinders")) fp.add(c->raw().dump());
+    }
+    p.fingerprint = fp.value();
     if (auto lv = v.find("lattice")) {
         lv->allow_keys({"sigma", "cells"});
         LatticeSpec spec;
@@ -133,13 +154,13 @@ Scene load_scene_text(const std::string& text, const std::string& file) {
             s.materials.push_back(parse_material(mats->at(name), name));
         }
     }
+    const ObjectParser parser(material_index, s.primitives);
     if (auto prims = root.find("primitives")) {
         if (!prims->is_object()) prims->fail("expected an object of named primitives");
         for (const std::string& name : prims->keys())
-            s.primitives.push_back(parse_primitive(prims->at(name), name));
+            s.primitives.push_back(parse_primitive(prims->at(name), name, &parser));
     }
     const JsonValue objects = root.at("objects");
-    const ObjectParser parser(material_index, s.primitives);
     for (std::size_t i = 0; i < objects.size(); ++i) s.objects.push_back(parser.parse(objects[i]));
     return s;
 }

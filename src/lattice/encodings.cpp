@@ -1,0 +1,38 @@
+#include "lattice/encodings.h"
+
+#include <stdexcept>
+
+#include "lattice/hash14_table.h"
+#include "util/error.h"
+
+namespace lat {
+
+const std::vector<EncodingInfo>& table_encodings() {
+    static const std::vector<EncodingInfo> list = {
+        {"hash14", "the paper's hash table, 14-byte entries with key and overflow chain",
+         Hash14Table::kMaxPoints, 15.0},
+    };
+    return list;
+}
+
+const EncodingInfo& encoding_info(const std::string& name) {
+    std::string known;
+    for (const EncodingInfo& e : table_encodings()) {
+        if (e.name == name) return e;
+        known += (known.empty() ? "" : ", ") + e.name;
+    }
+    throw InputError("unknown table encoding '" + name + "' (known: " + known + ")");
+}
+
+std::vector<std::uint8_t> encode_table(const std::string& encoding, const RasterizeResult& r) {
+    if (encoding == "hash14") return Hash14Table::build(r.raw);
+    throw std::invalid_argument("encode_table: unknown encoding " + encoding);
+}
+
+std::unique_ptr<LatticeTable> open_table(const std::string& encoding, const std::uint8_t* payload,
+                                         std::size_t size, std::uint64_t entries) {
+    if (encoding == "hash14") return std::make_unique<Hash14Table>(payload, size, entries);
+    throw std::runtime_error("unknown table encoding '" + encoding + "'");
+}
+
+}  // namespace lat

@@ -1,0 +1,221 @@
+#include "scene/lattice_tables.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include "lattice/boundary_grid.h"
+#include "lattice/encodings.h"
+#include "lattice/lattice_shape.h"
+#include "util/error.h"
+#include "util/hash.h"
+#include "util/memory.h"
+
+namespace lat {
+namespace {
+
+constexpr int kMaxSigmaInv = 1 << 20;
+
+std::string where(const Primitive& p, const std::string& file) {
+    return located_message(file, p.where, "");
+}
+
+LatticeGrid grid_of(const TableHeader& h) { return {h.cells, h.cell}; }
+
+}  // namespace
+
+TableHeader lattice_header(const Primitive& p, int sigma_inv, const std::string& encoding,
+                           const std::string& scene_file) {
+    if (!p.lattice)
+        throw InputError(where(p, scene_file) + "primitive '" + p.name +
+                         "' has no lattice (add \"lattice\": {\"sigma\": ..., \"cells\": [...]})");
+    if (sigma_inv < 1 || sigma_inv > kMaxSigmaInv)
+        throw InputError("--sigma-inv " + std::to_string(sigma_inv) + ": must be between 1 and " +
+                         std::to_string(kMaxSigmaInv));
+    TableHeader h;
+    h.encoding = encoding_info(encoding).name;
+    h.sigma = p.lattice->sigma;
+    h.sigma_inv = sigma_inv;
+    h.cell = p.lattice->sigma / sigma_inv;
+    for (std::size_t a = 0; a < 3; ++a) {
+        const long long n = static_cast<long long>(p.lattice->cells[a]) * sigma_inv;
+        h.cells[a] = static_cast<int>(std::min<long long>(n, 0x7FFFFFFF));
+    }
+    h.fingerprint = Fingerprint()
+                        .add(p.fingerprint)
+                        .add(h.sigma)
+                        .add(h.cells[0])
+                        .add(h.cells[1])
+                        .add(h.cells[2])
+                        .add(sigma_inv)
+                        .add(h.encoding)
+                        .add(kRasterizerVersion)
+                        .value();
+    return h;
+}
+
+void check_table_buildable(const Primitive& p, int sigma_inv, const std::string& encoding,
+                           const std::string& scene_file) {
+    const TableHeader h = lattice_header(p, sigma_inv, encoding, scene_file);
+    const std::string at = where(p, scene_file);
+    // The primitive must lie in its box: the table cannot see what sticks out.
+    const Bounds3 b = p.shape->bounds();
+    const double X = p.lattice->cells[0] * p.lattice->sigma, Y = p.lattice->cells[1] * p.lattice->sigma,
+                 Z = p.lattice->cells[2] * p.lattice->sigma;
+    const double tol = 1e-9 * std::max({X, Y, Z});
+    if (!b.finite() || b.lo.x < -tol || b.lo.y < -tol || b.lo.z < -tol || b.hi.x > X + tol ||
+        b.hi.y > Y + tol || b.hi.z > Z + tol) {
+        char buf[256];
+        std::snprintf(buf, sizeof buf,
+                      "primitive '%s' reaches outside its lattice box [0, %g] x [0, %g] x [0, %g] "
+                      "(its bounds are [%g, %g] x [%g, %g] x [%g, %g])",
+                      p.name.c_str(), X, Y, Z, b.lo.x, b.hi.x, b.lo.y, b.hi.y, b.lo.z, b.hi.z);
+        throw InputError(at + buf);
+    }
+    // Sizes, in floating point so that absurd refinements cannot overflow.
+    const long double nx = h.cells[0], ny = h.cells[1], nz = h.cells[2];
+    const long double yz = (ny + 1) * (nz + 1), zx = (nz + 1) * (nx + 1), xy = (nx + 1) * (ny + 1);
+    const long double pairs = 8 * (xy * yz + yz * zx + zx * xy) + 2 * (xy * xy + yz * yz + zx * zx);
+    const long double points = 2 * (xy + yz + zx);  // an upper bound (edges counted twice)
+    const EncodingInfo& enc = encoding_info(encoding);
+    const std::string size = std::to_string(h.cells[0]) + " x " + std::to_string(h.cells[1]) +
+                             " x " + std::to_string(h.cells[2]) + " cells (sigma^-1 = " +
+                             std::to_string(sigma_inv) + ")";
+    const double avail = static_cast<double>(available_memory_bytes());
+    auto refuse = [&](double hit_rate, double bytes) {
+        char buf[512];
+        std::snprintf(buf, sizeof buf,
+                      "the %s table of primitive '%s' at %s would need about %s (%.3Lg point "
+                      "pairs, %.0f %% of them hits, %.1f bytes per hit while building), more than "
+                      "the %s of memory available",
+                      encoding.c_str(), p.name.c_str(), size.c_str(), human_bytes(bytes).c_str(),
+                      pairs, hit_rate * 100, enc.bytes_per_hit + sizeof(RawHit),
+                      human_bytes(avail).c_str());
+        throw InputError(at + buf);
+    };
+    const double per_hit = enc.bytes_per_hit + sizeof(RawHit);
+    // Even a 1 % hit rate is too much: refuse without tracing anything.
+    if (avail > 0 && static_cast<double>(pairs) * 0.01 * per_hit > 0.8 * avail)
+        refuse(0.01, static_cast<double>(pairs) * 0.01 * per_hit);
+    if (points >= static_cast<long double>(0xFFFFFFFFu))
+        throw InputError(at + "a lattice of " + size + " has too many boundary points to index");
+    const BoundaryGrid grid(h.cells);
+    if (grid.count() > enc.max_points)
+        throw InputError(at + "the " + encoding + " encoding keys at most " +
+                         std::to_string(enc.max_points) + " boundary points; a lattice of " + size +
+                         " has " + std::to_string(grid.count()));
+    // Estimate the hit rate by tracing every n-th entry point.
+    RasterizeOptions opt;
+    opt.keep_hits = false;
+    opt.entry_stride = std::max<std::uint32_t>(1, grid.count() / 512);
+    const RasterizeResult sample = rasterize(*p.shape, grid_of(h), opt);
+    const double rate = sample.pairs_traced ? double(sample.hits) / double(sample.pairs_traced) : 0.0;
+    const double need = static_cast<double>(pairs) * rate * per_hit;
+    if (avail > 0 && need > 0.8 * avail) refuse(rate, need);
+}
+
+TableBuild build_table_file(const Primitive& p, int sigma_inv, const std::string& encoding,
+                            const std::string& path, const std::string& scene_file, bool progress) {
+    check_table_buildable(p, sigma_inv, encoding, scene_file);
+    TableBuild b;
+    b.header = lattice_header(p, sigma_inv, encoding, scene_file);
+    RasterizeOptions opt;
+    opt.progress = progress;
+    b.raster = rasterize(*p.shape, grid_of(b.header), opt);
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<std::uint8_t> payload = encode_table(encoding, b.raster);
+    b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    b.raster.raw.clear();
+    b.raster.raw.shrink_to_fit();
+    b.header.pairs = b.raster.pairs_eq2;
+    b.header.entries = b.raster.hits;
+    write_table_file(path, b.header, payload);
+    b.bytes = payload.size() + kTableHeaderBytes;
+    return b;
+}
+
+std::string default_cache_dir() {
+    if (const char* d = std::getenv("LATTICE_CACHE_DIR"); d && *d) return d;
+    if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/lattice";
+    if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/lattice";
+    return ".lattice-cache";
+}
+
+TableCache::TableCache(const std::string& dir, bool explicit_dir) : dir_(dir) {
+    struct stat st {};
+    if (::stat(dir_.c_str(), &st) != 0) {
+        if (explicit_dir)
+            throw InputError(dir_ + ": lattice cache directory does not exist: " + std::strerror(errno));
+        std::error_code ec;
+        std::filesystem::create_directories(dir_, ec);
+        if (ec) throw InputError(dir_ + ": cannot create the lattice cache directory: " + ec.message());
+    } else if (!S_ISDIR(st.st_mode)) {
+        throw InputError(dir_ + ": lattice cache is not a directory");
+    }
+    if (::access(dir_.c_str(), R_OK | W_OK | X_OK) != 0)
+        throw InputError(dir_ + ": lattice cache directory is not readable and writable: " +
+                         std::strerror(errno));
+}
+
+std::string TableCache::path_for(const Primitive& p, int sigma_inv, const std::string& encoding,
+                                 const std::string& scene_file) const {
+    const TableHeader h = lattice_header(p, sigma_inv, encoding, scene_file);
+    std::string safe;
+    for (char c : p.name) safe += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
+    char tail[64];
+    std::snprintf(tail, sizeof tail, "-s%d-%s-%016llx.lht", sigma_inv, encoding.c_str(),
+                  static_cast<unsigned long long>(h.fingerprint));
+    return dir_ + "/" + safe.substr(0, 64) + tail;
+}
+
+TableCache::Entry TableCache::get(const Primitive& p, int sigma_inv, const std::string& encoding,
+                                  const std::string& scene_file, bool progress) const {
+    Entry e;
+    e.path = path_for(p, sigma_inv, encoding, scene_file);
+    const TableHeader expected = lattice_header(p, sigma_inv, encoding, scene_file);
+    struct stat st {};
+    if (::stat(e.path.c_str(), &st) != 0) {
+        const auto t0 = std::chrono::steady_clock::now();
+        build_table_file(p, sigma_inv, encoding, e.path, scene_file, progress);
+        e.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        e.built = true;
+    }
+    try {
+        LoadedTable lt = load_table_file(e.path, &expected);
+        e.table = lt.table;
+        e.header = lt.header;
+    } catch (const InputError& err) {
+        throw InputError(std::string(err.what()) + " (delete the file to rebuild it)");
+    }
+    return e;
+}
+
+SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, int sigma_inv,
+                             const std::string& encoding, bool progress) {
+    SceneLattices out;
+    out.shapes.resize(scene.primitives.size());
+    std::vector<bool> used(scene.primitives.size(), false);
+    for (const SceneObject& o : scene.objects)
+        if (o.primitive >= 0) used[static_cast<std::size_t>(o.primitive)] = true;
+    for (std::size_t i = 0; i < scene.primitives.size(); ++i) {
+        if (!used[i]) continue;
+        const Primitive& p = scene.primitives[i];
+        const TableCache::Entry e = cache.get(p, sigma_inv, encoding, scene.file, progress);
+        out.shapes[i] = std::make_shared<LatticeShape>(e.table, e.header.cells, e.header.cell);
+        out.table_bytes += e.table->bytes();
+        out.table_entries += e.table->entries();
+        out.built += e.built ? 1 : 0;
+        out.build_seconds += e.build_seconds;
+        out.paths.push_back(e.path);
+    }
+    return out;
+}
+
+}  // namespace lat
