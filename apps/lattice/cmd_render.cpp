@@ -32,19 +32,6 @@ struct RenderArgs {
     bool quiet = false;
 };
 
-void write_stats(const std::string& path, const nlohmann::json& j) {
-    const std::string tmp = path + ".tmp";
-    {
-        std::ofstream f(tmp);
-        f << j.dump(2) << "\n";
-        if (!f) throw InputError(path + ": cannot write statistics");
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw InputError(path + ": cannot write statistics");
-    }
-}
-
 int run_render(const RenderArgs& a) {
     using clock = std::chrono::steady_clock;
     const auto t0 = clock::now();
@@ -54,10 +41,7 @@ int run_render(const RenderArgs& a) {
     if (!a.stats.empty()) check_writable(a.stats);
 
     const Scene scene = load_scene(a.scene);
-    std::unique_ptr<tbb::global_control> limit;
-    if (a.threads > 0)
-        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                      static_cast<std::size_t>(a.threads));
+    const auto limit = limit_threads(a.threads);
     const bool progress = !a.quiet && ProgressBar::stderr_is_terminal();
     const auto t1 = clock::now();
     SceneLattices lattices;
@@ -137,7 +121,7 @@ int run_render(const RenderArgs& a) {
         j["shadow_rays"] = st.shadow_rays;
         j["rays_per_second"] = mrays * 1e6;
         j["peak_memory_bytes"] = peak;
-        write_stats(a.stats, j);
+        write_json_file(a.stats, j);
     }
     return 0;
 }

@@ -4,6 +4,10 @@
 // lat::InputError (exit code 2).
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <tbb/global_control.h>
 
 namespace lat::cli {
 
@@ -13,5 +17,13 @@ struct Command {
 };
 
 Command add_render_command(CLI::App& parent);
+Command add_rasterize_command(CLI::App& parent);
+Command add_table1_command(CLI::App& parent);
+Command add_compare_command(CLI::App& parent);
+
+// Caps oneTBB (and so Embree's builds) at n threads for the object's lifetime; 0 = all cores.
+std::unique_ptr<tbb::global_control> limit_threads(int n);
+// Writes JSON atomically (temporary + rename); throws InputError naming the path.
+void write_json_file(const std::string& path, const nlohmann::json& j);
 
 }  // namespace lat::cli

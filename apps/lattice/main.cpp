@@ -14,6 +14,9 @@ int main(int argc, char** argv) {
 
     std::vector<lat::cli::Command> commands;
     commands.push_back(lat::cli::add_render_command(app));
+    commands.push_back(lat::cli::add_rasterize_command(app));
+    commands.push_back(lat::cli::add_table1_command(app));
+    commands.push_back(lat::cli::add_compare_command(app));
 
     try {
         app.parse(argc, argv);

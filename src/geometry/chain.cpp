@@ -21,13 +21,6 @@ const Shape& ChainShape::part(std::size_t i) const {
 
 Bounds3 ChainShape::primitive_bounds(std::size_t i) const { return part(i).bounds(); }
 
-bool ChainShape::intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
-                                     Crossing& hit) const {
-    if (!part(i).intersect(r, tmin, tmax, hit)) return false;
-    hit.part = static_cast<std::uint32_t>(i << 2) | hit.part;
-    return true;
-}
-
 void ChainShape::primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
     if (i < sphere_parts_.size()) {
         out.push_back({sphere_parts_[i].center(), sphere_parts_[i].radius()});

@@ -39,8 +39,15 @@ public:
     Bounds3 primitive_bounds(std::size_t i, const Transform& xf) const override {
         return part(i).placed_bounds(xf);
     }
+    // Inline and through the parts' concrete types: the rasterizer's innermost call.
     bool intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
-                             Crossing& hit) const override;
+                             Crossing& hit) const override {
+        const bool found = i < sphere_parts_.size()
+                               ? sphere_parts_[i].intersect(r, tmin, tmax, hit)
+                               : cyl_parts_[i - sphere_parts_.size()].intersect(r, tmin, tmax, hit);
+        if (found) hit.part = static_cast<std::uint32_t>(i << 2) | hit.part;
+        return found;
+    }
     void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
     bool occluded_primitive(std::size_t i, const Ray& r, double tmin, double tmax) const override {
         return part(i).occluded(r, tmin, tmax);

@@ -24,7 +24,7 @@ const EncodingInfo& encoding_info(const std::string& name) {
     throw InputError("unknown table encoding '" + name + "' (known: " + known + ")");
 }
 
-std::vector<std::uint8_t> encode_table(const std::string& encoding, const RasterizeResult& r) {
+ByteBuffer encode_table(const std::string& encoding, const RasterizeResult& r) {
     if (encoding == "hash14") return Hash14Table::build(r.raw);
     throw std::invalid_argument("encode_table: unknown encoding " + encoding);
 }

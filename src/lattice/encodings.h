@@ -9,6 +9,7 @@
 
 #include "lattice/rasterizer.h"
 #include "lattice/table.h"
+#include "util/big_buffer.h"
 
 namespace lat {
 
@@ -23,7 +24,7 @@ const std::vector<EncodingInfo>& table_encodings();
 // Throws InputError listing the known encodings when `name` is not one.
 const EncodingInfo& encoding_info(const std::string& name);
 
-std::vector<std::uint8_t> encode_table(const std::string& encoding, const RasterizeResult& r);
+ByteBuffer encode_table(const std::string& encoding, const RasterizeResult& r);
 // The table over a payload (which must outlive it); throws std::runtime_error if inconsistent.
 std::unique_ptr<LatticeTable> open_table(const std::string& encoding, const std::uint8_t* payload,
                                          std::size_t size, std::uint64_t entries);

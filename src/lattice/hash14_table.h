@@ -5,13 +5,13 @@
 //   normal     : 2 x 16 bits  octahedral encoding (angle error below 0.01 degrees)
 //   next       : 32 bits      overflow chain: index of the next entry, or none
 // Buckets are the first M entries (M = N/2 for N hits); colliding entries go to the overflow
-// area, each bucket's chain contiguous. The point lies exactly on the segment, so its error is
+// area, linked from their bucket. The point lies exactly on the segment, so its error is
 // at most |p_o - p_i| / 131070 (below 0.001 cells for the hair at sigma^-1 = 4).
 #include <cstdint>
-#include <span>
 #include <vector>
 
 #include "lattice/table.h"
+#include "util/big_buffer.h"
 
 namespace lat {
 
@@ -30,8 +30,9 @@ public:
     static constexpr std::uint32_t kMaxPoints = 0xFFFF;  // id 0xFFFF marks an empty bucket
     static constexpr std::uint32_t kEnd = 0xFFFFFFFFu;
 
-    // From rasterized hits (any order); every id must be below kMaxPoints.
-    static std::vector<std::uint8_t> build(std::span<const RawHit> hits);
+    // From rasterized hits; every id must be below kMaxPoints. Parallel; the payload does not
+    // depend on the thread count.
+    static ByteBuffer build(const RawHits& hits);
     // Over a payload made by build (owned or memory-mapped; it must outlive the table).
     Hash14Table(const std::uint8_t* payload, std::size_t size, std::uint64_t entries);
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "geometry/chain.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/octahedral.h"
 #include "util/progress.h"
@@ -17,10 +18,50 @@ namespace {
 constexpr std::uint32_t kBlock = 32;  // entry points per task
 
 struct FaceLayout {
-    int axis, level, ua, va, nu, nv;  // nu, nv: points along u and v
-    std::vector<std::uint8_t> mask;    // faces of each point
+    int axis, level, ua, va, nu, nv;      // nu, nv: points along u and v
+    std::vector<std::uint8_t> mask;       // faces of each point
     std::vector<std::uint8_t> canonical;  // 1 where this face is the point's lowest face
     std::vector<std::uint32_t> ids;
+};
+
+struct PartSphere {
+    Vec3 c;  // lattice units
+    double r;
+    std::uint32_t part;
+};
+
+struct Counts {
+    std::uint64_t enumerated = 0, traced = 0, hits = 0, counted = 0, tests = 0;
+};
+
+// Per-thread output: hits go into large huge-page buffers; a block's hits stay contiguous.
+class HitArena {
+public:
+    static constexpr std::size_t kHits = std::size_t{4} << 20;  // 64 MB per buffer
+
+    void begin_block() { block_start_ = used_; }
+    void push(const RawHit& h) {
+        if (used_ == cap_) grow();
+        cur_[used_++] = h;
+    }
+    std::span<const RawHit> end_block() const { return {cur_ + block_start_, used_ - block_start_}; }
+    std::vector<std::shared_ptr<const ByteBuffer>>& buffers() { return buffers_; }
+
+private:
+    std::vector<std::shared_ptr<const ByteBuffer>> buffers_;
+    RawHit* cur_ = nullptr;
+    std::size_t used_ = 0, cap_ = 0, block_start_ = 0;
+
+    void grow() {
+        // Move the unfinished block to the new buffer so that it stays in one piece.
+        const std::size_t partial = used_ - block_start_;
+        const std::size_t cap = std::max(kHits, 2 * partial);
+        auto buf = std::make_shared<ByteBuffer>(cap * sizeof(RawHit));
+        auto* next = reinterpret_cast<RawHit*>(buf->data());
+        std::copy(cur_ + block_start_, cur_ + used_, next);
+        buffers_.push_back(buf);
+        cur_ = next, cap_ = cap, used_ = partial, block_start_ = 0;
+    }
 };
 
 struct Scratch {
@@ -28,7 +69,8 @@ struct Scratch {
     std::vector<Crossing> best_c;
     std::vector<std::uint32_t> tested;  // generation of the last part tested at each point
     std::uint32_t generation = 0;
-    std::vector<std::size_t> touched;   // face points with a hit, to emit and reset
+    std::vector<std::size_t> touched;  // face points with a hit, to emit and reset
+    HitArena arena;
 };
 
 // The face-grid rectangle that can hold exits of segments from p that meet the box b: the
@@ -58,12 +100,6 @@ void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& 
     v1 = static_cast<int>(std::floor(std::min(vmax + eps, double(v1))));
 }
 
-struct PartSphere {
-    Vec3 c;  // lattice units
-    double r;
-    std::uint32_t part;
-};
-
 // Row v of face f: the u-interval of exits q whose segment from p can meet the sphere (c, r),
 // i.e. q inside the cone from p around the sphere. Conservative (padded against rounding);
 // returns false for an empty interval.
@@ -72,7 +108,7 @@ bool cone_row(const Vec3& p, const PartSphere& s, const FaceLayout& f, int v, do
     const auto ax = static_cast<std::size_t>(f.axis), ua = static_cast<std::size_t>(f.ua),
                va = static_cast<std::size_t>(f.va);
     const Vec3 w = s.c - p;
-    const double k = length_squared(w) - s.r * s.r;  // |w|^2 cos^2(half angle) * ...
+    const double k = length_squared(w) - s.r * s.r;
     const double da = f.level - p[ax], dv = v - p[va];
     const double alpha = da * w[ax] + dv * w[va], beta = w[ua];
     const double gamma = da * da + dv * dv;
@@ -93,19 +129,79 @@ bool cone_row(const Vec3& p, const PartSphere& s, const FaceLayout& f, int v, do
     return true;
 }
 
-}  // namespace
+// Everything about the lattice that does not depend on the entry point.
+class Tracer {
+public:
+    Tracer(const Shape& shape, const LatticeGrid& lg) : grid_(lg.cells), h_(lg.cell) {
+        for (int f = 0; f < 6; ++f) layout_face(f, lg);
+        count_sums();
+        // The parts as bounding spheres in lattice units, grouped by part, padded beyond the
+        // parts' touch tolerance so culling never drops a touching hit.
+        for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
+            std::vector<BoundingSphere> bs;
+            shape.primitive_spheres(i, bs);
+            for (const BoundingSphere& b : bs)
+                spheres_.push_back({b.center / h_, b.radius / h_ * (1 + 1e-6) + 1e-9,
+                                    static_cast<std::uint32_t>(i)});
+        }
+    }
 
-RasterizeResult rasterize(const Shape& shape, const LatticeGrid& lg, const RasterizeOptions& opt) {
-    const auto start = std::chrono::steady_clock::now();
-    const BoundaryGrid grid(lg.cells);
-    const double h = lg.cell;
+    const BoundaryGrid& grid() const { return grid_; }
 
-    // Per face: its grid, which face each point belongs to, and the point ids.
-    std::array<FaceLayout, 6> faces;
-    for (int f = 0; f < 6; ++f) {
-        FaceLayout& fl = faces[static_cast<std::size_t>(f)];
+    // All exits from entry point a: tests, counts and (with keep) the hits.
+    template <class S>
+    void trace_entry(const S& shape, std::uint32_t a, bool keep, Scratch& s, Counts& cnt) const {
+        const GridPoint gp = grid_.point(a);
+        const std::uint8_t fa = grid_.faces(gp);
+        const Vec3 p{double(gp.x), double(gp.y), double(gp.z)};
+        // Eq. (2) also counts a point paired with itself on two of its faces.
+        const int nf = __builtin_popcount(fa);
+        cnt.enumerated += static_cast<std::uint64_t>(nf * nf - nf);
+        const bool start_inside = shape.inside(p * h_);
+        for (int f = 0; f < 6; ++f) {
+            const FaceLayout& fl = faces_[static_cast<std::size_t>(f)];
+            if (s.best_t.size() < fl.mask.size()) {
+                s.best_t.assign(fl.mask.size(), kInfinity);
+                s.best_c.resize(fl.mask.size());
+                s.tested.assign(fl.mask.size(), 0);
+            }
+            if (start_inside) {  // every segment starts in the solid: all hit at t = 0
+                for (std::size_t k = 0; k < fl.mask.size(); ++k)
+                    if (fl.canonical[k]) s.touched.push_back(k);
+            } else {
+                trace_face(shape, p, fl, s, cnt);
+            }
+            // Counts over the whole face from per-mask tallies; hits from the touched list.
+            const bool own = __builtin_ctz(fa) == f && BoundaryGrid::valid_pair(fa, fa);
+            cnt.enumerated += sums_[fa][static_cast<std::size_t>(f)].multiplicity -
+                              (own ? static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fa)) : 0);
+            cnt.traced += sums_[fa][static_cast<std::size_t>(f)].valid - (own ? 1 : 0);
+            for (const std::size_t k : s.touched) {
+                if (fl.ids[k] == a || !BoundaryGrid::valid_pair(fa, fl.mask[k])) continue;
+                ++cnt.hits;
+                cnt.counted += static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fl.mask[k]));
+                if (keep) s.arena.push(make_hit(shape, a, p, fl.ids[k], start_inside, s, k));
+            }
+            if (!start_inside)
+                for (const std::size_t k : s.touched) s.best_t[k] = kInfinity;
+            s.touched.clear();
+        }
+    }
+
+private:
+    BoundaryGrid grid_;
+    double h_;
+    std::array<FaceLayout, 6> faces_;
+    struct Sum {
+        std::uint64_t valid = 0, multiplicity = 0;
+    };
+    std::array<std::array<Sum, 6>, 64> sums_{};
+    std::vector<PartSphere> spheres_;
+
+    void layout_face(int f, const LatticeGrid& lg) {
+        FaceLayout& fl = faces_[static_cast<std::size_t>(f)];
         fl.axis = BoundaryGrid::face_axis(f);
-        fl.level = grid.face_level(f);
+        fl.level = grid_.face_level(f);
         fl.ua = (fl.axis + 1) % 3;
         fl.va = (fl.axis + 2) % 3;
         fl.nu = lg.cells[static_cast<std::size_t>(fl.ua)] + 1;
@@ -116,30 +212,96 @@ RasterizeResult rasterize(const Shape& shape, const LatticeGrid& lg, const Raste
             for (int u = 0; u < fl.nu; ++u) {
                 GridPoint q;
                 q[fl.axis] = fl.level, q[fl.ua] = u, q[fl.va] = v;
-                const std::size_t k = static_cast<std::size_t>(v) * static_cast<std::size_t>(fl.nu) + static_cast<std::size_t>(u);
-                fl.mask[k] = grid.faces(q);
+                const std::size_t k = static_cast<std::size_t>(v * fl.nu + u);
+                fl.mask[k] = grid_.faces(q);
                 fl.canonical[k] = (__builtin_ctz(fl.mask[k]) == f) ? 1 : 0;
-                fl.ids[k] = grid.id(q);
+                fl.ids[k] = grid_.id(q);
             }
     }
 
-    // The primitive's parts as bounding spheres in lattice units, grouped by part.
-    std::vector<PartSphere> spheres;
-    for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
-        std::vector<BoundingSphere> bs;
-        shape.primitive_spheres(i, bs);
-        for (const BoundingSphere& b : bs)
-            // Padded beyond the parts' touch tolerance, so culling never drops a touching hit.
-            spheres.push_back({b.center / h, b.radius / h * (1 + 1e-6) + 1e-9,
-                               static_cast<std::uint32_t>(i)});
+    // For every face mask of an entry point and every exit face: how many exit points there
+    // make a valid pair, and how many face pairs they stand for (the paper's count).
+    void count_sums() {
+        for (int f = 0; f < 6; ++f) {
+            std::array<std::uint64_t, 64> tally{};
+            const FaceLayout& fl = faces_[static_cast<std::size_t>(f)];
+            for (std::size_t k = 0; k < fl.mask.size(); ++k)
+                if (fl.canonical[k]) ++tally[fl.mask[k]];
+            for (std::uint8_t fa = 1; fa < 64; ++fa)
+                for (std::uint8_t m = 1; m < 64; ++m) {
+                    if (!tally[m] || !BoundaryGrid::valid_pair(fa, m)) continue;
+                    Sum& sum = sums_[fa][static_cast<std::size_t>(f)];
+                    sum.valid += tally[m];
+                    sum.multiplicity += tally[m] * static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, m));
+                }
+        }
     }
 
-    const std::uint32_t npoints = grid.count();
+    // The closest hit of every segment from p to face fl, culled per part by its cones.
+    template <class S>
+    void trace_face(const S& shape, const Vec3& p, const FaceLayout& fl, Scratch& s, Counts& cnt) const {
+        std::uint32_t last_part = ~0u;
+        for (const PartSphere& ps : spheres_) {
+            if (ps.part != last_part) {
+                last_part = ps.part;
+                ++s.generation;  // marks "tested for this part" in s.tested
+            }
+            int u0, u1, v0, v1;
+            const Vec3 rr{ps.r, ps.r, ps.r};
+            projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
+            for (int v = v0; v <= v1; ++v) {
+                double ulo, uhi;
+                if (!cone_row(p, ps, fl, v, ulo, uhi)) continue;
+                // Clamp in double first: the interval may be unbounded or huge.
+                const int ub = static_cast<int>(std::ceil(std::max(ulo, double(u0))));
+                const int ue = static_cast<int>(std::floor(std::min(uhi, double(u1))));
+                for (int u = ub; u <= ue; ++u) {
+                    const std::size_t k = static_cast<std::size_t>(v * fl.nu + u);
+                    if (!fl.canonical[k] || s.tested[k] == s.generation) continue;
+                    s.tested[k] = s.generation;
+                    Vec3 q;
+                    q[static_cast<std::size_t>(fl.axis)] = fl.level;
+                    q[static_cast<std::size_t>(fl.ua)] = u;
+                    q[static_cast<std::size_t>(fl.va)] = v;
+                    const Ray r{p * h_, (q - p) * h_};
+                    Crossing c;
+                    ++cnt.tests;
+                    const double tmax = std::min(s.best_t[k], 1.0 + 1e-12);
+                    if (shape.intersect_primitive(ps.part, r, 0.0, tmax, c)) {
+                        if (s.best_t[k] == kInfinity) s.touched.push_back(k);
+                        s.best_t[k] = c.t;
+                        s.best_c[k] = c;
+                    }
+                }
+            }
+        }
+    }
+
+    template <class S>
+    RawHit make_hit(const S& shape, std::uint32_t a, const Vec3& p, std::uint32_t b, bool start_inside,
+                    const Scratch& s, std::size_t k) const {
+        const GridPoint q = grid_.point(b);
+        const Vec3 qv{double(q.x), double(q.y), double(q.z)};
+        const Ray r{p * h_, (qv - p) * h_};
+        const Vec3 n = start_inside ? normalize(-r.d) : shape.normal(r, s.best_c[k]);
+        const float t = start_inside ? 0.0f : static_cast<float>(std::min(1.0, s.best_t[k]));
+        const Oct o = oct_encode(n, kRawNormalBits);
+        return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v)};
+    }
+};
+
+}  // namespace
+
+RasterizeResult rasterize(const Shape& shape, const LatticeGrid& lg, const RasterizeOptions& opt) {
+    const auto start = std::chrono::steady_clock::now();
+    const Tracer tracer(shape, lg);
+    // Chains (the common primitive) are traced through their concrete type, without virtual
+    // calls in the innermost loop.
+    const auto* chain = dynamic_cast<const ChainShape*>(&shape);
+
+    const std::uint32_t npoints = tracer.grid().count();
     const std::uint32_t nblocks = (npoints + kBlock - 1) / kBlock;
-    std::vector<std::vector<RawHit>> block_hits(opt.keep_hits ? nblocks : 0);
-    struct Counts {
-        std::uint64_t enumerated = 0, traced = 0, hits = 0, counted = 0, tests = 0;
-    };
+    std::vector<std::span<const RawHit>> block_hits(opt.keep_hits ? nblocks : 0);
     std::vector<Counts> block_counts(nblocks);
     tbb::enumerable_thread_specific<Scratch> scratch;
     ProgressBar bar("rasterize", npoints, opt.progress);
@@ -147,96 +309,14 @@ RasterizeResult rasterize(const Shape& shape, const LatticeGrid& lg, const Raste
     tbb::parallel_for(std::uint32_t{0}, nblocks, [&](std::uint32_t blk) {
         Scratch& s = scratch.local();
         Counts cnt;
-        std::vector<RawHit> out;
+        s.arena.begin_block();
         const std::uint32_t a_end = std::min(npoints, (blk + 1) * kBlock);
         for (std::uint32_t a = blk * kBlock; a < a_end; ++a) {
             if (a % opt.entry_stride != 0) continue;
-            const GridPoint gp = grid.point(a);
-            const std::uint8_t fa = grid.faces(gp);
-            const Vec3 p{double(gp.x), double(gp.y), double(gp.z)};
-            // Eq. (2) also counts a point paired with itself on two of its faces.
-            const int nf = __builtin_popcount(fa);
-            cnt.enumerated += static_cast<std::uint64_t>(nf * nf - nf);
-            const bool start_inside = shape.inside(p * h);
-            for (int f = 0; f < 6; ++f) {
-                const FaceLayout& fl = faces[static_cast<std::size_t>(f)];
-                const std::size_t n = fl.mask.size();
-                if (s.best_t.size() < n) {
-                    s.best_t.assign(n, kInfinity);
-                    s.best_c.resize(n);
-                    s.tested.assign(n, 0);
-                }
-                std::uint32_t last_part = ~0u;
-                for (const PartSphere& ps : spheres) {
-                    if (start_inside) break;
-                    if (ps.part != last_part) {
-                        last_part = ps.part;
-                        ++s.generation;  // marks "tested for this part" in s.tested
-                    }
-                    int u0, u1, v0, v1;
-                    const Bounds3 sb{ps.c - Vec3{ps.r, ps.r, ps.r}, ps.c + Vec3{ps.r, ps.r, ps.r}};
-                    projected_range(p, sb, fl, u0, u1, v0, v1);
-                    for (int v = v0; v <= v1; ++v) {
-                        double ulo, uhi;
-                        if (!cone_row(p, ps, fl, v, ulo, uhi)) continue;
-                        // Clamp in double first: the interval may be unbounded or huge.
-                        const int ub = static_cast<int>(std::ceil(std::max(ulo, double(u0))));
-                        const int ue = static_cast<int>(std::floor(std::min(uhi, double(u1))));
-                        for (int u = ub; u <= ue; ++u) {
-                            const std::size_t k = static_cast<std::size_t>(v) * static_cast<std::size_t>(fl.nu) + static_cast<std::size_t>(u);
-                            if (!fl.canonical[k] || s.tested[k] == s.generation) continue;
-                            s.tested[k] = s.generation;
-                            GridPoint q;
-                            q[fl.axis] = fl.level, q[fl.ua] = u, q[fl.va] = v;
-                            const Vec3 qv{double(q.x), double(q.y), double(q.z)};
-                            const Ray r{p * h, (qv - p) * h};
-                            Crossing c;
-                            ++cnt.tests;
-                            const double tmax = std::min(s.best_t[k], 1.0 + 1e-12);
-                            if (shape.intersect_primitive(ps.part, r, 0.0, tmax, c)) {
-                                if (s.best_t[k] == kInfinity) s.touched.push_back(k);
-                                s.best_t[k] = c.t;
-                                s.best_c[k] = c;
-                            }
-                        }
-                    }
-                }
-                for (std::size_t k = 0; k < n; ++k) {
-                    if (!fl.canonical[k] || fl.ids[k] == a) continue;
-                    if (!BoundaryGrid::valid_pair(fa, fl.mask[k])) continue;
-                    const int m = BoundaryGrid::multiplicity(fa, fl.mask[k]);
-                    cnt.enumerated += static_cast<std::uint64_t>(m);
-                    ++cnt.traced;
-                    const bool hit = start_inside || s.best_t[k] <= 1.0;
-                    if (!hit) continue;
-                    ++cnt.hits;
-                    cnt.counted += static_cast<std::uint64_t>(m);
-                    if (!opt.keep_hits) continue;
-                    const GridPoint q = grid.point(fl.ids[k]);
-                    const Vec3 qv{double(q.x), double(q.y), double(q.z)};
-                    const Ray r{p * h, (qv - p) * h};
-                    Vec3 nrm;
-                    float t;
-                    if (start_inside) {
-                        t = 0.0f;
-                        nrm = normalize(-r.d);
-                    } else {
-                        t = static_cast<float>(std::min(1.0, s.best_t[k]));
-                        nrm = shape.normal(r, s.best_c[k]);
-                    }
-                    const Oct o = oct_encode(nrm, kRawNormalBits);
-                    out.push_back({a, fl.ids[k], t, static_cast<std::uint16_t>(o.u),
-                                   static_cast<std::uint16_t>(o.v)});
-                }
-                for (const std::size_t k : s.touched) s.best_t[k] = kInfinity;
-                s.touched.clear();
-            }
+            if (chain) tracer.trace_entry(*chain, a, opt.keep_hits, s, cnt);
+            else tracer.trace_entry(shape, a, opt.keep_hits, s, cnt);
         }
-        if (opt.keep_hits) {
-            std::sort(out.begin(), out.end(),
-                      [](const RawHit& x, const RawHit& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
-            block_hits[blk] = std::move(out);
-        }
+        if (opt.keep_hits) block_hits[blk] = s.arena.end_block();
         block_counts[blk] = cnt;
         bar.add(a_end - blk * kBlock);
     });
@@ -244,7 +324,7 @@ RasterizeResult rasterize(const Shape& shape, const LatticeGrid& lg, const Raste
 
     RasterizeResult res;
     res.grid = lg;
-    res.pairs_eq2 = grid.pairs_eq2();
+    res.pairs_eq2 = tracer.grid().pairs_eq2();
     for (const Counts& c : block_counts) {
         res.pairs_enumerated += c.enumerated;
         res.pairs_traced += c.traced;
@@ -253,8 +333,9 @@ RasterizeResult rasterize(const Shape& shape, const LatticeGrid& lg, const Raste
         res.tests += c.tests;
     }
     if (opt.keep_hits) {
-        res.raw.reserve(res.hits);
-        for (auto& b : block_hits) res.raw.insert(res.raw.end(), b.begin(), b.end());
+        res.raw.chunks = std::move(block_hits);
+        for (Scratch& s : scratch)
+            for (auto& b : s.arena.buffers()) res.raw.storage.push_back(std::move(b));
     }
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return res;

@@ -32,7 +32,7 @@ struct RasterizeResult {
     std::uint64_t hits_counted = 0;      // N_ix, counted as the paper counts N_lp
     std::uint64_t tests = 0;             // exact segment-part tests performed
     double seconds = 0;
-    std::vector<RawHit> raw;  // sorted by (a, b) when keep_hits
+    RawHits raw;  // when keep_hits: in entry point order, the same for any thread count
 };
 
 RasterizeResult rasterize(const Shape& primitive, const LatticeGrid& grid,

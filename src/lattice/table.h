@@ -5,7 +5,11 @@
 // later) live behind it.
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
+
+#include "util/big_buffer.h"
 
 #include "math/vec.h"
 
@@ -23,6 +27,25 @@ struct RawHit {
     std::uint16_t nu = 0, nv = 0;  // octahedral normal, 16 bits each
 };
 inline constexpr int kRawNormalBits = 16;
+
+// Rasterized hits in chunks (one per block of entry points, in a fixed order) that point into
+// large buffers, so that a big rasterization is never copied or grown piecewise.
+struct RawHits {
+    std::vector<std::shared_ptr<const ByteBuffer>> storage;
+    std::vector<std::span<const RawHit>> chunks;
+
+    std::uint64_t size() const {
+        std::uint64_t n = 0;
+        for (const auto& c : chunks) n += c.size();
+        return n;
+    }
+    std::vector<RawHit> flatten() const {
+        std::vector<RawHit> out;
+        out.reserve(size());
+        for (const auto& c : chunks) out.insert(out.end(), c.begin(), c.end());
+        return out;
+    }
+};
 
 class LatticeTable {
 public:

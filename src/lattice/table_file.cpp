@@ -140,7 +140,7 @@ private:
 }  // namespace
 
 void write_table_file(const std::string& path, const TableHeader& h0,
-                      const std::vector<std::uint8_t>& payload) {
+                      const ByteBuffer& payload) {
     TableHeader h = h0;
     h.payload_bytes = payload.size();
     const auto header = encode_header(h, hash_bytes(payload.data(), payload.size()));

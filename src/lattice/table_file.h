@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "lattice/table.h"
+#include "util/big_buffer.h"
 
 namespace lat {
 
@@ -33,7 +34,7 @@ inline constexpr std::size_t kTableHeaderBytes = 128;
 
 // Writes atomically (temporary file + rename); throws InputError naming the path.
 void write_table_file(const std::string& path, const TableHeader& h,
-                      const std::vector<std::uint8_t>& payload);
+                      const ByteBuffer& payload);
 
 // A table loaded from disk, with the mapping that holds its payload.
 struct LoadedTable {

@@ -130,10 +130,9 @@ TableBuild build_table_file(const Primitive& p, int sigma_inv, const std::string
     opt.progress = progress;
     b.raster = rasterize(*p.shape, grid_of(b.header), opt);
     const auto t0 = std::chrono::steady_clock::now();
-    const std::vector<std::uint8_t> payload = encode_table(encoding, b.raster);
+    const ByteBuffer payload = encode_table(encoding, b.raster);
     b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    b.raster.raw.clear();
-    b.raster.raw.shrink_to_fit();
+    b.raster.raw = {};
     b.header.pairs = b.raster.pairs_eq2;
     b.header.entries = b.raster.hits;
     write_table_file(path, b.header, payload);

@@ -1,0 +1,152 @@
+#include "scene/table1.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "lattice/rasterizer.h"
+#include "scene/json_reader.h"
+#include "scene/scene_loader.h"
+#include "util/error.h"
+
+namespace lat {
+namespace {
+
+// Two significant digits, as the paper prints them.
+double round2(double v) {
+    if (v == 0) return 0;
+    const double e = std::floor(std::log10(std::abs(v)));
+    const double scale = std::pow(10.0, e - 1);
+    return std::round(v / scale) * scale;
+}
+
+}  // namespace
+
+std::string paper_notation(double v) {
+    if (v <= 0) return "0";
+    const double r = round2(v);
+    const int e = static_cast<int>(std::floor(std::log10(r) + 1e-12));
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f (%d)", r / std::pow(10.0, e), e);
+    return buf;
+}
+
+// The paper rounds most values but truncates some (its text gives N_lp = 9,950 for the hook,
+// printed 9.9 (3)): either reading of the printed digits counts as a match.
+bool matches_printed(double v, double printed) {
+    if (v <= 0 || printed <= 0) return v == printed;
+    const double e = std::floor(std::log10(v));
+    const double scale = std::pow(10.0, e - 1);
+    const double rounded = std::round(v / scale) * scale, truncated = std::floor(v / scale) * scale;
+    const double tol = 1e-9 * printed;
+    return std::abs(rounded - printed) <= tol || std::abs(truncated - printed) <= tol;
+}
+
+std::vector<Table1Row> compute_table1(const std::string& path, bool progress) {
+    const nlohmann::json doc = parse_json_file(path);
+    const JsonValue root(doc, "", path);
+    if (!root.is_object()) root.fail("a Table 1 file must hold a JSON object");
+    root.allow_keys({"format", "rows"});
+    const JsonValue rows = root.at("rows");
+    std::vector<Table1Row> out;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        const JsonValue r = rows[i];
+        r.allow_keys({"primitive", "shape", "box_world", "paper"});
+        Table1Row row;
+        row.primitive = r.at("primitive").string();
+        const Primitive prim = parse_primitive(r.at("shape"), row.primitive);
+        const JsonValue box = r.at("box_world");
+        const Vec3 b = box.vec3();
+        for (std::size_t a = 0; a < 3; ++a) {
+            row.box[a] = b[a];
+            if (!(b[a] >= 1 && b[a] == std::floor(b[a])))
+                box[a].fail("the box must be a whole number of units (sigma = 1) along each axis");
+        }
+        const JsonValue paper = r.at("paper");
+        for (std::size_t k = 0; k < paper.size(); ++k) {
+            const JsonValue p = paper[k];
+            p.allow_keys({"sigma_inv", "N_lp", "N_ix", "ratio"});
+            Table1Cell c;
+            c.sigma_inv = p.at("sigma_inv").integer();
+            if (c.sigma_inv < 1 || c.sigma_inv > 64) p.at("sigma_inv").fail("must be between 1 and 64");
+            c.paper_n_lp = p.at("N_lp").number();
+            c.paper_n_ix = p.at("N_ix").number();
+            c.paper_ratio = p.at("ratio").number();
+            LatticeGrid g;
+            for (std::size_t a = 0; a < 3; ++a) g.cells[a] = static_cast<int>(b[a]) * c.sigma_inv;
+            g.cell = 1.0 / c.sigma_inv;
+            c.cells = g.cells;
+            RasterizeOptions opt;
+            opt.keep_hits = false;
+            opt.progress = progress;
+            const RasterizeResult res = rasterize(*prim.shape, g, opt);
+            c.n_lp_eq2 = res.pairs_eq2;
+            c.n_lp_enumerated = res.pairs_enumerated;
+            c.n_ix = res.hits_counted;
+            c.ratio = double(c.n_ix) / double(c.n_lp_eq2);
+            c.seconds = res.seconds;
+            c.n_lp_matches = matches_printed(double(c.n_lp_eq2), c.paper_n_lp);
+            c.n_ix_matches = matches_printed(double(c.n_ix), c.paper_n_ix);
+            c.ratio_matches = std::abs(std::round(c.ratio * 100) / 100 - c.paper_ratio) < 1e-9;
+            row.cells.push_back(c);
+        }
+        out.push_back(std::move(row));
+    }
+    return out;
+}
+
+std::string table1_text(const std::vector<Table1Row>& rows) {
+    std::string s;
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "%-40s %4s %-11s  %-9s %10s %10s   %-9s %9s %9s   %-5s %5s\n",
+                  "primitive", "s^-1", "cells", "N_lp", "eq. (2)", "enumerated", "N_ix", "",
+                  "counted", "ratio", "");
+    s += buf;
+    std::snprintf(buf, sizeof buf, "%-40s %4s %-11s  %-9s %10s %10s   %-9s %9s %9s   %-5s %5s\n", "",
+                  "", "", "paper", "", "", "paper", "ours", "", "paper", "ours");
+    s += buf;
+    for (const Table1Row& r : rows) {
+        const char* name = r.primitive.c_str();
+        bool first = true;
+        for (const Table1Cell& c : r.cells) {
+            char cells[32];
+            std::snprintf(cells, sizeof cells, "%dx%dx%d", c.cells[0], c.cells[1], c.cells[2]);
+            std::snprintf(buf, sizeof buf,
+                          "%-40.40s %4d %-11s  %-9s %10llu %10llu%s  %-9s %9s %9llu%s  %-5.2f %5.3f%s\n",
+                          first ? name : "", c.sigma_inv, cells, paper_notation(c.paper_n_lp).c_str(),
+                          static_cast<unsigned long long>(c.n_lp_eq2),
+                          static_cast<unsigned long long>(c.n_lp_enumerated), c.n_lp_matches ? " " : "*",
+                          paper_notation(c.paper_n_ix).c_str(), paper_notation(double(c.n_ix)).c_str(),
+                          static_cast<unsigned long long>(c.n_ix), c.n_ix_matches ? " " : "*",
+                          c.paper_ratio, c.ratio, c.ratio_matches ? "" : " *");
+            s += buf;
+            first = false;
+        }
+    }
+    s += "* differs from the paper at its printed precision (two significant digits, rounded or\n"
+         "  truncated as the paper does; the ratio to 0.01)\n";
+    return s;
+}
+
+nlohmann::json table1_json(const std::vector<Table1Row>& rows) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const Table1Row& r : rows) {
+        nlohmann::json jr;
+        jr["primitive"] = r.primitive;
+        jr["box"] = r.box;
+        for (const Table1Cell& c : r.cells) {
+            jr["cells"].push_back({{"sigma_inv", c.sigma_inv},
+                                   {"lattice_cells", c.cells},
+                                   {"N_lp_eq2", c.n_lp_eq2},
+                                   {"N_lp_enumerated", c.n_lp_enumerated},
+                                   {"N_ix", c.n_ix},
+                                   {"ratio", c.ratio},
+                                   {"paper", {{"N_lp", c.paper_n_lp}, {"N_ix", c.paper_n_ix}, {"ratio", c.paper_ratio}}},
+                                   {"matches_paper", {{"N_lp", c.n_lp_matches}, {"N_ix", c.n_ix_matches}, {"ratio", c.ratio_matches}}},
+                                   {"seconds", c.seconds}});
+        }
+        out.push_back(jr);
+    }
+    return out;
+}
+
+}  // namespace lat

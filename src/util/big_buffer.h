@@ -1,0 +1,32 @@
+#pragma once
+// Large uninitialised buffers for tables: anonymous memory with transparent huge pages
+// requested, so that filling hundreds of megabytes does not spend its time in 4 kB page
+// faults, and no time zeroing what is about to be written anyway.
+#include <cstddef>
+#include <cstdint>
+
+namespace lat {
+
+class ByteBuffer {
+public:
+    ByteBuffer() = default;
+    explicit ByteBuffer(std::size_t size);
+    ~ByteBuffer();
+    ByteBuffer(ByteBuffer&& o) noexcept : data_(o.data_), size_(o.size_), mapped_(o.mapped_) {
+        o.data_ = nullptr, o.size_ = 0, o.mapped_ = 0;
+    }
+    ByteBuffer& operator=(ByteBuffer&& o) noexcept;
+    ByteBuffer(const ByteBuffer&) = delete;
+    ByteBuffer& operator=(const ByteBuffer&) = delete;
+
+    std::uint8_t* data() { return data_; }
+    const std::uint8_t* data() const { return data_; }
+    std::size_t size() const { return size_; }
+
+private:
+    std::uint8_t* data_ = nullptr;
+    std::size_t size_ = 0;
+    std::size_t mapped_ = 0;
+};
+
+}  // namespace lat
