@@ -50,3 +50,13 @@ endforeach()
 add_test(NAME cli.threads_identical
   COMMAND ${CMAKE_COMMAND} -E compare_files ${CLI_OUT}/threads1.png ${CLI_OUT}/threads2.png)
 set_tests_properties(cli.threads_identical PROPERTIES FIXTURES_REQUIRED "threads_1;threads_2")
+
+# Lattice tables: bad cache directories, corrupt, truncated and mismatched tables, sizes that
+# cannot fit, and the cache itself.
+foreach(case corrupt truncated other_primitive missing_dir not_a_dir too_big unknown_primitive
+             render_then_reuse)
+  add_test(NAME cli.lattice_${case}
+    COMMAND ${CMAKE_COMMAND} -DLATTICE=$<TARGET_FILE:lattice> -DEXAMPLES=${PROJECT_SOURCE_DIR}/examples
+            -DWORK=${CLI_OUT}/lattice-${case} -DCASE=${case}
+            -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/lattice_cases.cmake)
+endforeach()

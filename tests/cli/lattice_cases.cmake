@@ -1,0 +1,69 @@
+# Lattice-table scenarios that need files prepared first; -DCASE=... picks one.
+#   cmake -DLATTICE=path/to/lattice -DEXAMPLES=dir -DWORK=dir -DCASE=name -P lattice_cases.cmake
+function(run expect_code pattern)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT code EQUAL expect_code)
+    message(FATAL_ERROR "${ARGN}\nexit code ${code}, expected ${expect_code}\n${out}\n${err}")
+  endif()
+  if(pattern AND NOT err MATCHES "${pattern}")
+    message(FATAL_ERROR "${ARGN}\nstderr does not match '${pattern}':\n${err}")
+  endif()
+endfunction()
+
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+set(P2 ${EXAMPLES}/plate2-thistle.json)
+set(P3 ${EXAMPLES}/plate3-hair-closeup.json)
+
+if(CASE STREQUAL "corrupt")
+  run(0 "" ${LATTICE} rasterize -q ${P3} --primitive hair --lattice-dir ${WORK})
+  file(GLOB tables ${WORK}/hair-*.lht)
+  # Overwrite one byte of the payload in place.
+  execute_process(COMMAND sh -c "printf Z | dd of='${tables}' bs=1 seek=300 conv=notrunc 2>/dev/null")
+  run(2 "hair-s1-hash14-[0-9a-f]+\\.lht: not a valid lattice table: payload checksum mismatch"
+      ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/x.png)
+  if(EXISTS ${WORK}/x.png)
+    message(FATAL_ERROR "an image was written")
+  endif()
+elseif(CASE STREQUAL "truncated")
+  run(0 "" ${LATTICE} rasterize -q ${P3} --primitive hair --lattice-dir ${WORK})
+  file(GLOB tables ${WORK}/hair-*.lht)
+  file(SIZE ${tables} size)
+  math(EXPR keep "${size} - 1000")
+  execute_process(COMMAND truncate -s ${keep} ${tables})
+  run(2 "not a valid lattice table: payload is [0-9]+ bytes, header says [0-9]+ \\(truncated\\?\\)"
+      ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/x.png)
+elseif(CASE STREQUAL "other_primitive")
+  # The hair's cache file replaced by the thistle spike's table.
+  run(0 "" ${LATTICE} rasterize -q ${P3} --primitive hair --lattice-dir ${WORK})
+  file(GLOB hair ${WORK}/hair-*.lht)
+  run(0 "" ${LATTICE} rasterize -q ${P2} --primitive spike -o ${hair})
+  run(2 "lattice table is for hash14, 1 x 1 x 20 cells \\(sigma 1, sigma\\^-1 1\\), expected hash14, 7 x 7 x 20 cells"
+      ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/x.png)
+elseif(CASE STREQUAL "missing_dir")
+  run(2 "no/such/dir: lattice cache directory does not exist"
+      ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK}/no/such/dir -o ${WORK}/x.png)
+elseif(CASE STREQUAL "not_a_dir")
+  file(WRITE ${WORK}/file "x")
+  run(2 "file: lattice cache is not a directory"
+      ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK}/file -o ${WORK}/x.png)
+elseif(CASE STREQUAL "too_big")
+  run(2 "primitives\\.hair: the hash14 table of primitive 'hair' at 7000 x 7000 x 20000 cells \\(sigma\\^-1 = 1000\\) would need about [0-9.]+ [kMGTPE]B"
+      ${LATTICE} rasterize -q ${P3} --primitive hair --sigma-inv 1000 -o ${WORK}/big.lht)
+  if(EXISTS ${WORK}/big.lht)
+    message(FATAL_ERROR "a table was written")
+  endif()
+elseif(CASE STREQUAL "unknown_primitive")
+  run(2 "no primitive named 'fur' \\(it has: hair\\)"
+      ${LATTICE} rasterize -q ${P3} --primitive fur -o ${WORK}/t.lht)
+elseif(CASE STREQUAL "render_then_reuse")
+  # A lattice render builds its table once, then finds it in the cache.
+  run(0 "1 table .*1 built" ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/a.png)
+  run(0 "1 table .*0 built" ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/b.png)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/a.png ${WORK}/b.png RESULT_VARIABLE same)
+  if(NOT same EQUAL 0)
+    message(FATAL_ERROR "the cached table renders a different image")
+  endif()
+else()
+  message(FATAL_ERROR "unknown case ${CASE}")
+endif()
