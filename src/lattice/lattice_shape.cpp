@@ -9,11 +9,12 @@ LatticeShape::LatticeShape(std::shared_ptr<const LatticeTable> table, std::array
     : table_(std::move(table)),
       grid_(cells),
       cell_(cell),
+      inv_cell_(1.0 / cell),
       box_{{0, 0, 0}, Vec3{double(cells[0]), double(cells[1]), double(cells[2])} * cell} {}
 
 bool LatticeShape::snap(const Ray& r, std::uint32_t& a, std::uint32_t& b, GridPoint& pa,
                         GridPoint& pb) const {
-    const Vec3 o = r.o / cell_, d = r.d / cell_;
+    const Vec3 o = r.o * inv_cell_, d = r.d * inv_cell_;
     const auto& n = grid_.cells();
     double t0 = -kInfinity, t1 = kInfinity;
     int ax0 = -1, ax1 = -1;
@@ -23,7 +24,8 @@ bool LatticeShape::snap(const Ray& r, std::uint32_t& a, std::uint32_t& b, GridPo
             if (o[uk] < 0 || o[uk] > n[uk]) return false;
             continue;
         }
-        double tn = -o[uk] / d[uk], tf = (n[uk] - o[uk]) / d[uk];
+        const double inv = 1.0 / d[uk];
+        double tn = -o[uk] * inv, tf = (n[uk] - o[uk]) * inv;
         if (tn > tf) std::swap(tn, tf);
         if (tn > t0) t0 = tn, ax0 = k;
         if (tf < t1) t1 = tf, ax1 = k;
@@ -61,7 +63,7 @@ LatticeShape::LineHits LatticeShape::line_hits(const Ray& r) const {
     TableHit fwd, rev;
     if (!table_->lookup(a, b, fwd)) return lh;
     const Vec3 va = to_vec(pa), vb = to_vec(pb);
-    const Vec3 o = r.o / cell_, d = r.d / cell_;
+    const Vec3 o = r.o * inv_cell_, d = r.d * inv_cell_;
     const double dd = dot(d, d);
     const Vec3 pf = lerp(va, vb, fwd.t);
     lh.hit = true;

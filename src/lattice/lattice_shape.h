@@ -43,7 +43,7 @@ public:
 private:
     std::shared_ptr<const LatticeTable> table_;
     BoundaryGrid grid_;
-    double cell_;
+    double cell_, inv_cell_;
     Bounds3 box_;  // primitive units
 
     // Snapped entry and exit point ids of the ray's line; false if it misses the box.
