@@ -89,21 +89,22 @@ void check_table_buildable(const Primitive& p, int sigma_inv, const std::string&
                              " x " + std::to_string(h.cells[2]) + " cells (sigma^-1 = " +
                              std::to_string(sigma_inv) + ")";
     const double avail = static_cast<double>(available_memory_bytes());
-    auto refuse = [&](double hit_rate, double bytes) {
+    auto refuse = [&](double hit_rate, double bytes, bool lower_bound) {
         char buf[512];
         std::snprintf(buf, sizeof buf,
-                      "the %s table of primitive '%s' at %s would need about %s (%.3Lg point "
-                      "pairs, %.0f %% of them hits, %.1f bytes per hit while building), more than "
-                      "the %s of memory available",
-                      encoding.c_str(), p.name.c_str(), size.c_str(), human_bytes(bytes).c_str(),
-                      pairs, hit_rate * 100, enc.bytes_per_hit + sizeof(RawHit),
-                      human_bytes(avail).c_str());
+                      "the %s table of primitive '%s' at %s would need %s %s (%.3Lg point pairs, "
+                      "%s %.0f %% of them %s, at %.1f bytes per hit while building), more than the "
+                      "%s of memory available",
+                      encoding.c_str(), p.name.c_str(), size.c_str(), lower_bound ? "at least" : "about",
+                      human_bytes(bytes).c_str(), pairs,
+                      lower_bound ? "even if only" : "an estimated", hit_rate * 100,
+                      lower_bound ? "were hits" : "hits", enc.bytes_per_hit + sizeof(RawHit), human_bytes(avail).c_str());
         throw InputError(at + buf);
     };
     const double per_hit = enc.bytes_per_hit + sizeof(RawHit);
     // Even a 1 % hit rate is too much: refuse without tracing anything.
     if (avail > 0 && static_cast<double>(pairs) * 0.01 * per_hit > 0.8 * avail)
-        refuse(0.01, static_cast<double>(pairs) * 0.01 * per_hit);
+        refuse(0.01, static_cast<double>(pairs) * 0.01 * per_hit, true);
     if (points >= static_cast<long double>(0xFFFFFFFFu))
         throw InputError(at + "a lattice of " + size + " has too many boundary points to index");
     const BoundaryGrid grid(h.cells);
@@ -118,7 +119,7 @@ void check_table_buildable(const Primitive& p, int sigma_inv, const std::string&
     const RasterizeResult sample = rasterize(*p.shape, grid_of(h), opt);
     const double rate = sample.pairs_traced ? double(sample.hits) / double(sample.pairs_traced) : 0.0;
     const double need = static_cast<double>(pairs) * rate * per_hit;
-    if (avail > 0 && need > 0.8 * avail) refuse(rate, need);
+    if (avail > 0 && need > 0.8 * avail) refuse(rate, need, false);
 }
 
 TableBuild build_table_file(const Primitive& p, int sigma_inv, const std::string& encoding,
