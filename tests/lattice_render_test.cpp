@@ -46,6 +46,15 @@ TEST_F(LatticeRender, PlatesAreCloseToExact) {
     }
 }
 
+TEST_F(LatticeRender, CsgPrimitivesRasterizeToo) {
+    // A primitive given as a CSG object (torus minus sphere), instanced twice.
+    const Scene s = small("lattice-rings", 128);
+    ASSERT_EQ(s.primitives.size(), 1u);
+    const ImageDiffStats d = compare_images(render_exact(s), render_lattice(s, cache, 1));
+    EXPECT_GT(d.psnr_db, 26);
+    EXPECT_LT(d.psnr_db, 60);
+}
+
 TEST_F(LatticeRender, RefiningTheLatticeApproachesExact) {
     const Scene s = small("plate3-hair-closeup", 128);
     const Image8 exact = render_exact(s);
