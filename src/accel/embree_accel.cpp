@@ -46,6 +46,22 @@ float float_above(double t) {
     return static_cast<double>(f) > t ? f : std::nextafter(f, INFINITY);
 }
 
+void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax) {
+    ray.org_x = static_cast<float>(r.o.x);
+    ray.org_y = static_cast<float>(r.o.y);
+    ray.org_z = static_cast<float>(r.o.z);
+    ray.dir_x = static_cast<float>(r.d.x);
+    ray.dir_y = static_cast<float>(r.d.y);
+    ray.dir_z = static_cast<float>(r.d.z);
+    // Embree prunes in float: widen the range a little so that it never cuts a double hit.
+    ray.tnear = std::max(0.0f, static_cast<float>(tmin) * 0.5f);
+    ray.tfar = std::isfinite(tmax) ? float_above(tmax) : INFINITY;
+    ray.time = 0;
+    ray.mask = 0xFFFFFFFFu;
+    ray.id = 0;
+    ray.flags = 0;
+}
+
 }  // namespace
 
 struct EmbreeAccel::Impl {
@@ -203,20 +219,27 @@ struct EmbreeAccel::Impl {
         *args->bounds_o = to_rtc_bounds(shape->primitive_bounds(args->primID));
     }
 
+    // One user geometry of n primitives with these callbacks, attached to scene s.
+    void attach_user_geometry(RTCScene s, std::size_t n, void* user, RTCBoundsFunction bounds,
+                              RTCIntersectFunctionN intersect, RTCOccludedFunctionN occluded) const {
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(n));
+        rtcSetGeometryUserData(g, user);
+        rtcSetGeometryBoundsFunction(g, bounds, user);
+        rtcSetGeometryIntersectFunction(g, intersect);
+        rtcSetGeometryOccludedFunction(g, occluded);
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(s, g);
+        rtcReleaseGeometry(g);
+    }
+
     RTCScene prototype_scene(const Shape* shape) {
         auto it = prototypes.find(shape);
         if (it != prototypes.end()) return it->second.scene;
         RTCScene s = rtcNewScene(device);
         rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
-        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(shape->primitive_count()));
-        rtcSetGeometryUserData(g, const_cast<Shape*>(shape));
-        rtcSetGeometryBoundsFunction(g, bounds_proto, const_cast<Shape*>(shape));
-        rtcSetGeometryIntersectFunction(g, proto_intersect);
-        rtcSetGeometryOccludedFunction(g, proto_occluded);
-        rtcCommitGeometry(g);
-        rtcAttachGeometry(s, g);
-        rtcReleaseGeometry(g);
+        attach_user_geometry(s, shape->primitive_count(), const_cast<Shape*>(shape), bounds_proto,
+                             proto_intersect, proto_occluded);
         rtcCommitScene(s);
         prototypes[shape] = {shape, s};
         return s;
@@ -271,28 +294,12 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             m.direct.push_back(i);
         }
     }
-    if (!m.direct.empty()) {
-        RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(m.direct.size()));
-        rtcSetGeometryUserData(g, &m);
-        rtcSetGeometryBoundsFunction(g, Impl::bounds_direct, &m);
-        rtcSetGeometryIntersectFunction(g, Impl::direct_intersect);
-        rtcSetGeometryOccludedFunction(g, Impl::direct_occluded);
-        rtcCommitGeometry(g);
-        rtcAttachGeometry(m.scene, g);
-        rtcReleaseGeometry(g);
-    }
-    if (!m.flat.empty()) {
-        RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(m.flat.size()));
-        rtcSetGeometryUserData(g, &m);
-        rtcSetGeometryBoundsFunction(g, Impl::bounds_flat, &m);
-        rtcSetGeometryIntersectFunction(g, Impl::flat_intersect);
-        rtcSetGeometryOccludedFunction(g, Impl::flat_occluded);
-        rtcCommitGeometry(g);
-        rtcAttachGeometry(m.scene, g);
-        rtcReleaseGeometry(g);
-    }
+    if (!m.direct.empty())
+        m.attach_user_geometry(m.scene, m.direct.size(), &m, Impl::bounds_direct,
+                               Impl::direct_intersect, Impl::direct_occluded);
+    if (!m.flat.empty())
+        m.attach_user_geometry(m.scene, m.flat.size(), &m, Impl::bounds_flat, Impl::flat_intersect,
+                               Impl::flat_occluded);
     rtcCommitScene(m.scene);
     if (!m.error.empty()) throw std::runtime_error("Embree: " + m.error);
 }
@@ -312,19 +319,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
     ctx.hit = &hit;
 
     alignas(16) RTCRayHit rh;
-    rh.ray.org_x = static_cast<float>(r.o.x);
-    rh.ray.org_y = static_cast<float>(r.o.y);
-    rh.ray.org_z = static_cast<float>(r.o.z);
-    rh.ray.dir_x = static_cast<float>(r.d.x);
-    rh.ray.dir_y = static_cast<float>(r.d.y);
-    rh.ray.dir_z = static_cast<float>(r.d.z);
-    // Embree prunes in float: widen the range a little so that it never cuts a double hit.
-    rh.ray.tnear = std::max(0.0f, static_cast<float>(tmin) * 0.5f);
-    rh.ray.tfar = std::isfinite(tmax) ? float_above(tmax) : INFINITY;
-    rh.ray.time = 0;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
+    set_rtc_ray(rh.ray, r, tmin, tmax);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(m.scene, &ctx.rtc, &rh);
@@ -359,18 +354,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     }
 
     alignas(16) RTCRay ray;
-    ray.org_x = static_cast<float>(r.o.x);
-    ray.org_y = static_cast<float>(r.o.y);
-    ray.org_z = static_cast<float>(r.o.z);
-    ray.dir_x = static_cast<float>(r.d.x);
-    ray.dir_y = static_cast<float>(r.d.y);
-    ray.dir_z = static_cast<float>(r.d.z);
-    ray.tnear = std::max(0.0f, static_cast<float>(tmin) * 0.5f);
-    ray.tfar = std::isfinite(tmax) ? float_above(tmax) : INFINITY;
-    ray.time = 0;
-    ray.mask = 0xFFFFFFFFu;
-    ray.id = 0;
-    ray.flags = 0;
+    set_rtc_ray(ray, r, tmin, tmax);
     rtcOccluded1(m.scene, &ctx.rtc, &ray);
     return ctx.found;
 }

@@ -14,15 +14,16 @@ struct Oct {
 
 inline double sign_not_zero(double v) { return v >= 0 ? 1.0 : -1.0; }
 
-inline Oct oct_encode(Vec3 n, int bits) {
+// The point of the square [-1, 1]^2 that n maps to.
+inline Vec2 oct_fold(Vec3 n) {
     const double l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
-    double px = n.x / l1, py = n.y / l1;
-    if (n.z < 0) {
-        const double ox = (1 - std::abs(py)) * sign_not_zero(px);
-        const double oy = (1 - std::abs(px)) * sign_not_zero(py);
-        px = ox;
-        py = oy;
-    }
+    const double px = n.x / l1, py = n.y / l1;
+    if (n.z >= 0) return {px, py};
+    return {(1 - std::abs(py)) * sign_not_zero(px), (1 - std::abs(px)) * sign_not_zero(py)};
+}
+
+inline Oct oct_encode(Vec3 n, int bits) {
+    const auto [px, py] = oct_fold(n);
     const double scale = static_cast<double>((1u << bits) - 1);
     return {static_cast<std::uint32_t>(std::lround((px * 0.5 + 0.5) * scale)),
             static_cast<std::uint32_t>(std::lround((py * 0.5 + 0.5) * scale))};
@@ -45,14 +46,7 @@ inline Vec3 oct_decode(Oct o, int bits) {
 // is not optimal on the folded map, and this halves the worst angle error for the same bits.
 inline Oct oct_encode_precise(Vec3 n, int bits) {
     const Oct r = oct_encode(n, bits);
-    const double l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
-    double px = n.x / l1, py = n.y / l1;
-    if (n.z < 0) {
-        const double ox = (1 - std::abs(py)) * sign_not_zero(px);
-        const double oy = (1 - std::abs(px)) * sign_not_zero(py);
-        px = ox;
-        py = oy;
-    }
+    const auto [px, py] = oct_fold(n);
     const double scale = static_cast<double>((1u << bits) - 1);
     const auto u0 = static_cast<std::uint32_t>(std::floor((px * 0.5 + 0.5) * scale));
     const auto v0 = static_cast<std::uint32_t>(std::floor((py * 0.5 + 0.5) * scale));
