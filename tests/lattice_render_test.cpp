@@ -9,6 +9,8 @@
 #include "temp_dir.h"
 #include "test_paths.h"
 
+#include <string>
+
 namespace lat {
 namespace {
 
@@ -53,6 +55,34 @@ TEST_F(LatticeRender, CsgPrimitivesRasterizeToo) {
     const ImageDiffStats d = compare_images(render_exact(s), render_lattice(s, cache, 1));
     EXPECT_GT(d.psnr_db, 26);
     EXPECT_LT(d.psnr_db, 60);
+}
+
+TEST_F(LatticeRender, LatticesAreCsgLeaves) {
+    // Plate 3's hair cut by a half-space and minus a sphere: in lattice mode the instance leaf
+    // is answered by its table (first and last crossing per ray), the rest stays exact.
+    const std::string text = R"({
+      "camera": {"eye": [30, -45, 22], "look_at": [3.5, 3.5, 10], "fov_y_deg": 30, "width": 128, "height": 128},
+      "lights": [{"position": [60, -60, 60], "intensity": 0.9}],
+      "materials": {"fur": {"color": [0.55, 0.35, 0.15]}, "cut": {"color": [0.2, 0.5, 0.9]}},
+      "primitives": {"hair": )" + std::string("PRIM") + R"(},
+      "objects": [{"type": "csg", "op": "difference", "material": "fur", "children": [
+          {"type": "csg", "op": "intersection", "children": [
+            {"type": "instance", "primitive": "hair"},
+            {"type": "halfspace", "point": [0, 0, 12], "normal": [0, 0, 1]}]},
+          {"type": "sphere", "center": [3, 3, 5], "radius": 2.5}]}]})";
+    const std::string prim = R"({"spheres": [[3.5,3.5,0.5,0.5],[3.833333,4.07735,2.611111,0.5],
+        [2.833333,4.654701,4.722222,0.5],[1.5,3.5,6.833333,0.5],[2.166667,1.190599,8.944444,0.5],
+        [5.0,0.901924,11.055556,0.5],[6.5,3.5,13.166667,0.5],[5.0,6.098076,15.277778,0.5],
+        [2.0,6.098076,17.388889,0.5],[0.5,3.5,19.5,0.5]],
+        "cylinders": [[0,1,0.5],[1,2,0.5],[2,3,0.5],[3,4,0.5],[4,5,0.5],[5,6,0.5],[6,7,0.5],[7,8,0.5],[8,9,0.5]],
+        "lattice": {"sigma": 1.0, "cells": [7, 7, 20]}})";
+    std::string full = text;
+    full.replace(full.find("PRIM"), 4, prim);
+    const Scene cut = load_scene_text(full, "cut.json");
+    const Image8 exact = render_exact(cut), lattice = render_lattice(cut, cache, 1);
+    const ImageDiffStats d = compare_images(exact, lattice);
+    EXPECT_GT(d.psnr_db, 22);
+    EXPECT_LT(d.psnr_db, 60) << "the instance leaf was not traced through its lattice";
 }
 
 TEST_F(LatticeRender, RefiningTheLatticeApproachesExact) {

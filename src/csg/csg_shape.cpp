@@ -1,6 +1,7 @@
 #include "csg/csg_shape.h"
 
 #include <cassert>
+#include <algorithm>
 #include <cmath>
 #include <deque>
 
@@ -85,6 +86,15 @@ int CsgShape::add_node(CsgOp op, std::vector<int> children) {
 void CsgShape::set_root(int ref) {
     root_ = ref;
     compute_bounds(root_);
+    tolerance_ = 0;
+    for (const Leaf& l : leaves_) {
+        const double t = l.leaf.shape->surface_tolerance();
+        if (t == 0) continue;
+        // A length in the leaf grows by at most the transform's largest column norm.
+        const Mat3& m = l.leaf.xf.forward().m;
+        const double scale = std::max({length(m.col(0)), length(m.col(1)), length(m.col(2))});
+        tolerance_ = std::max(tolerance_, t * scale);
+    }
 }
 
 Bounds3 CsgShape::compute_bounds(int ref) {
@@ -98,6 +108,28 @@ Bounds3 CsgShape::compute_bounds(int ref) {
     }
     n.bounds = b;
     return b;
+}
+
+std::vector<int> CsgShape::leaf_primitives() const {
+    std::vector<int> out;
+    for (const Leaf& l : leaves_)
+        if (l.leaf.primitive >= 0) out.push_back(l.leaf.primitive);
+    return out;
+}
+
+std::shared_ptr<CsgShape> CsgShape::with_primitive_shapes(const PrimitiveShapeFn& shape) const {
+    bool any = false;
+    for (const Leaf& l : leaves_) any = any || l.leaf.primitive >= 0;
+    if (!any) return nullptr;
+    auto out = std::make_shared<CsgShape>();
+    for (const Leaf& l : leaves_) {
+        CsgLeaf leaf = l.leaf;
+        if (leaf.primitive >= 0) leaf.shape = shape(leaf.primitive);
+        out->add_leaf(std::move(leaf));
+    }
+    out->nodes_ = nodes_;
+    out->set_root(root_);
+    return out;
 }
 
 Bounds3 CsgShape::bounds() const {

@@ -2,6 +2,7 @@
 // Constructive solid geometry (paper 3.1): a tree whose leaves are shapes and whose inner nodes
 // are union, intersection and difference. A ray is answered by merging the leaves' sorted
 // span lists bottom-up; surfaces of subtracted solids come back with their normals turned.
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -19,6 +20,7 @@ struct CsgLeaf {
     std::shared_ptr<const Shape> shape;
     Transform xf;           // leaf coordinates -> the CSG object's coordinates
     std::uint32_t tag = 0;  // material of the leaf's surface
+    int primitive = -1;     // for an instance of a scene primitive: its index
 };
 
 class CsgShape final : public Shape {
@@ -32,11 +34,20 @@ public:
 
     std::size_t leaf_count() const { return leaves_.size(); }
 
+    // The scene primitives that instance leaves refer to (with repeats).
+    std::vector<int> leaf_primitives() const;
+    // A copy whose instance leaves trace shape(primitive) instead (lattice mode); null when
+    // no leaf is an instance.
+    using PrimitiveShapeFn = std::function<std::shared_ptr<const Shape>(int primitive)>;
+    std::shared_ptr<CsgShape> with_primitive_shapes(const PrimitiveShapeFn& shape) const;
+
     Bounds3 bounds() const override;
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
     bool inside(Vec3 p) const override { return inside(root_, p); }
+    // The largest of the leaves' (lattices have one), in this shape's units.
+    double surface_tolerance() const override { return tolerance_; }
     std::uint32_t tag(const Crossing& c, std::uint32_t fallback) const override {
         const std::uint32_t t = leaves_[c.leaf_index()].leaf.tag;
         return t == kNoMaterial ? fallback : t;
@@ -56,6 +67,7 @@ private:
     std::vector<Leaf> leaves_;
     std::vector<Node> nodes_;
     int root_ = 0;
+    double tolerance_ = 0;
 
     Bounds3 compute_bounds(int ref);
     void eval(int ref, const Ray& r, SpanList& out, int depth) const;

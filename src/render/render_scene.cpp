@@ -1,5 +1,7 @@
 #include "render/render_scene.h"
 
+#include "csg/csg_shape.h"
+
 namespace lat {
 
 RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape,
@@ -8,7 +10,12 @@ RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_sha
     shapes_.reserve(scene.objects.size());
     for (const SceneObject& o : scene.objects) {
         std::shared_ptr<const Shape> s = o.shape;
-        if (o.primitive >= 0 && instance_shape) s = instance_shape(o.primitive);
+        if (o.primitive >= 0 && instance_shape) {
+            s = instance_shape(o.primitive);
+        } else if (const auto* csg = dynamic_cast<const CsgShape*>(o.shape.get());
+                   csg && instance_shape) {
+            if (auto swapped = csg->with_primitive_shapes(instance_shape)) s = swapped;  // CSG leaves
+        }
         shapes_.push_back(std::move(s));
     }
     for (std::size_t i = 0; i < scene.objects.size(); ++i)

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "csg/csg_shape.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/encodings.h"
 #include "lattice/lattice_shape.h"
@@ -201,9 +202,13 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, int si
                              const std::string& encoding, bool progress) {
     SceneLattices out;
     out.shapes.resize(scene.primitives.size());
+    // Instances, at the top level or as CSG leaves.
     std::vector<bool> used(scene.primitives.size(), false);
-    for (const SceneObject& o : scene.objects)
+    for (const SceneObject& o : scene.objects) {
         if (o.primitive >= 0) used[static_cast<std::size_t>(o.primitive)] = true;
+        if (const auto* csg = dynamic_cast<const CsgShape*>(o.shape.get()))
+            for (const int p : csg->leaf_primitives()) used[static_cast<std::size_t>(p)] = true;
+    }
     for (std::size_t i = 0; i < scene.primitives.size(); ++i) {
         if (!used[i]) continue;
         const Primitive& p = scene.primitives[i];

@@ -188,7 +188,7 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
         v.fail("missing field 'material' (needed unless an enclosing csg node sets one)");
     }
     if (override_material && v.has("material")) (void)material(v.at("material"));  // still check
-    return csg.add_leaf({leaf.shape, xf * leaf.placement, mat});
+    return csg.add_leaf({leaf.shape, xf * leaf.placement, mat, leaf.primitive});
 }
 
 std::shared_ptr<const Shape> ObjectParser::parse_shape(const JsonValue& v) const {
