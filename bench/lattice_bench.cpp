@@ -34,7 +34,9 @@ void BM_Rasterize(benchmark::State& state) {
     const int k = static_cast<int>(state.range(0));
     const std::string path = cache_dir() + "/bench-hair.lht";
     lat::TableBuild b;
-    for (auto _ : state) b = lat::build_table_file(hair, k, "hash14", path, scene.file, false);
+    lat::TableSpec spec;
+    spec.sigma_inv = k;
+    for (auto _ : state) b = lat::build_table_file(hair, spec, path, scene.file, false);
     const double pairs = static_cast<double>(b.raster.pairs_eq2);
     state.counters["pairs"] = pairs;
     state.counters["stored_hits"] = static_cast<double>(b.raster.hits);
@@ -60,7 +62,7 @@ Prepared& prepared(const std::string& plate) {
     Prepared& p = cache[plate];
     p.scene = lat::load_scene(example(plate));
     const lat::TableCache tables(cache_dir(), true);
-    p.lattices = lat::scene_lattices(p.scene, tables, 1, "hash14", false);
+    p.lattices = lat::scene_lattices(p.scene, tables, {}, false);
     p.exact = std::make_unique<lat::RenderScene>(p.scene);
     p.lattice = std::make_unique<lat::RenderScene>(
         p.scene, [&p](int i) { return p.lattices.shapes[static_cast<std::size_t>(i)]; });

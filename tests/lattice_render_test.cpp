@@ -22,8 +22,12 @@ Scene small(const char* name, int size) {
 
 Image8 render_exact(const Scene& s) { return render_image(RenderScene(s), {}).display; }
 
-Image8 render_lattice(const Scene& s, const TableCache& cache, int sigma_inv) {
-    const SceneLattices l = scene_lattices(s, cache, sigma_inv, "hash14", false);
+Image8 render_lattice(const Scene& s, const TableCache& cache, int sigma_inv,
+                      const std::string& encoding = "hash14") {
+    TableSpec spec;
+    spec.sigma_inv = sigma_inv;
+    spec.encoding = encoding;
+    const SceneLattices l = scene_lattices(s, cache, spec, false);
     const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
     return render_image(rs, {}).display;
 }

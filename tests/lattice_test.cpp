@@ -172,7 +172,7 @@ protected:
         header.pairs = r.pairs_eq2;
         header.entries = r.hits;
         path = (dir.path() / "hook.lht").string();
-        write_table_file(path, header, encode_table("hash14", r));
+        write_table_file(path, header, encode_table("hash14", r, {}));
     }
     std::string load_error(const TableHeader* expected = nullptr) {
         try {
@@ -198,7 +198,7 @@ TEST_F(LatticeFile, RoundTrip) {
 
 TEST_F(LatticeFile, RejectsTruncatedFile) {
     std::filesystem::resize_file(path, std::filesystem::file_size(path) - 7);
-    EXPECT_NE(load_error().find("hook.lht: not a valid lattice table: payload is"), std::string::npos)
+    EXPECT_NE(load_error().find("hook.lht: not a valid lattice table: file holds"), std::string::npos)
         << load_error();
     std::filesystem::resize_file(path, 40);
     EXPECT_NE(load_error().find("too short"), std::string::npos);
@@ -236,7 +236,7 @@ TEST(LatticeShapeTest, AgreesWithExactUpToACell) {
     const double cell = 1.0 / k;
     const LatticeGrid lg{{4 * k, 2 * k, 4 * k}, cell};
     const RasterizeResult r = rasterize(s, lg);
-    const auto payload = encode_table("hash14", r);
+    const auto payload = encode_table("hash14", r, {});
     auto table = std::make_shared<Hash14Table>(payload.data(), payload.size(), r.hits);
     const LatticeShape ls(table, lg.cells, lg.cell);
     const ChainShape thin = grown_hook(-cell), thick = grown_hook(cell);

@@ -13,8 +13,8 @@ namespace lat::cli {
 namespace {
 
 struct RasterizeArgs {
-    std::string scene, primitive, output, encoding = "hash14", lattice_dir, stats;
-    int sigma_inv = 1;
+    std::string scene, primitive, output, lattice_dir, stats;
+    TableSpec spec;
     int threads = 0;
     bool quiet = false;
 };
@@ -34,10 +34,10 @@ int run_rasterize(const RasterizeArgs& a) {
     if (path.empty()) {
         const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
                                !a.lattice_dir.empty());
-        path = cache.path_for(*prim, a.sigma_inv, a.encoding, a.scene);
+        path = cache.path_for(*prim, a.spec, a.scene);
     }
     const auto limit = limit_threads(a.threads);
-    const TableBuild b = build_table_file(*prim, a.sigma_inv, a.encoding, path, a.scene,
+    const TableBuild b = build_table_file(*prim, a.spec, path, a.scene,
                                           !a.quiet && ProgressBar::stderr_is_terminal());
     const RasterizeResult& r = b.raster;
     const double seconds = r.seconds + b.encode_seconds;
@@ -45,7 +45,7 @@ int run_rasterize(const RasterizeArgs& a) {
     if (!a.quiet) {
         std::printf("%s: primitive '%s', %d x %d x %d cells (sigma %g, sigma^-1 %d)\n", path.c_str(),
                     prim->name.c_str(), b.header.cells[0], b.header.cells[1], b.header.cells[2],
-                    b.header.sigma, a.sigma_inv);
+                    b.header.sigma, a.spec.sigma_inv);
         std::printf("  N_lp %llu (eq. 2), %llu distinct segments traced\n",
                     static_cast<unsigned long long>(r.pairs_eq2),
                     static_cast<unsigned long long>(r.pairs_traced));
@@ -54,15 +54,15 @@ int run_rasterize(const RasterizeArgs& a) {
                     static_cast<unsigned long long>(r.hits), double(r.hits_counted) / double(r.pairs_eq2));
         std::printf("  %.3f s (rasterize %.3f s, encode %.3f s), %.1f M pairs/s\n", seconds, r.seconds,
                     b.encode_seconds, double(r.pairs_eq2) / seconds / 1e6);
-        std::printf("  table %s (%s), %llu bytes, %.2f bytes per stored hit\n", a.encoding.c_str(),
+        std::printf("  table %s (%s), %llu bytes, %.2f bytes per stored hit\n", a.spec.encoding.c_str(),
                     human_bytes(double(b.bytes)).c_str(), static_cast<unsigned long long>(b.bytes),
                     per_entry);
     }
     if (!a.stats.empty()) {
         write_json_file(a.stats, {{"table", path},
                                   {"primitive", prim->name},
-                                  {"sigma_inv", a.sigma_inv},
-                                  {"encoding", a.encoding},
+                                  {"sigma_inv", a.spec.sigma_inv},
+                                  {"encoding", a.spec.encoding},
                                   {"cells", b.header.cells},
                                   {"N_lp", r.pairs_eq2},
                                   {"segments_traced", r.pairs_traced},
@@ -87,12 +87,9 @@ Command add_rasterize_command(CLI::App& parent) {
     c.app = parent.add_subcommand("rasterize", "Build a primitive's lattice table (.lht)");
     c.app->add_option("scene", args->scene, "Scene file (JSON) that defines the primitive")->required();
     c.app->add_option("--primitive", args->primitive, "Name of the primitive")->required();
-    c.app->add_option("--sigma-inv", args->sigma_inv,
-                      "Refine the lattice K times: K x the cells at sigma / K, same box")
-        ->check(CLI::Range(1, 1 << 20));
+    add_table_options(*c.app, args->spec);
     c.app->add_option("-o,--output", args->output,
                       "Table file (default: the render cache, where `render --mode lattice` finds it)");
-    c.app->add_option("--encoding", args->encoding, "Table encoding (hash14)");
     c.app->add_option("--lattice-dir", args->lattice_dir, "Cache directory for the default output");
     c.app->add_option("--stats", args->stats, "Write the figures as JSON");
     c.app->add_option("--threads", args->threads, "Worker threads (default: all cores)")

@@ -26,8 +26,7 @@ struct RenderArgs {
     std::string stats;
     std::string mode = "exact";
     std::string lattice_dir;
-    int sigma_inv = 1;
-    std::string encoding = "hash14";
+    TableSpec spec;
     std::string instancing = "auto";
     bool quiet = false;
 };
@@ -49,7 +48,7 @@ int run_render(const RenderArgs& a) {
     if (a.mode == "lattice") {
         const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
                                !a.lattice_dir.empty());
-        lattices = scene_lattices(scene, cache, a.sigma_inv, a.encoding, progress);
+        lattices = scene_lattices(scene, cache, a.spec, progress);
         instance_shape = [&lattices](int prim) { return lattices.shapes[static_cast<std::size_t>(prim)]; };
     }
     const auto t1b = clock::now();
@@ -107,8 +106,8 @@ int run_render(const RenderArgs& a) {
         j["load_ms"] = load_ms;
         j["build_ms"] = build_ms;
         if (a.mode == "lattice") {
-            j["sigma_inv"] = a.sigma_inv;
-            j["encoding"] = a.encoding;
+            j["sigma_inv"] = a.spec.sigma_inv;
+            j["encoding"] = a.spec.encoding;
             j["tables_ms"] = tables_ms;
             j["tables_built"] = lattices.built;
             j["table_bytes"] = lattices.table_bytes;
@@ -146,10 +145,7 @@ Command add_render_command(CLI::App& parent) {
     c.app->add_option("--lattice-dir", args->lattice_dir,
                       "Directory of cached lattice tables (default: $LATTICE_CACHE_DIR, "
                       "$XDG_CACHE_HOME/lattice or ~/.cache/lattice)");
-    c.app->add_option("--sigma-inv", args->sigma_inv,
-                      "Refine every lattice K times (K x the cells at sigma / K)")
-        ->check(CLI::Range(1, 1 << 20));
-    c.app->add_option("--encoding", args->encoding, "Lattice table encoding (hash14)");
+    add_table_options(*c.app, args->spec);
     c.app->add_option("--instancing", args->instancing,
                       "Multi-part objects as Embree instances (always), flattened into one "
                       "hierarchy (never), or flattened unless that would be huge (auto)")

@@ -9,6 +9,8 @@
 #include <string>
 #include <tbb/global_control.h>
 
+#include "scene/lattice_tables.h"
+
 namespace lat::cli {
 
 struct Command {
@@ -20,6 +22,9 @@ Command add_render_command(CLI::App& parent);
 Command add_rasterize_command(CLI::App& parent);
 Command add_table1_command(CLI::App& parent);
 Command add_compare_command(CLI::App& parent);
+
+// --sigma-inv, --encoding and the encodings' error targets, shared by render and rasterize.
+void add_table_options(CLI::App& app, TableSpec& spec);
 
 // Caps oneTBB (and so Embree's builds) at n threads for the object's lifetime; 0 = all cores.
 std::unique_ptr<tbb::global_control> limit_threads(int n);

@@ -10,7 +10,7 @@ namespace lat {
 const std::vector<EncodingInfo>& table_encodings() {
     static const std::vector<EncodingInfo> list = {
         {"hash14", "the paper's hash table, 14-byte entries with key and overflow chain",
-         Hash14Table::kMaxPoints, 15.0},
+         Hash14Table::kMaxPoints, 15.0, true},
     };
     return list;
 }
@@ -24,13 +24,15 @@ const EncodingInfo& encoding_info(const std::string& name) {
     throw InputError("unknown table encoding '" + name + "' (known: " + known + ")");
 }
 
-ByteBuffer encode_table(const std::string& encoding, const RasterizeResult& r) {
+ByteBuffer encode_table(const std::string& encoding, const RasterizeResult& r,
+                        const TableContext&, const EncodeOptions&) {
     if (encoding == "hash14") return Hash14Table::build(r.raw);
     throw std::invalid_argument("encode_table: unknown encoding " + encoding);
 }
 
 std::unique_ptr<LatticeTable> open_table(const std::string& encoding, const std::uint8_t* payload,
-                                         std::size_t size, std::uint64_t entries) {
+                                         std::size_t size, std::uint64_t entries,
+                                         const TableContext&) {
     if (encoding == "hash14") return std::make_unique<Hash14Table>(payload, size, entries);
     throw std::runtime_error("unknown table encoding '" + encoding + "'");
 }

@@ -286,7 +286,9 @@ private:
         const Vec3 n = start_inside ? normalize(-r.d) : shape.normal(r, s.best_c[k]);
         const float t = start_inside ? 0.0f : static_cast<float>(std::min(1.0, s.best_t[k]));
         const Oct o = oct_encode(n, kRawNormalBits);
-        return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v)};
+        const Crossing& c = s.best_c[k];
+        return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v),
+                start_inside ? 0 : c.part, start_inside ? 0 : c.leaf};
     }
 };
 

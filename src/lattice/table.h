@@ -3,6 +3,7 @@
 // points, the intersection closest to p_i of the segment p_i -> p_o with the primitive, if any.
 // The renderer only sees this interface; encodings (the paper's 14-byte hash table, and others
 // later) live behind it.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -24,7 +25,8 @@ struct TableHit {
 struct RawHit {
     std::uint32_t a = 0, b = 0;  // boundary point ids of p_i and p_o
     float t = 0;
-    std::uint16_t nu = 0, nv = 0;  // octahedral normal, 16 bits each
+    std::uint16_t nu = 0, nv = 0;     // octahedral normal, 16 bits each
+    std::uint32_t part = 0, leaf = 0;  // the primitive's Crossing (which surface was hit)
 };
 inline constexpr int kRawNormalBits = 16;
 
@@ -47,11 +49,39 @@ struct RawHits {
     }
 };
 
+class Shape;
+
+// What a table knows besides its payload: the lattice, and the primitive (encodings that
+// intersect it exactly, or re-evaluate its normals, need it).
+struct TableContext {
+    std::array<int, 3> cells{};      // at the refinement
+    double cell = 1;                 // primitive units per lattice unit (sigma / sigma^-1)
+    double sigma = 1;                // the primitive's own grid spacing
+    const Shape* primitive = nullptr;
+};
+
+// Up to this many parts per candidate list (a table with longer lists cannot be built).
+inline constexpr int kMaxCandidates = 64;
+struct CandidateList {
+    int count = 0;
+    std::uint32_t parts[kMaxCandidates];
+};
+
 class LatticeTable {
 public:
     virtual ~LatticeTable() = default;
 
+    // Hit tables answer with the stored hit of a pair; candidate tables with the parts of the
+    // primitive that a ray snapping to the pair can meet, which the renderer then intersects
+    // exactly with the real ray.
+    enum class Kind { kHits, kCandidates };
+    virtual Kind kind() const { return Kind::kHits; }
+
+    // The hit closest to p_a on the segment p_a -> p_b, if any (candidate tables intersect
+    // their candidates with the segment exactly).
     virtual bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const = 0;
+    // Candidate tables: the parts for the pair (a, b); false when there are none.
+    virtual bool candidates(std::uint32_t, std::uint32_t, CandidateList&) const { return false; }
 
     virtual std::string encoding() const = 0;
     // Stored hits, and every byte the table occupies (payload, indices, headers).

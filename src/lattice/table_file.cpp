@@ -63,6 +63,7 @@ std::array<std::uint8_t, kTableHeaderBytes> encode_header(const TableHeader& h,
     f.put(h.pairs);
     f.put(h.entries);
     f.put(h.payload_bytes);
+    f.put(static_cast<std::uint64_t>(h.metadata.size()));
     f.put(payload_checksum);
     const std::uint64_t header_checksum = hash_bytes(b.data(), f.off);
     f.put(header_checksum);
@@ -77,7 +78,7 @@ std::string describe(const TableHeader& h) {
 }
 
 TableHeader decode_header(const std::uint8_t* b, std::size_t file_size, const std::string& path,
-                          std::uint64_t& payload_checksum) {
+                          std::uint64_t& payload_checksum, std::uint64_t& meta_bytes) {
     auto bad = [&](const std::string& what) -> InputError {
         return InputError(path + ": not a valid lattice table: " + what);
     };
@@ -103,12 +104,14 @@ TableHeader decode_header(const std::uint8_t* b, std::size_t file_size, const st
     h.pairs = r.get<std::uint64_t>();
     h.entries = r.get<std::uint64_t>();
     h.payload_bytes = r.get<std::uint64_t>();
+    meta_bytes = r.get<std::uint64_t>();
     payload_checksum = r.get<std::uint64_t>();
     const std::size_t covered = r.off;
     if (r.get<std::uint64_t>() != hash_bytes(b, covered)) throw bad("header checksum mismatch (corrupt)");
-    if (h.payload_bytes != file_size - kTableHeaderBytes)
-        throw bad("payload is " + std::to_string(file_size - kTableHeaderBytes) + " bytes, header says " +
-                  std::to_string(h.payload_bytes) + " (truncated?)");
+    const std::uint64_t body = file_size - kTableHeaderBytes;
+    if (h.payload_bytes > body || meta_bytes != body - h.payload_bytes)
+        throw bad("file holds " + std::to_string(body) + " bytes after the header, header says " +
+                  std::to_string(h.payload_bytes + meta_bytes) + " (truncated?)");
     return h;
 }
 
@@ -125,16 +128,22 @@ class MappedTable final : public LatticeTable {
 public:
     MappedTable(std::shared_ptr<Mapping> m, std::unique_ptr<LatticeTable> t)
         : mapping_(std::move(m)), table_(std::move(t)) {}
+    Kind kind() const override { return table_->kind(); }
     bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const override {
         return table_->lookup(a, b, hit);
     }
+    bool candidates(std::uint32_t a, std::uint32_t b, CandidateList& out) const override {
+        return table_->candidates(a, b, out);
+    }
     std::string encoding() const override { return table_->encoding(); }
     std::uint64_t entries() const override { return table_->entries(); }
-    std::uint64_t bytes() const override { return table_->bytes() + kTableHeaderBytes; }
+    std::uint64_t bytes() const override { return table_->bytes() + kTableHeaderBytes + meta_; }
+    void set_meta_bytes(std::uint64_t n) { meta_ = n; }
 
 private:
     std::shared_ptr<Mapping> mapping_;
     std::unique_ptr<LatticeTable> table_;
+    std::uint64_t meta_ = 0;
 };
 
 }  // namespace
@@ -143,12 +152,15 @@ void write_table_file(const std::string& path, const TableHeader& h0,
                       const ByteBuffer& payload) {
     TableHeader h = h0;
     h.payload_bytes = payload.size();
-    const auto header = encode_header(h, hash_bytes(payload.data(), payload.size()));
+    const std::uint64_t checksum =
+        hash_bytes(h.metadata.data(), h.metadata.size(), hash_bytes(payload.data(), payload.size()));
+    const auto header = encode_header(h, checksum);
     const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
     FILE* f = std::fopen(tmp.c_str(), "wb");
     if (!f) throw InputError(path + ": cannot write lattice table: " + std::strerror(errno));
     bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size() &&
-              std::fwrite(payload.data(), 1, payload.size(), f) == payload.size();
+              std::fwrite(payload.data(), 1, payload.size(), f) == payload.size() &&
+              std::fwrite(h.metadata.data(), 1, h.metadata.size(), f) == h.metadata.size();
     const int err = errno;
     ok = (std::fclose(f) == 0) && ok;
     if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
@@ -167,11 +179,12 @@ TableHeader read_table_header(const std::string& path) {
     const ssize_t got = ::pread(fd, buf, sizeof buf, 0);
     ::close(fd);
     if (!ok || got < 0) throw InputError(path + ": cannot read lattice table");
-    std::uint64_t checksum;
-    return decode_header(buf, static_cast<std::size_t>(st.st_size), path, checksum);
+    std::uint64_t checksum, meta;
+    return decode_header(buf, static_cast<std::size_t>(st.st_size), path, checksum, meta);
 }
 
-LoadedTable load_table_file(const std::string& path, const TableHeader* expected) {
+LoadedTable load_table_file(const std::string& path, const TableHeader* expected,
+                            const Shape* primitive) {
     const int fd = ::open(path.c_str(), O_RDONLY);
     if (fd < 0) throw InputError(path + ": cannot open lattice table: " + std::strerror(errno));
     struct stat st {};
@@ -186,10 +199,10 @@ LoadedTable load_table_file(const std::string& path, const TableHeader* expected
     if (m->size > 0 && m->addr == MAP_FAILED)
         throw InputError(path + ": cannot map lattice table: " + std::strerror(errno));
     const auto* bytes = static_cast<const std::uint8_t*>(m->addr);
-    std::uint64_t checksum = 0;
+    std::uint64_t checksum = 0, meta_bytes = 0;
     LoadedTable out;
-    out.header = decode_header(bytes, m->size, path, checksum);
-    const TableHeader& h = out.header;
+    out.header = decode_header(bytes, m->size, path, checksum, meta_bytes);
+    TableHeader& h = out.header;
     if (expected) {
         if (h.encoding != expected->encoding || h.cells != expected->cells ||
             h.sigma_inv != expected->sigma_inv || h.cell != expected->cell)
@@ -200,10 +213,16 @@ LoadedTable load_table_file(const std::string& path, const TableHeader* expected
                              "(its geometry fingerprint differs); rebuild it");
     }
     const std::uint8_t* payload = bytes + kTableHeaderBytes;
-    if (hash_bytes(payload, h.payload_bytes) != checksum)
+    const std::uint8_t* meta = payload + h.payload_bytes;
+    if (hash_bytes(meta, meta_bytes, hash_bytes(payload, h.payload_bytes)) != checksum)
         throw InputError(path + ": not a valid lattice table: payload checksum mismatch (corrupt)");
+    h.metadata.assign(reinterpret_cast<const char*>(meta), meta_bytes);
+    const TableContext ctx{h.cells, h.cell, h.sigma, primitive};
     try {
-        out.table = std::make_shared<MappedTable>(m, open_table(h.encoding, payload, h.payload_bytes, h.entries));
+        auto mapped = std::make_shared<MappedTable>(
+            m, open_table(h.encoding, payload, h.payload_bytes, h.entries, ctx));
+        mapped->set_meta_bytes(meta_bytes);
+        out.table = mapped;
     } catch (const std::exception& e) {
         throw InputError(path + ": not a valid lattice table: " + e.what());
     }

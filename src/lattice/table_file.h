@@ -2,8 +2,9 @@
 // The lattice table file (.lht), documented in docs/lattice-tables.md:
 //   a 128-byte little-endian header — magic "LATTICE\x1a", format version, header size,
 //   encoding name, lattice geometry (cells at the refinement, sigma, sigma^-1, cell size), the
-//   fingerprint of the primitive it was built for, counts (N_lp, stored hits), payload size,
-//   payload checksum, header checksum — followed by the encoding's payload.
+//   fingerprint of the primitive it was built for, counts (N_lp, stored hits), payload and
+//   metadata sizes, their checksum, header checksum — followed by the encoding's payload and
+//   the metadata (JSON).
 // Loading checks all of it and rejects a truncated, corrupt or mismatched file with a message
 // naming the file and what is wrong. The payload is memory-mapped, not copied.
 #include <array>
@@ -27,6 +28,9 @@ struct TableHeader {
     std::uint64_t pairs = 0;    // N_lp by eq. (2)
     std::uint64_t entries = 0;  // stored hits
     std::uint64_t payload_bytes = 0;
+    // JSON, after the payload: the primitive's name and definition and the scene it came from,
+    // so that a table file can be inspected on its own.
+    std::string metadata;
 };
 
 inline constexpr std::uint32_t kTableFormatVersion = 1;
@@ -45,7 +49,9 @@ struct LoadedTable {
 // Reads just the header (validated); throws InputError.
 TableHeader read_table_header(const std::string& path);
 // Loads and validates a whole file; `expected`, when given, must match its encoding,
-// geometry and fingerprint (a table built for another primitive is rejected).
-LoadedTable load_table_file(const std::string& path, const TableHeader* expected = nullptr);
+// geometry and fingerprint (a table built for another primitive is rejected). `primitive` is
+// what encodings that intersect it exactly use (null: the table's lookups may be unusable).
+LoadedTable load_table_file(const std::string& path, const TableHeader* expected = nullptr,
+                            const Shape* primitive = nullptr);
 
 }  // namespace lat

@@ -10,10 +10,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "csg/csg_shape.h"
 #include "lattice/boundary_grid.h"
-#include "lattice/encodings.h"
 #include "lattice/lattice_shape.h"
 #include "util/error.h"
 #include "util/hash.h"
@@ -32,8 +32,8 @@ LatticeGrid grid_of(const TableHeader& h) { return {h.cells, h.cell}; }
 
 }  // namespace
 
-TableHeader lattice_header(const Primitive& p, int sigma_inv, const std::string& encoding,
-                           const std::string& scene_file) {
+TableHeader lattice_header(const Primitive& p, const TableSpec& spec, const std::string& scene_file) {
+    const int sigma_inv = spec.sigma_inv;
     if (!p.lattice)
         throw InputError(where(p, scene_file) + "primitive '" + p.name +
                          "' has no lattice (add \"lattice\": {\"sigma\": ..., \"cells\": [...]})");
@@ -41,7 +41,7 @@ TableHeader lattice_header(const Primitive& p, int sigma_inv, const std::string&
         throw InputError("--sigma-inv " + std::to_string(sigma_inv) + ": must be between 1 and " +
                          std::to_string(kMaxSigmaInv));
     TableHeader h;
-    h.encoding = encoding_info(encoding).name;
+    h.encoding = encoding_info(spec.encoding).name;
     h.sigma = p.lattice->sigma;
     h.sigma_inv = sigma_inv;
     h.cell = p.lattice->sigma / sigma_inv;
@@ -57,14 +57,25 @@ TableHeader lattice_header(const Primitive& p, int sigma_inv, const std::string&
                         .add(h.cells[2])
                         .add(sigma_inv)
                         .add(h.encoding)
+                        .add(spec.options.max_point_error)
+                        .add(spec.options.max_normal_error_deg)
+                        .add(spec.options.normals)
                         .add(kRasterizerVersion)
                         .value();
+    h.metadata = nlohmann::json{{"primitive", p.name}, {"definition", nlohmann::json::parse(p.definition)},
+                                {"scene", scene_file}}
+                     .dump();
     return h;
 }
 
-void check_table_buildable(const Primitive& p, int sigma_inv, const std::string& encoding,
-                           const std::string& scene_file) {
-    const TableHeader h = lattice_header(p, sigma_inv, encoding, scene_file);
+TableContext table_context(const Primitive& p, const TableHeader& h) {
+    return {h.cells, h.cell, h.sigma, p.shape.get()};
+}
+
+void check_table_buildable(const Primitive& p, const TableSpec& spec, const std::string& scene_file) {
+    const TableHeader h = lattice_header(p, spec, scene_file);
+    const int sigma_inv = spec.sigma_inv;
+    const std::string& encoding = spec.encoding;
     const std::string at = where(p, scene_file);
     // The primitive must lie in its box: the table cannot see what sticks out.
     const Bounds3 b = p.shape->bounds();
@@ -123,22 +134,24 @@ void check_table_buildable(const Primitive& p, int sigma_inv, const std::string&
     if (avail > 0 && need > 0.8 * avail) refuse(rate, need, false);
 }
 
-TableBuild build_table_file(const Primitive& p, int sigma_inv, const std::string& encoding,
-                            const std::string& path, const std::string& scene_file, bool progress) {
-    check_table_buildable(p, sigma_inv, encoding, scene_file);
+TableBuild build_table_file(const Primitive& p, const TableSpec& spec, const std::string& path,
+                            const std::string& scene_file, bool progress) {
+    check_table_buildable(p, spec, scene_file);
     TableBuild b;
-    b.header = lattice_header(p, sigma_inv, encoding, scene_file);
+    b.header = lattice_header(p, spec, scene_file);
     RasterizeOptions opt;
     opt.progress = progress;
+    opt.keep_hits = encoding_info(spec.encoding).needs_hits;
     b.raster = rasterize(*p.shape, grid_of(b.header), opt);
     const auto t0 = std::chrono::steady_clock::now();
-    const ByteBuffer payload = encode_table(encoding, b.raster);
+    const ByteBuffer payload =
+        encode_table(spec.encoding, b.raster, table_context(p, b.header), spec.options);
     b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     b.raster.raw = {};
     b.header.pairs = b.raster.pairs_eq2;
     b.header.entries = b.raster.hits;
     write_table_file(path, b.header, payload);
-    b.bytes = payload.size() + kTableHeaderBytes;
+    b.bytes = payload.size() + kTableHeaderBytes + b.header.metadata.size();
     return b;
 }
 
@@ -165,31 +178,31 @@ TableCache::TableCache(const std::string& dir, bool explicit_dir) : dir_(dir) {
                          std::strerror(errno));
 }
 
-std::string TableCache::path_for(const Primitive& p, int sigma_inv, const std::string& encoding,
+std::string TableCache::path_for(const Primitive& p, const TableSpec& spec,
                                  const std::string& scene_file) const {
-    const TableHeader h = lattice_header(p, sigma_inv, encoding, scene_file);
+    const TableHeader h = lattice_header(p, spec, scene_file);
     std::string safe;
     for (char c : p.name) safe += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
     char tail[64];
-    std::snprintf(tail, sizeof tail, "-s%d-%s-%016llx.lht", sigma_inv, encoding.c_str(),
+    std::snprintf(tail, sizeof tail, "-s%d-%s-%016llx.lht", spec.sigma_inv, spec.encoding.c_str(),
                   static_cast<unsigned long long>(h.fingerprint));
     return dir_ + "/" + safe.substr(0, 64) + tail;
 }
 
-TableCache::Entry TableCache::get(const Primitive& p, int sigma_inv, const std::string& encoding,
+TableCache::Entry TableCache::get(const Primitive& p, const TableSpec& spec,
                                   const std::string& scene_file, bool progress) const {
     Entry e;
-    e.path = path_for(p, sigma_inv, encoding, scene_file);
-    const TableHeader expected = lattice_header(p, sigma_inv, encoding, scene_file);
+    e.path = path_for(p, spec, scene_file);
+    const TableHeader expected = lattice_header(p, spec, scene_file);
     struct stat st {};
     if (::stat(e.path.c_str(), &st) != 0) {
         const auto t0 = std::chrono::steady_clock::now();
-        build_table_file(p, sigma_inv, encoding, e.path, scene_file, progress);
+        build_table_file(p, spec, e.path, scene_file, progress);
         e.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         e.built = true;
     }
     try {
-        LoadedTable lt = load_table_file(e.path, &expected);
+        LoadedTable lt = load_table_file(e.path, &expected, p.shape.get());
         e.table = lt.table;
         e.header = lt.header;
     } catch (const InputError& err) {
@@ -198,8 +211,8 @@ TableCache::Entry TableCache::get(const Primitive& p, int sigma_inv, const std::
     return e;
 }
 
-SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, int sigma_inv,
-                             const std::string& encoding, bool progress) {
+SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const TableSpec& spec,
+                             bool progress) {
     SceneLattices out;
     out.shapes.resize(scene.primitives.size());
     // Instances, at the top level or as CSG leaves.
@@ -212,7 +225,7 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, int si
     for (std::size_t i = 0; i < scene.primitives.size(); ++i) {
         if (!used[i]) continue;
         const Primitive& p = scene.primitives[i];
-        const TableCache::Entry e = cache.get(p, sigma_inv, encoding, scene.file, progress);
+        const TableCache::Entry e = cache.get(p, spec, scene.file, progress);
         out.shapes[i] = std::make_shared<LatticeShape>(e.table, e.header.cells, e.header.cell);
         out.table_bytes += e.table->bytes();
         out.table_entries += e.table->entries();

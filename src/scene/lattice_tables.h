@@ -1,10 +1,11 @@
 #pragma once
-// Lattice tables for a scene's primitives: what a table for (primitive, sigma^-1, encoding)
-// must be, building one (with an up-front size check), and the on-disk cache that `render`
-// uses so that a lattice-mode render builds each table once and then reuses it.
+// Lattice tables for a scene's primitives: what a table for (primitive, spec) must be, building
+// one (with an up-front size check), and the on-disk cache that `render` uses so that a
+// lattice-mode render builds each table once and then reuses it.
 #include <memory>
 #include <string>
 
+#include "lattice/encodings.h"
 #include "lattice/rasterizer.h"
 #include "lattice/table_file.h"
 #include "scene/scene.h"
@@ -12,18 +13,24 @@
 namespace lat {
 
 // Bump when rasterization semantics change, so cached tables are rebuilt.
-inline constexpr int kRasterizerVersion = 1;
+inline constexpr int kRasterizerVersion = 2;
+
+// Which table of a primitive: refinement, encoding and its error targets.
+struct TableSpec {
+    int sigma_inv = 1;
+    std::string encoding = "hash14";
+    EncodeOptions options;
+};
 
 // The header a table for this primitive must carry; throws InputError when the primitive has
-// no lattice or sigma_inv is out of range.
-TableHeader lattice_header(const Primitive& p, int sigma_inv, const std::string& encoding,
-                           const std::string& scene_file);
+// no lattice, sigma_inv is out of range or the encoding is unknown.
+TableHeader lattice_header(const Primitive& p, const TableSpec& spec, const std::string& scene_file);
+TableContext table_context(const Primitive& p, const TableHeader& h);
 
 // Throws InputError, before any long work, when the table cannot be built here: the primitive
 // leaves its lattice box, the encoding cannot key that many points, or the table would not fit
 // in memory (the message gives the size it would need).
-void check_table_buildable(const Primitive& p, int sigma_inv, const std::string& encoding,
-                           const std::string& scene_file);
+void check_table_buildable(const Primitive& p, const TableSpec& spec, const std::string& scene_file);
 
 struct TableBuild {
     TableHeader header;
@@ -33,8 +40,8 @@ struct TableBuild {
 };
 
 // Rasterizes the primitive, encodes the table and writes it to `path` atomically.
-TableBuild build_table_file(const Primitive& p, int sigma_inv, const std::string& encoding,
-                            const std::string& path, const std::string& scene_file, bool progress);
+TableBuild build_table_file(const Primitive& p, const TableSpec& spec, const std::string& path,
+                            const std::string& scene_file, bool progress);
 
 // The default cache directory: $LATTICE_CACHE_DIR, else $XDG_CACHE_HOME/lattice, else
 // ~/.cache/lattice.
@@ -46,8 +53,7 @@ public:
     TableCache(const std::string& dir, bool explicit_dir);
 
     const std::string& dir() const { return dir_; }
-    std::string path_for(const Primitive& p, int sigma_inv, const std::string& encoding,
-                         const std::string& scene_file) const;
+    std::string path_for(const Primitive& p, const TableSpec& spec, const std::string& scene_file) const;
 
     struct Entry {
         std::shared_ptr<const LatticeTable> table;
@@ -57,8 +63,8 @@ public:
         double build_seconds = 0;
     };
     // Loads the cached table, or builds and caches it.
-    Entry get(const Primitive& p, int sigma_inv, const std::string& encoding,
-              const std::string& scene_file, bool progress) const;
+    Entry get(const Primitive& p, const TableSpec& spec, const std::string& scene_file,
+              bool progress) const;
 
 private:
     std::string dir_;
@@ -73,7 +79,7 @@ struct SceneLattices {
     double build_seconds = 0;
     std::vector<std::string> paths;
 };
-SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, int sigma_inv,
-                             const std::string& encoding, bool progress);
+SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const TableSpec& spec,
+                             bool progress);
 
 }  // namespace lat

@@ -42,6 +42,7 @@ struct Primitive {
     std::string where;  // e.g. "primitives.hair", for messages
     std::shared_ptr<const Shape> shape;
     std::uint64_t fingerprint = 0;  // of the geometry as written, to key lattice tables
+    std::string definition;         // the geometry as written (JSON), stored with its tables
     std::optional<LatticeSpec> lattice;
 };
 

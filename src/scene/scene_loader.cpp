@@ -96,11 +96,17 @@ Primitive parse_primitive(const JsonValue& v, const std::string& name, const Obj
             v.fail("a primitive is either spheres and cylinders or an object, not both");
         if (!objects) obj->fail("objects are not allowed as primitives here");
         p.shape = objects->parse_shape(*obj);
+        p.definition = nlohmann::json{{"object", obj->raw()}}.dump();
         fp.add("object").add(obj->raw().dump());
     } else {
         p.shape = parse_chain(v);
         fp.add("chain").add(v.at("spheres").raw().dump());
-        if (auto c = v.find("cylinders")) fp.add(c->raw().dump());
+        nlohmann::json def{{"spheres", v.at("spheres").raw()}};
+        if (auto c = v.find("cylinders")) {
+            fp.add(c->raw().dump());
+            def["cylinders"] = c->raw();
+        }
+        p.definition = def.dump();
     }
     p.fingerprint = fp.value();
     if (auto lv = v.find("lattice")) {

@@ -31,7 +31,7 @@ elseif(CASE STREQUAL "truncated")
   file(SIZE ${tables} size)
   math(EXPR keep "${size} - 1000")
   execute_process(COMMAND truncate -s ${keep} ${tables})
-  run(2 "not a valid lattice table: payload is [0-9]+ bytes, header says [0-9]+ \\(truncated\\?\\)"
+  run(2 "not a valid lattice table: file holds [0-9]+ bytes after the header, header says [0-9]+ \\(truncated\\?\\)"
       ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/x.png)
 elseif(CASE STREQUAL "other_primitive")
   # The hair's cache file replaced by the thistle spike's table.
