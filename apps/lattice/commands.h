@@ -22,6 +22,7 @@ Command add_render_command(CLI::App& parent);
 Command add_rasterize_command(CLI::App& parent);
 Command add_table1_command(CLI::App& parent);
 Command add_compare_command(CLI::App& parent);
+Command add_inspect_command(CLI::App& parent);
 
 // --sigma-inv, --encoding and the encodings' error targets, shared by render and rasterize.
 void add_table_options(CLI::App& app, TableSpec& spec);

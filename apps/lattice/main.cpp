@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     commands.push_back(lat::cli::add_rasterize_command(app));
     commands.push_back(lat::cli::add_table1_command(app));
     commands.push_back(lat::cli::add_compare_command(app));
+    commands.push_back(lat::cli::add_inspect_command(app));
 
     try {
         app.parse(argc, argv);

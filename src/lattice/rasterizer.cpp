@@ -283,12 +283,27 @@ private:
         const GridPoint q = grid_.point(b);
         const Vec3 qv{double(q.x), double(q.y), double(q.z)};
         const Ray r{p * h_, (qv - p) * h_};
-        const Vec3 n = start_inside ? normalize(-r.d) : shape.normal(r, s.best_c[k]);
-        const float t = start_inside ? 0.0f : static_cast<float>(std::min(1.0, s.best_t[k]));
-        const Oct o = oct_encode(n, kRawNormalBits);
-        const Crossing& c = s.best_c[k];
-        return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v),
-                start_inside ? 0 : c.part, start_inside ? 0 : c.leaf};
+        Crossing c = s.best_c[k];
+        float t = static_cast<float>(std::min(1.0, s.best_t[k]));
+        if (start_inside) {
+            // p lies in the closed solid (on its surface, where a primitive touches the box): the
+            // hit is p itself, with the surface there the crossing nearest to it.
+            t = 0.0f;
+            c = nearest_crossing(shape, r);
+        }
+        const Oct o = oct_encode(shape.normal(r, c), kRawNormalBits);
+        return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v), c.part, c.leaf};
+    }
+
+    static Crossing nearest_crossing(const Shape& shape, const Ray& r) {
+        SpanList spans;
+        shape.spans(r, spans);
+        Crossing best{kInfinity, 0, 0};
+        for (const Span& sp : spans)
+            for (const Crossing& c : {sp.in, sp.out})
+                if (std::abs(c.t) < std::abs(best.t)) best = c;
+        best.t = 0;
+        return best;
     }
 };
 

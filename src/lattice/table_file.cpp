@@ -177,10 +177,23 @@ TableHeader read_table_header(const std::string& path) {
     std::uint8_t buf[kTableHeaderBytes] = {};
     const bool ok = ::fstat(fd, &st) == 0;
     const ssize_t got = ::pread(fd, buf, sizeof buf, 0);
-    ::close(fd);
-    if (!ok || got < 0) throw InputError(path + ": cannot read lattice table");
+    if (!ok || got < 0) {
+        ::close(fd);
+        throw InputError(path + ": cannot read lattice table");
+    }
     std::uint64_t checksum, meta;
-    return decode_header(buf, static_cast<std::size_t>(st.st_size), path, checksum, meta);
+    TableHeader h;
+    try {
+        h = decode_header(buf, static_cast<std::size_t>(st.st_size), path, checksum, meta);
+    } catch (...) {
+        ::close(fd);
+        throw;
+    }
+    h.metadata.resize(meta);
+    const ssize_t m = ::pread(fd, h.metadata.data(), meta, static_cast<off_t>(kTableHeaderBytes + h.payload_bytes));
+    ::close(fd);
+    if (m != static_cast<ssize_t>(meta)) throw InputError(path + ": cannot read lattice table metadata");
+    return h;
 }
 
 LoadedTable load_table_file(const std::string& path, const TableHeader* expected,

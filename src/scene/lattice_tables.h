@@ -43,6 +43,9 @@ struct TableBuild {
 TableBuild build_table_file(const Primitive& p, const TableSpec& spec, const std::string& path,
                             const std::string& scene_file, bool progress);
 
+// The primitive a table file was built for, from the definition stored in its metadata.
+Primitive primitive_from_metadata(const TableHeader& h, const std::string& path);
+
 // The default cache directory: $LATTICE_CACHE_DIR, else $XDG_CACHE_HOME/lattice, else
 // ~/.cache/lattice.
 std::string default_cache_dir();
