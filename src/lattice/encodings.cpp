@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "lattice/dense_table.h"
 #include "lattice/hash14_table.h"
 #include "util/error.h"
 
@@ -11,6 +12,9 @@ const std::vector<EncodingInfo>& table_encodings() {
     static const std::vector<EncodingInfo> list = {
         {"hash14", "the paper's hash table, 14-byte entries with key and overflow chain",
          Hash14Table::kMaxPoints, 15.0, true},
+        {"dense", "no hashing: occupancy bits with a rank directory, both directions per record, "
+                  "bit widths chosen per table for the error targets",
+         0xFFFFFFFFull, 4.0, true},
     };
     return list;
 }
@@ -25,15 +29,17 @@ const EncodingInfo& encoding_info(const std::string& name) {
 }
 
 ByteBuffer encode_table(const std::string& encoding, const RasterizeResult& r,
-                        const TableContext&, const EncodeOptions&) {
+                        const TableContext& ctx, const EncodeOptions& opt) {
     if (encoding == "hash14") return Hash14Table::build(r.raw);
+    if (encoding == "dense") return DenseTable::build(r.raw, ctx, opt);
     throw std::invalid_argument("encode_table: unknown encoding " + encoding);
 }
 
 std::unique_ptr<LatticeTable> open_table(const std::string& encoding, const std::uint8_t* payload,
                                          std::size_t size, std::uint64_t entries,
-                                         const TableContext&) {
+                                         const TableContext& ctx) {
     if (encoding == "hash14") return std::make_unique<Hash14Table>(payload, size, entries);
+    if (encoding == "dense") return std::make_unique<DenseTable>(payload, size, entries, ctx);
     throw std::runtime_error("unknown table encoding '" + encoding + "'");
 }
 
