@@ -154,6 +154,13 @@ std::uint64_t BBHash::operator()(std::uint64_t key) const {
     return kNone;
 }
 
+void BBHash::prefetch(std::uint64_t key) const {
+    if (levels_ == 0) return;
+    const std::uint64_t p = position(key_hash(key), 0, start_[1] * 64);
+    __builtin_prefetch(bits_ + (p >> 6));
+    __builtin_prefetch(rank_ + (p >> 6) / kRankWords);
+}
+
 double BBHash::accept_rate() const {
     double reject = 1;
     for (int l = 0; l < levels_; ++l) {

@@ -38,6 +38,9 @@ public:
 
     // The key's value in [0, keys()), or kNone when it falls through every level.
     std::uint64_t operator()(std::uint64_t key) const;
+    // Starts loading what the first level needs for the key (to overlap the cache misses of
+    // a run of lookups).
+    void prefetch(std::uint64_t key) const;
 
     std::uint64_t keys() const { return n_; }
     int levels() const { return levels_; }

@@ -58,7 +58,12 @@ ByteBuffer PerfectTable::build(const RawHits& hits, int fingerprint_bits) {
     std::uint8_t* entries = payload.data() + kHeader + mphf_bytes;
     // Each pair owns its slot (the MPHF is a bijection), so chunks fill in parallel.
     tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
-        for (const RawHit& h : hits.chunks[c]) {
+        const std::span<const RawHit> chunk = hits.chunks[c];
+        constexpr std::size_t kAhead = 16;
+        for (std::size_t i = 0; i < chunk.size(); ++i) {
+            if (i + kAhead < chunk.size())
+                mphf.prefetch(key(chunk[i + kAhead].a, chunk[i + kAhead].b));
+            const RawHit& h = chunk[i];
             const std::uint64_t k = key(h.a, h.b);
             std::uint8_t* e = entries + mphf(k) * stride;
             const auto t = static_cast<std::uint16_t>(
