@@ -161,29 +161,14 @@ ByteBuffer CandidatesTable::build(const TableContext& ctx, bool progress) {
             for (const FaceLayout& fl : faces) {
                 if (s.mask.size() < fl.mask.size()) s.mask.assign(fl.mask.size(), 0);
                 for (const PartSphere& ps : cull) {
-                    int u0, u1, v0, v1;
-                    const Vec3 rr{ps.r, ps.r, ps.r};
-                    projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
-                    for (int v = v0; v <= v1; ++v) {
-                        double ulo, uhi;
-                        if (!cone_row(p, ps, fl, v, ulo, uhi)) continue;
-                        const int ub = static_cast<int>(std::ceil(std::max(ulo, double(u0))));
-                        const int ue = static_cast<int>(std::floor(std::min(uhi, double(u1))));
-                        for (int u = ub; u <= ue; ++u) {
-                            const std::size_t k = static_cast<std::size_t>(v * fl.nu + u);
-                            const std::uint32_t b = fl.ids[k];
-                            const std::uint64_t bit = std::uint64_t{1} << ps.part;
-                            if (!fl.canonical[k] || b <= a || (s.mask[k] & bit)) continue;
-                            if (!BoundaryGrid::valid_pair(fa, fl.mask[k])) continue;
-                            Vec3 q;
-                            q[static_cast<std::size_t>(fl.axis)] = fl.level;
-                            q[static_cast<std::size_t>(fl.ua)] = u;
-                            q[static_cast<std::size_t>(fl.va)] = v;
-                            if (!parts[ps.part].near(p, q, kReach)) continue;
-                            if (!s.mask[k]) s.touched.push_back(k);
-                            s.mask[k] |= bit;
-                        }
-                    }
+                    const std::uint64_t bit = std::uint64_t{1} << ps.part;
+                    for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
+                        if (fl.ids[k] <= a || (s.mask[k] & bit)) return;
+                        if (!BoundaryGrid::valid_pair(fa, fl.mask[k])) return;
+                        if (!parts[ps.part].near(p, q, kReach)) return;
+                        if (!s.mask[k]) s.touched.push_back(k);
+                        s.mask[k] |= bit;
+                    });
                 }
                 for (const std::size_t k : s.touched) {
                     out.push_back({pair_index(a, fl.ids[k]), s.mask[k]});

@@ -2,6 +2,8 @@
 // Culling segments from an entry point to the grid points of an exit face: a face's grid, and
 // for a sphere the exit points whose segment from p can meet it (the cone from p around the
 // sphere, row by row). Shared by rasterization and the candidate tables.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -36,5 +38,30 @@ void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& 
 // for an empty interval.
 bool cone_row(const Vec3& p, const PartSphere& s, const FaceLayout& f, int v, double& ulo,
               double& uhi);
+
+// Every canonical exit point of face fl inside the cone from p around the sphere ps: calls
+// visit(k, q) with k the point's index in the face and q its lattice coordinates.
+template <class Visit>
+void for_each_exit_in_cone(const Vec3& p, const PartSphere& ps, const FaceLayout& fl, Visit&& visit) {
+    int u0, u1, v0, v1;
+    const Vec3 rr{ps.r, ps.r, ps.r};
+    projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
+    for (int v = v0; v <= v1; ++v) {
+        double ulo, uhi;
+        if (!cone_row(p, ps, fl, v, ulo, uhi)) continue;
+        // Clamp in double first: the interval may be unbounded or huge.
+        const int ub = static_cast<int>(std::ceil(std::max(ulo, double(u0))));
+        const int ue = static_cast<int>(std::floor(std::min(uhi, double(u1))));
+        for (int u = ub; u <= ue; ++u) {
+            const std::size_t k = static_cast<std::size_t>(v * fl.nu + u);
+            if (!fl.canonical[k]) continue;
+            Vec3 q;
+            q[static_cast<std::size_t>(fl.axis)] = fl.level;
+            q[static_cast<std::size_t>(fl.ua)] = u;
+            q[static_cast<std::size_t>(fl.va)] = v;
+            visit(k, q);
+        }
+    }
+}
 
 }  // namespace lat

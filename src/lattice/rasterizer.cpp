@@ -159,34 +159,19 @@ private:
                 last_part = ps.part;
                 ++s.generation;  // marks "tested for this part" in s.tested
             }
-            int u0, u1, v0, v1;
-            const Vec3 rr{ps.r, ps.r, ps.r};
-            projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
-            for (int v = v0; v <= v1; ++v) {
-                double ulo, uhi;
-                if (!cone_row(p, ps, fl, v, ulo, uhi)) continue;
-                // Clamp in double first: the interval may be unbounded or huge.
-                const int ub = static_cast<int>(std::ceil(std::max(ulo, double(u0))));
-                const int ue = static_cast<int>(std::floor(std::min(uhi, double(u1))));
-                for (int u = ub; u <= ue; ++u) {
-                    const std::size_t k = static_cast<std::size_t>(v * fl.nu + u);
-                    if (!fl.canonical[k] || s.tested[k] == s.generation) continue;
-                    s.tested[k] = s.generation;
-                    Vec3 q;
-                    q[static_cast<std::size_t>(fl.axis)] = fl.level;
-                    q[static_cast<std::size_t>(fl.ua)] = u;
-                    q[static_cast<std::size_t>(fl.va)] = v;
-                    const Ray r{p * h_, (q - p) * h_};
-                    Crossing c;
-                    ++cnt.tests;
-                    const double tmax = std::min(s.best_t[k], 1.0 + 1e-12);
-                    if (shape.intersect_primitive(ps.part, r, 0.0, tmax, c)) {
-                        if (s.best_t[k] == kInfinity) s.touched.push_back(k);
-                        s.best_t[k] = c.t;
-                        s.best_c[k] = c;
-                    }
+            for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
+                if (s.tested[k] == s.generation) return;
+                s.tested[k] = s.generation;
+                const Ray r{p * h_, (q - p) * h_};
+                Crossing c;
+                ++cnt.tests;
+                const double tmax = std::min(s.best_t[k], 1.0 + 1e-12);
+                if (shape.intersect_primitive(ps.part, r, 0.0, tmax, c)) {
+                    if (s.best_t[k] == kInfinity) s.touched.push_back(k);
+                    s.best_t[k] = c.t;
+                    s.best_c[k] = c;
                 }
-            }
+            });
         }
     }
 
