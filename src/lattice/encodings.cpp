@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "lattice/hash14_table.h"
+#include "lattice/learned_table.h"
 #include "util/error.h"
 
 namespace lat {
@@ -11,6 +12,12 @@ const std::vector<EncodingInfo>& table_encodings() {
     static const std::vector<EncodingInfo> list = {
         {"hash14", "the paper's hash table, 14-byte entries with key and overflow chain",
          Hash14Table::kMaxPoints, 15.0, true},
+        // Planned at the build's peak: the reference normals and hit index it keeps (32 bytes
+        // per hit) besides the table itself.
+        {"learned",
+         "a fitted coarse-grid function of the pair, plus exceptions where it errs beyond the "
+         "bounds",
+         LearnedTable::kMaxPoints, 36.0, true},
     };
     return list;
 }
@@ -25,15 +32,17 @@ const EncodingInfo& encoding_info(const std::string& name) {
 }
 
 ByteBuffer encode_table(const std::string& encoding, const RasterizeResult& r,
-                        const TableContext&, const EncodeOptions&) {
+                        const TableContext& ctx, const EncodeOptions& opt) {
     if (encoding == "hash14") return Hash14Table::build(r.raw);
+    if (encoding == "learned") return LearnedTable::build(r.raw, ctx, opt);
     throw std::invalid_argument("encode_table: unknown encoding " + encoding);
 }
 
 std::unique_ptr<LatticeTable> open_table(const std::string& encoding, const std::uint8_t* payload,
                                          std::size_t size, std::uint64_t entries,
-                                         const TableContext&) {
+                                         const TableContext& ctx) {
     if (encoding == "hash14") return std::make_unique<Hash14Table>(payload, size, entries);
+    if (encoding == "learned") return std::make_unique<LearnedTable>(payload, size, entries, ctx);
     throw std::runtime_error("unknown table encoding '" + encoding + "'");
 }
 
