@@ -1,5 +1,6 @@
 #include "lattice/learned_bits.h"
 
+#include <algorithm>
 #include <bit>
 #include <stdexcept>
 
@@ -19,8 +20,9 @@ EliasFanoShape EliasFanoShape::for_keys(std::uint64_t n, std::uint64_t universe)
     s.n = n;
     s.universe = universe;
     s.low_bits = 0;
-    if (n > 0)
-        while (s.low_bits < 62 && (universe >> (s.low_bits + 1)) >= n) ++s.low_bits;
+    // About log2(universe / n) low bits leaves at most 2n buckets; an empty set needs one.
+    const std::uint64_t keep = std::max<std::uint64_t>(n, 1);
+    while (s.low_bits < 63 && (universe >> (s.low_bits + 1)) >= keep) ++s.low_bits;
     return s;
 }
 
@@ -45,7 +47,8 @@ EliasFanoView::EliasFanoView(const std::uint64_t* words, const EliasFanoShape& s
     : high_(words), low_(words + shape.high_words()), shape_(shape) {
     const std::uint64_t nbits = shape.high_bits(), nwords = shape.high_words();
     std::uint64_t ones = 0;
-    for (std::uint64_t w = 0; w < nwords; ++w) ones += static_cast<std::uint64_t>(std::popcount(high_[w]));
+    for (std::uint64_t w = 0; w < nwords; ++w)
+        ones += static_cast<std::uint64_t>(std::popcount(high_[w]));
     const unsigned tail = static_cast<unsigned>(nbits & 63);
     if (ones != shape.n || (tail != 0 && (high_[nwords - 1] >> tail) != 0))
         throw std::runtime_error("learned: exception index is inconsistent");
@@ -88,7 +91,7 @@ bool EliasFanoView::find(std::uint64_t key, std::uint64_t& rank) const {
     const std::uint64_t nbits = shape_.high_bits();
     for (std::uint64_t pos = h == 0 ? 0 : select_zero(h - 1) + 1; pos < nbits; ++pos) {
         if (((high_[pos >> 6] >> (pos & 63)) & 1) == 0) return false;  // end of the bucket
-        const std::uint64_t i = pos - h;  // ones before pos
+        const std::uint64_t i = pos - h;                               // ones before pos
         const std::uint64_t low = read_bits(low_, i * lb, lb);
         if (low == want) {
             rank = i;

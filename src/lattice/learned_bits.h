@@ -19,11 +19,15 @@ inline std::uint64_t read_bits(const std::uint64_t* w, std::uint64_t pos, unsign
     return width == 64 ? v : v & ((std::uint64_t{1} << width) - 1);
 }
 
-inline std::uint64_t words_for_bits(std::uint64_t bits) { return (bits + 63) / 64; }
+inline std::uint64_t words_for_bits(std::uint64_t bits) {
+    return (bits + 63) / 64;
+}
 
 class BitWriter {
 public:
-    explicit BitWriter(std::uint64_t reserve_bits = 0) { words_.reserve(words_for_bits(reserve_bits)); }
+    explicit BitWriter(std::uint64_t reserve_bits = 0) {
+        words_.reserve(words_for_bits(reserve_bits));
+    }
     void put(std::uint64_t v, unsigned width) {
         if (width == 0) return;
         if (width < 64) v &= (std::uint64_t{1} << width) - 1;
