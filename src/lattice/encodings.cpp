@@ -12,12 +12,12 @@ const std::vector<EncodingInfo>& table_encodings() {
     static const std::vector<EncodingInfo> list = {
         {"hash14", "the paper's hash table, 14-byte entries with key and overflow chain",
          Hash14Table::kMaxPoints, 15.0, true},
-        // Planned at the build's peak: the reference normals and hit index it keeps (32 bytes
-        // per hit) besides the table itself.
+        // Planned at the build's peak: the index of the hits by entry point (8 bytes per hit),
+        // the exception list and the table (a few bytes per hit at most).
         {"learned",
-         "a fitted coarse-grid function of the pair, plus exceptions where it errs beyond the "
-         "bounds",
-         LearnedTable::kMaxPoints, 36.0, true},
+         "a distance field fitted to the hits, marched along the pair, plus exceptions where "
+         "it errs beyond the bounds",
+         LearnedTable::kMaxPoints, 12.0, true},
     };
     return list;
 }

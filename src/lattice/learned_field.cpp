@@ -99,21 +99,16 @@ FieldView::FieldView(const FieldShape& s, const std::uint64_t* dense_bits,
             if (any) voxels_[b] |= std::uint64_t{1} << v;
         }
     }
-    // Groups of 4^3 bricks with nothing but outside in them are skipped whole.
+    // Per group of 4^3 bricks, those that are dense or inside: groups with none are skipped
+    // whole, and empty bricks without a look at the bitmaps.
     for (std::size_t ax = 0; ax < 3; ++ax) supers_[ax] = (bricks_[ax] + kBrick - 1) / kBrick;
-    live_.assign(words_for_bits(std::uint64_t(supers_[0]) * std::uint64_t(supers_[1]) *
-                                std::uint64_t(supers_[2])),
-                 0);
+    groups_.assign(
+        std::uint64_t(supers_[0]) * std::uint64_t(supers_[1]) * std::uint64_t(supers_[2]), 0);
     for (int k = 0; k < bricks_[2]; ++k)
         for (int j = 0; j < bricks_[1]; ++j)
-            for (int i = 0; i < bricks_[0]; ++i) {
-                if (dense_index(i, j, k) < 0 && !inside_brick(i, j, k)) continue;
-                const std::uint64_t g = (std::uint64_t(k / kBrick) * std::uint64_t(supers_[1]) +
-                                         std::uint64_t(j / kBrick)) *
-                                            std::uint64_t(supers_[0]) +
-                                        std::uint64_t(i / kBrick);
-                live_[g >> 6] |= std::uint64_t{1} << (g & 63);
-            }
+            for (int i = 0; i < bricks_[0]; ++i)
+                if (dense_index(i, j, k) >= 0 || inside_brick(i, j, k))
+                    groups_[group_of(i, j, k)] |= std::uint64_t{1} << brick_bit(i, j, k);
 }
 
 std::int64_t FieldView::dense_index(int i, int j, int k) const {
@@ -162,7 +157,12 @@ double FieldView::value_at(Vec3 p, Vec3* n) const {
         v[ax] = static_cast<int>(c);
         f[ax] = std::clamp(p[ax] - c, 0.0, 1.0);
     }
-    const std::int64_t brick = dense_index(v[0] / kBrick, v[1] / kBrick, v[2] / kBrick);
+    const int bi = v[0] / kBrick, bj = v[1] / kBrick, bk = v[2] / kBrick;
+    if (!((groups_[group_of(bi, bj, bk)] >> brick_bit(bi, bj, bk)) & 1)) {
+        if (n) *n = {0, 0, 1};
+        return s_.dmax;  // an empty outside brick
+    }
+    const std::int64_t brick = dense_index(bi, bj, bk);
     if (brick < 0) {
         if (n) *n = {0, 0, 1};
         return inside_brick(v[0] / kBrick, v[1] / kBrick, v[2] / kBrick) ? -s_.dmax : s_.dmax;
@@ -207,7 +207,7 @@ bool FieldView::voxel_root(std::uint64_t brick, const std::array<int, 3>& v, con
     }
     auto f = [&](double s) { return ((k3 * s + k2) * s + k1) * s + k0; };
     // Monotone pieces between the cubic's critical points; the first piece ending at or below
-    // zero holds the first zero, found by bisection.
+    // zero holds the first zero.
     double breaks[4] = {0, 1, 1, 1};
     int nb = 1;
     const double A = 3 * k3, B = 2 * k2, C = k1;
@@ -225,28 +225,26 @@ bool FieldView::voxel_root(std::uint64_t brick, const std::array<int, 3>& v, con
         if (r > 0 && r < 1) breaks[nb++] = r;
     }
     breaks[nb++] = 1;
+    auto df = [&](double x) { return (A * x + B) * x + C; };
     double s = -1;
     if (f(0) <= 0) s = 0;
     for (int k = 0; k + 1 < nb && s < 0; ++k) {
-        double lo = breaks[k], hi = breaks[k + 1], flo = f(lo), fhi = f(hi);
+        double lo = breaks[k], hi = breaks[k + 1];
+        const double flo = f(lo), fhi = f(hi);
         if (!(fhi <= 0)) continue;
-        // Regula falsi, Illinois variant (superlinear), down to 1e-9 of a voxel.
-        int side = 0;
-        for (int it = 0; it < 64 && hi - lo > 1e-9; ++it) {
-            double mid = (lo * fhi - hi * flo) / (fhi - flo);
-            if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
-            const double fm = f(mid);
-            if (fm <= 0) {
-                hi = mid, fhi = fm;
-                if (side == -1) flo *= 0.5;
-                side = -1;
-            } else {
-                lo = mid, flo = fm;
-                if (side == 1) fhi *= 0.5;
-                side = 1;
-            }
+        // Newton on the monotone piece, kept inside the bracket by bisection.
+        double x = flo > fhi ? (flo * hi - fhi * lo) / (flo - fhi) : 0.5 * (lo + hi);
+        for (int it = 0; it < 48; ++it) {
+            const double fx = f(x);
+            (fx <= 0 ? hi : lo) = x;
+            const double d1 = df(x);
+            double next = d1 != 0 ? x - fx / d1 : 0.5 * (lo + hi);
+            if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+            const bool done = std::abs(next - x) < 1e-8 || hi - lo < 1e-8;
+            x = next;
+            if (done) break;
         }
-        s = hi;
+        s = x;
     }
     if (s < 0) return false;
     out.t = std::clamp(t0 + s * (t1 - t0), 0.0, 1.0);
@@ -282,8 +280,10 @@ bool FieldView::march_group(const std::array<int, 3>& s, const FieldSegment& g, 
         lo[ax] = s[ax] * kBrick;
         hi[ax] = std::min(lo[ax] + kBrick, bricks_[ax]);
     }
+    const std::uint64_t mask = groups_[group_of(lo[0], lo[1], lo[2])];
     return traverse(g, double(kBrick), t0, t1, lo, hi,
                     [&](const std::array<int, 3>& b, double ta, double tb) {
+                        if (!((mask >> brick_bit(b[0], b[1], b[2])) & 1)) return false;
                         const std::int64_t brick = dense_index(b[0], b[1], b[2]);
                         if (brick >= 0) return march_brick(std::uint64_t(brick), b, g, ta, tb, out);
                         if (!inside_brick(b[0], b[1], b[2])) return false;
@@ -305,11 +305,9 @@ bool FieldView::predict(Vec3 pa, Vec3 pb, TableHit& out) const {
     }
     return traverse(g, double(kBrick * kBrick), 0, 1, {0, 0, 0}, supers_,
                     [&](const std::array<int, 3>& s, double ta, double tb) {
-                        const std::uint64_t k = (std::uint64_t(s[2]) * std::uint64_t(supers_[1]) +
-                                                 std::uint64_t(s[1])) *
-                                                    std::uint64_t(supers_[0]) +
-                                                std::uint64_t(s[0]);
-                        return ((live_[k >> 6] >> (k & 63)) & 1) && march_group(s, g, ta, tb, out);
+                        return groups_[group_of(s[0] * kBrick, s[1] * kBrick, s[2] * kBrick)] !=
+                                   0 &&
+                               march_group(s, g, ta, tb, out);
                     });
 }
 

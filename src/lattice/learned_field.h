@@ -58,7 +58,7 @@ public:
     // Bytes of the indexes built at open (not part of the payload).
     std::uint64_t index_bytes() const {
         return rank_.size() * sizeof(std::uint32_t) + voxels_.size() * sizeof(std::uint64_t) +
-               live_.size() * sizeof(std::uint64_t);
+               groups_.size() * sizeof(std::uint64_t);
     }
 
 private:
@@ -70,9 +70,18 @@ private:
     std::vector<std::uint32_t> rank_;    // dense bricks before each bitmap word
     std::vector<std::uint64_t> voxels_;  // per dense brick: its voxels with a corner <= 0
     std::array<int, 3> supers_{};        // groups of 4^3 bricks
-    std::vector<std::uint64_t> live_;    // per group: some brick is dense or inside
+    std::vector<std::uint64_t> groups_;  // per group: its bricks that are dense or inside
     double inv_g_ = 1;
 
+    // The group of brick (i, j, k), and the brick's bit in the group's mask.
+    std::uint64_t group_of(int i, int j, int k) const {
+        return (std::uint64_t(k / kBrick) * std::uint64_t(supers_[1]) + std::uint64_t(j / kBrick)) *
+                   std::uint64_t(supers_[0]) +
+               std::uint64_t(i / kBrick);
+    }
+    static int brick_bit(int i, int j, int k) {
+        return ((k % kBrick) * kBrick + j % kBrick) * kBrick + i % kBrick;
+    }
     // The dense index of brick (i, j, k), or -1 when it is not dense.
     std::int64_t dense_index(int i, int j, int k) const;
     bool inside_brick(int i, int j, int k) const;

@@ -87,8 +87,8 @@ bool LearnedTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const
                                 static_cast<int>(ex_n_));
         return true;
     }
-    if (miss_ex_.find(key, rank)) return false;
-    return field_.predict(vec_of(pa), vec_of(pb), hit);
+    // A "miss" exception only ever overrides a predicted hit.
+    return field_.predict(vec_of(pa), vec_of(pb), hit) && !miss_ex_.find(key, rank);
 }
 
 }  // namespace lat
