@@ -99,7 +99,8 @@ void expect_certified(const Raster& x, const EncodeOptions& opt, LearnedStats* s
     EXPECT_LE(c.max_normal_error_deg, opt.max_normal_error_deg);
     EXPECT_EQ(st.total_bytes, payload.size());
     EXPECT_GE(table.bytes(), payload.size());
-    EXPECT_EQ(table.hit_exceptions(), st.hit_exceptions);
+    EXPECT_EQ(table.exceptions(1), st.hit_exceptions);
+    EXPECT_EQ(table.exceptions(2), st.normal_exceptions);
     if (stats) *stats = st;
 }
 
@@ -113,7 +114,10 @@ TEST(LearnedTable, HairCertifiedWithinTwoBounds) {
     expect_certified(hair_k1(), bounds(0.01, 1.0), &tight);
     expect_certified(hair_k1(), bounds(0.05, 5.0), &loose);
     // Looser bounds need fewer exceptions, and the table is well below hash14's 14.95 bytes.
-    EXPECT_LT(loose.hit_exceptions, tight.hit_exceptions);
+    auto all = [](const LearnedStats& s) {
+        return s.miss_exceptions + s.hit_exceptions + s.normal_exceptions + s.t_exceptions;
+    };
+    EXPECT_LT(all(loose), all(tight));
     EXPECT_LT(double(loose.total_bytes), 2.0 * double(hair_k1().r.hits));
     EXPECT_LT(double(tight.total_bytes), 5.0 * double(hair_k1().r.hits));
 }
@@ -124,7 +128,10 @@ TEST(LearnedTable, ExceptionsCorrectTheModel) {
     const EncodeOptions opt = bounds(0.002, 0.2);
     LearnedStats st;
     expect_certified(x, opt, &st);
-    EXPECT_GT(st.hit_exceptions, x.r.hits / 4);
+    const std::uint64_t corrections = st.hit_exceptions + st.normal_exceptions + st.t_exceptions;
+    EXPECT_GT(corrections, x.r.hits / 4);
+    EXPECT_GT(st.hit_exceptions, 0u);
+    EXPECT_GT(st.normal_exceptions, 0u);
     const ByteBuffer payload = LearnedTable::build(x.r.raw, x.ctx, opt);
     const LearnedTable table(payload.data(), payload.size(), x.r.hits, x.ctx);
     int corrected = 0;
@@ -134,7 +141,7 @@ TEST(LearnedTable, ExceptionsCorrectTheModel) {
         const bool predicted = table.predict(h.a, h.b, model);
         corrected += !predicted || model.t != answer.t || !(model.normal == answer.normal);
     }
-    EXPECT_EQ(std::uint64_t(corrected), st.hit_exceptions);
+    EXPECT_EQ(std::uint64_t(corrected), corrections);
 }
 
 TEST(LearnedTable, SameBytesForAnyThreadCount) {
@@ -198,7 +205,9 @@ TEST(LearnedTable, RejectsShortAndCorruptPayloads) {
              {5, 0xFFF0000000000000ull},
              {6, words[6] + 1},
              {7, words[7] + 1},
-             {8, ~std::uint64_t{0}}}) {
+             {8, ~std::uint64_t{0}},
+             {9, words[9] + 3},
+             {10, std::uint64_t{1} << 40}}) {
         std::vector<std::uint64_t> bad = words;
         bad[word] = value;
         EXPECT_THROW(open(bad, good.size(), x.ctx), std::runtime_error) << word;
@@ -209,7 +218,7 @@ TEST(LearnedTable, RejectsShortAndCorruptPayloads) {
     for (int trial = 0; trial < 40; ++trial) {
         std::vector<std::uint64_t> bad = words;
         for (int k = 0; k < 4; ++k)
-            bad[9 + rng() % (bad.size() - 9)] ^= std::uint64_t{1} << (rng() % 64);
+            bad[11 + rng() % (bad.size() - 11)] ^= std::uint64_t{1} << (rng() % 64);
         try {
             const LearnedTable t = open(bad, good.size(), x.ctx);
             lookup_everything(t, BoundaryGrid(x.ctx.cells).count());

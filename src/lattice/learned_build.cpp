@@ -100,6 +100,7 @@ Fit::Fit(const RawHits& hits, const TableContext& c, const EncodeOptions& opt)
 struct Exception {
     std::uint64_t key;  // a * points + b
     std::uint32_t hit;  // into Fit::by_a, or kNone for "miss"
+    int kind;           // ExceptionKind
 };
 
 // The exceptions of every stride-th entry point's pairs, in key order; counts the pairs.
@@ -126,10 +127,14 @@ std::vector<Exception> find_exceptions(const Fit& fit, const FieldView& field, s
                 const bool predicted = field.predict(pa, vec_of(fit.pts[b]), p);
                 const std::uint32_t i = row[b];
                 if (!predicted && i == kNone) continue;
-                if (predicted && i != kNone && fit.point_ok(p.t, *fit.by_a[i]) &&
-                    dot(fit.normal(*fit.by_a[i]), p.normal) >= fit.cos_normal)
-                    continue;
-                found[task].push_back({std::uint64_t(a) * n + b, i});
+                int kind = predicted ? kMiss : kHit;
+                if (predicted && i != kNone) {
+                    const bool t_ok = fit.point_ok(p.t, *fit.by_a[i]);
+                    const bool n_ok = dot(fit.normal(*fit.by_a[i]), p.normal) >= fit.cos_normal;
+                    if (t_ok && n_ok) continue;
+                    kind = t_ok ? kNormal : n_ok ? kT : kHit;
+                }
+                found[task].push_back({std::uint64_t(a) * n + b, i, kind});
             }
             for (std::uint64_t i = fit.start[a]; i < fit.start[a + 1]; ++i)
                 row[fit.by_a[i]->b] = kNone;
@@ -144,14 +149,15 @@ std::vector<Exception> find_exceptions(const Fit& fit, const FieldView& field, s
     return out;
 }
 
-// The narrowest widths of a hit exception's t and normal that keep all of them in bounds.
+// The narrowest widths of the exceptions' t and normals that keep all of them in bounds.
 void value_widths(const Fit& fit, const std::vector<Exception>& ex, unsigned& ex_t,
                   unsigned& ex_n) {
-    std::vector<std::uint32_t> hits;
-    for (const Exception& e : ex)
-        if (e.hit != kNone) hits.push_back(e.hit);
+    std::vector<std::uint32_t> hits, normals;
+    for (const Exception& e : ex) {
+        if (e.kind == kHit || e.kind == kT) hits.push_back(e.hit);
+        if (e.kind == kHit || e.kind == kNormal) normals.push_back(e.hit);
+    }
     ex_t = 1, ex_n = 2;
-    if (hits.empty()) return;
     const std::uint64_t t_ok = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, hits.size()), ~std::uint64_t{0},
         [&](const auto& r, std::uint64_t m) {
@@ -168,12 +174,13 @@ void value_widths(const Fit& fit, const std::vector<Exception>& ex, unsigned& ex
     for (unsigned bits = 1; bits <= 32 && !ex_t; ++bits)
         if ((t_ok >> bits) & 1) ex_t = bits;
     if (!ex_t) throw InputError("learned: the point error bound is below what 32-bit t can meet");
+    if (normals.empty()) return;
     auto all_pass = [&](unsigned bits) {
         return tbb::parallel_reduce(
-            tbb::blocked_range<std::size_t>(0, hits.size()), true,
+            tbb::blocked_range<std::size_t>(0, normals.size()), true,
             [&](const auto& r, bool ok) {
                 for (std::size_t k = r.begin(); k != r.end() && ok; ++k) {
-                    const Vec3 n = fit.normal(*fit.by_a[hits[k]]);
+                    const Vec3 n = fit.normal(*fit.by_a[normals[k]]);
                     ok = dot(n, oct_decode(oct_encode_precise(n, int(bits)), int(bits))) >=
                          fit.cos_normal;
                 }
@@ -209,9 +216,9 @@ ByteBuffer write_payload(const Fit& fit, const Trial& tr, const std::vector<Exce
     h.field = tr.shape;
     h.dense = tr.fit->dense;
     value_widths(fit, ex, h.ex_t, h.ex_n);
-    std::vector<std::uint64_t> miss, hit;
-    for (const Exception& e : ex) (e.hit == kNone ? miss : hit).push_back(e.key);
-    h.misses = miss.size(), h.hits = hit.size();
+    std::array<std::vector<std::uint64_t>, kKinds> keys;
+    for (const Exception& e : ex) keys[std::size_t(e.kind)].push_back(e.key);
+    for (std::size_t k = 0; k < kKinds; ++k) h.count[k] = keys[k].size();
     const std::uint64_t universe = std::uint64_t(fit.grid.count()) * fit.grid.count();
     const Sections s = sections(h, universe);
     std::vector<std::uint64_t> out;
@@ -220,20 +227,25 @@ ByteBuffer write_payload(const Fit& fit, const Trial& tr, const std::vector<Exce
     out.insert(out.end(), head.begin(), head.end());
     for (const auto* part : {&tr.fit->dense_bits, &tr.fit->sign_bits, &tr.nodes})
         out.insert(out.end(), part->begin(), part->end());
-    for (const auto& [keys, shape] : {std::pair{&miss, s.misses}, std::pair{&hit, s.hits}}) {
-        const auto ef = elias_fano_encode(*keys, shape);
+    for (std::size_t k = 0; k < kKinds; ++k) {
+        const auto ef = elias_fano_encode(keys[k], s.keys[k]);
         out.insert(out.end(), ef.begin(), ef.end());
     }
-    BitWriter values(h.hits * value_width(h.ex_t, h.ex_n));
-    for (const Exception& e : ex) {
-        if (e.hit == kNone) continue;
-        const RawHit& r = *fit.by_a[e.hit];
-        const Oct o = oct_encode_precise(fit.normal(r), static_cast<int>(h.ex_n));
-        values.put(encode_value_t(r.t, h.ex_t), h.ex_t);
-        values.put(o.u, h.ex_n);
-        values.put(o.v, h.ex_n);
+    for (const int kind : {kHit, kNormal, kT}) {
+        BitWriter values(h.count[std::size_t(kind)] * value_width(h, kind));
+        for (const Exception& e : ex) {
+            if (e.kind != kind) continue;
+            const RawHit& r = *fit.by_a[e.hit];
+            if (kind != kNormal) values.put(encode_value_t(r.t, h.ex_t), h.ex_t);
+            if (kind == kT) continue;
+            const Oct o = oct_encode_precise(fit.normal(r), static_cast<int>(h.ex_n));
+            values.put(o.u, h.ex_n);
+            values.put(o.v, h.ex_n);
+        }
+        std::vector<std::uint64_t> w = values.words();
+        w.resize(s.values[std::size_t(kind)], 0);
+        out.insert(out.end(), w.begin(), w.end());
     }
-    out.insert(out.end(), values.words().begin(), values.words().end());
     out.resize(s.total(), 0);
     ByteBuffer payload(out.size() * 8);
     std::memcpy(payload.data(), out.data(), payload.size());
@@ -242,7 +254,8 @@ ByteBuffer write_payload(const Fit& fit, const Trial& tr, const std::vector<Exce
         st->nodes_per_sigma = tr.m;
         st->dense_bricks = h.dense;
         st->ex_t = h.ex_t, st->ex_n = h.ex_n;
-        st->hit_exceptions = h.hits, st->miss_exceptions = h.misses;
+        st->miss_exceptions = h.count[kMiss], st->hit_exceptions = h.count[kHit];
+        st->normal_exceptions = h.count[kNormal], st->t_exceptions = h.count[kT];
         st->model_bytes = 8 * (kHeaderWords + 2 * s.bitmap + s.nodes);
         st->total_bytes = payload.size();
         st->exception_bytes = st->total_bytes - st->model_bytes;
@@ -278,25 +291,29 @@ ByteBuffer LearnedTable::build(const RawHits& hits, const TableContext& ctx,
                              tr.nodes.data(), tr.fit->dense);
         std::uint64_t sampled = 0;
         std::vector<Exception> ex = find_exceptions(fit, view, stride, sampled);
-        std::uint64_t miss = 0, hit = 0;
-        for (const Exception& e : ex) (e.hit == kNone ? miss : hit) += 1;
+        std::array<std::uint64_t, kKinds> count{};
+        for (const Exception& e : ex) ++count[std::size_t(e.kind)];
         const double scale = double(fit.valid_pairs) / double(std::max<std::uint64_t>(1, sampled));
         unsigned et, en;
         value_widths(fit, ex, et, en);
         Header h;
         h.field = tr.shape, h.dense = tr.fit->dense, h.ex_t = et, h.ex_n = en;
-        h.misses = std::uint64_t(double(miss) * scale), h.hits = std::uint64_t(double(hit) * scale);
+        for (std::size_t k = 0; k < kKinds; ++k)
+            h.count[k] = std::uint64_t(double(count[k]) * scale);
         tr.estimate = 8 * sections(h, std::uint64_t(n) * n).total();
         char line[256];
         std::snprintf(line, sizeof line,
                       "%2d nodes/sigma, distance %u + normal 2 x %u bits: %llu dense bricks, model "
-                      "%llu bytes; "
-                      "on %llu pairs %llu hit + %llu miss exceptions; estimate %llu bytes",
+                      "%llu bytes; on %llu pairs exceptions: %llu miss, %llu hit, %llu normal, "
+                      "%llu t; estimate %llu bytes",
                       tr.m, tr.shape.dist_bits, tr.shape.normal_bits,
                       static_cast<unsigned long long>(tr.fit->dense),
                       static_cast<unsigned long long>(8 * tr.nodes.size()),
                       static_cast<unsigned long long>(sampled),
-                      static_cast<unsigned long long>(hit), static_cast<unsigned long long>(miss),
+                      static_cast<unsigned long long>(count[kMiss]),
+                      static_cast<unsigned long long>(count[kHit]),
+                      static_cast<unsigned long long>(count[kNormal]),
+                      static_cast<unsigned long long>(count[kT]),
                       static_cast<unsigned long long>(tr.estimate));
         st.trials.push_back(line);
         if (stride == 1) tr.ex = std::move(ex);

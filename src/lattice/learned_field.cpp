@@ -140,13 +140,10 @@ Vec3 FieldView::node_normal(std::uint64_t brick, int li, int lj, int lk) const {
                               std::uint64_t(node_of(li, lj, lk)) * s_.node_bits() + s_.dist_bits;
     const std::uint64_t c = read_bits(nodes_, pos, 2 * s_.normal_bits);
     const std::uint64_t mask = (std::uint64_t{1} << s_.normal_bits) - 1;
-    // The point on the octahedron, not normalised: only the direction of the weighted sum of
-    // a voxel's normals is used.
-    const double scale = 2.0 / double(mask);
-    const double px = double(c & mask) * scale - 1, py = double(c >> s_.normal_bits) * scale - 1;
-    const double pz = 1 - std::abs(px) - std::abs(py);
-    if (pz >= 0) return {px, py, pz};
-    return {(1 - std::abs(py)) * sign_not_zero(px), (1 - std::abs(px)) * sign_not_zero(py), pz};
+    // Unit length, so that a voxel's normals weigh as its trilinear weights say.
+    return oct_decode(
+        {static_cast<std::uint32_t>(c & mask), static_cast<std::uint32_t>(c >> s_.normal_bits)},
+        static_cast<int>(s_.normal_bits));
 }
 
 double FieldView::value_at(Vec3 p, Vec3* n) const {

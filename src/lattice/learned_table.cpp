@@ -42,25 +42,31 @@ LearnedTable::LearnedTable(const std::uint8_t* payload, std::size_t size, std::u
     // Counts are bounded before sizes are multiplied, so nothing below can overflow.
     const std::uint64_t universe = std::uint64_t(grid_.count()) * grid_.count();
     constexpr std::uint64_t kLimit = std::uint64_t{1} << 48;
-    if (f.brick_count() >= kLimit || h.dense > f.brick_count() || h.misses > universe ||
-        h.hits > universe)
-        throw std::runtime_error("learned: bad counts");
+    bool bad = f.brick_count() >= kLimit || h.dense > f.brick_count();
+    for (const std::uint64_t n : h.count) bad |= n > universe;
+    if (bad) throw std::runtime_error("learned: bad counts");
     const Sections s = sections(h, universe);
     if (s.total() != size / 8)
         throw std::runtime_error("learned: payload size does not match its header");
     const std::uint64_t* p = words + kHeaderWords;
     field_ = FieldView(f, p, p + s.bitmap, p + 2 * s.bitmap, h.dense);
     p += 2 * s.bitmap + s.nodes;
-    miss_ex_ = EliasFanoView(p, s.misses);
-    p += s.misses.high_words() + s.misses.low_words();
-    hit_ex_ = EliasFanoView(p, s.hits);
-    values_ = p + s.hits.high_words() + s.hits.low_words();
+    for (std::size_t k = 0; k < kKinds; ++k) {
+        ex_[k] = EliasFanoView(p, s.keys[k]);
+        p += s.keys[k].high_words() + s.keys[k].low_words();
+    }
+    for (std::size_t k = 0; k < kKinds; ++k) {
+        values_[k] = p;
+        p += s.values[k];
+    }
     ex_t_ = h.ex_t;
     ex_n_ = h.ex_n;
 }
 
 std::uint64_t LearnedTable::bytes() const {
-    return size_ + field_.index_bytes() + miss_ex_.index_bytes() + hit_ex_.index_bytes();
+    std::uint64_t n = size_ + field_.index_bytes();
+    for (const EliasFanoView& e : ex_) n += e.index_bytes();
+    return n;
 }
 
 bool LearnedTable::predict(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
@@ -76,19 +82,27 @@ bool LearnedTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const
     const GridPoint pa = grid_.point(a), pb = grid_.point(b);
     if (!BoundaryGrid::valid_pair(grid_.faces(pa), grid_.faces(pb))) return false;
     const std::uint64_t key = std::uint64_t(a) * grid_.count() + b;
-    std::uint64_t rank;
-    if (hit_ex_.find(key, rank)) {
-        const auto width = static_cast<unsigned>(value_width(ex_t_, ex_n_));
-        const std::uint64_t code = read_bits(values_, rank * width, width);
-        const std::uint64_t mask = (std::uint64_t{1} << ex_n_) - 1;
+    const std::uint64_t nmask = (std::uint64_t{1} << ex_n_) - 1;
+    auto normal_at = [&](std::uint64_t code) {
+        return oct_decode({static_cast<std::uint32_t>(code & nmask),
+                           static_cast<std::uint32_t>((code >> ex_n_) & nmask)},
+                          static_cast<int>(ex_n_));
+    };
+    std::uint64_t r;
+    if (ex_[kHit].find(key, r)) {
+        const unsigned w = ex_t_ + 2 * ex_n_;
+        const std::uint64_t code = read_bits(values_[kHit], r * w, w);
         hit.t = decode_value_t(code, ex_t_);
-        hit.normal = oct_decode({static_cast<std::uint32_t>((code >> ex_t_) & mask),
-                                 static_cast<std::uint32_t>((code >> (ex_t_ + ex_n_)) & mask)},
-                                static_cast<int>(ex_n_));
+        hit.normal = normal_at(code >> ex_t_);
         return true;
     }
-    // A "miss" exception only ever overrides a predicted hit.
-    return field_.predict(vec_of(pa), vec_of(pb), hit) && !miss_ex_.find(key, rank);
+    // The other kinds only ever correct a predicted hit.
+    if (!field_.predict(vec_of(pa), vec_of(pb), hit) || ex_[kMiss].find(key, r)) return false;
+    if (ex_[kNormal].find(key, r))
+        hit.normal = normal_at(read_bits(values_[kNormal], r * 2 * ex_n_, 2 * ex_n_));
+    else if (ex_[kT].find(key, r))
+        hit.t = decode_value_t(read_bits(values_[kT], r * ex_t_, ex_t_), ex_t_);
+    return true;
 }
 
 }  // namespace lat

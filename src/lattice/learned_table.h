@@ -5,9 +5,10 @@
 // whole is within them (certify_table checks every pair).
 //   model       a signed distance field fitted to the hits, marched along the pair's segment
 //               (learned_field.h)
-//   exceptions  two Elias-Fano sets of pair keys a * points + b: "miss" (the model hits, the
-//               pair does not) and "hit" (the model misses or errs), the latter with t and an
-//               octahedral normal at the narrowest widths that meet the bounds
+//   exceptions  Elias-Fano sets of pair keys a * points + b: "miss" (the model hits, the pair
+//               does not), "hit" (the model misses, or errs in t and the normal: both stored),
+//               "normal" and "t" (the model errs in that alone: it is stored), the values at
+//               the narrowest widths that meet the bounds
 // The build tries several node spacings and widths and keeps the smallest table. Payload and
 // measurements: docs/encoding-learned.md.
 #include <array>
@@ -31,7 +32,8 @@ struct LearnedStats {
     FieldShape field;
     std::uint64_t dense_bricks = 0;
     unsigned ex_t = 0, ex_n = 0;
-    std::uint64_t hits = 0, hit_exceptions = 0, miss_exceptions = 0;
+    std::uint64_t hits = 0;
+    std::uint64_t miss_exceptions = 0, hit_exceptions = 0, normal_exceptions = 0, t_exceptions = 0;
     std::uint64_t model_bytes = 0, exception_bytes = 0, total_bytes = 0;
     double seconds = 0;
     std::vector<std::string> trials;  // one line per parameter set tried
@@ -57,8 +59,8 @@ public:
     std::uint64_t bytes() const override;
 
     const FieldShape& field() const { return field_.shape(); }
-    std::uint64_t hit_exceptions() const { return hit_ex_.size(); }
-    std::uint64_t miss_exceptions() const { return miss_ex_.size(); }
+    // Exceptions of a kind: 0 miss, 1 hit, 2 normal, 3 t.
+    std::uint64_t exceptions(int kind) const { return ex_[std::size_t(kind)].size(); }
     // The model's own answer, without the exceptions.
     bool predict(std::uint32_t a, std::uint32_t b, TableHit& hit) const;
 
@@ -66,8 +68,8 @@ private:
     BoundaryGrid grid_;
     FieldView field_;
     unsigned ex_t_ = 0, ex_n_ = 0;
-    const std::uint64_t* values_ = nullptr;
-    EliasFanoView miss_ex_, hit_ex_;
+    std::array<EliasFanoView, 4> ex_;               // by kind
+    std::array<const std::uint64_t*, 4> values_{};  // by kind
     std::uint64_t entries_;
     std::size_t size_;
 };
