@@ -7,10 +7,17 @@
 namespace lat {
 namespace {
 
-// Position of the r-th (0-based) set bit of x, which has more than r set bits.
+// Position of the r-th (0-based) set bit of x, which has more than r set bits: the byte by
+// popcounts, then the bit.
 unsigned select_in_word(std::uint64_t x, unsigned r) {
+    unsigned shift = 0;
+    for (;;) {
+        const auto c = static_cast<unsigned>(std::popcount(x & 0xFF));
+        if (r < c) break;
+        r -= c, x >>= 8, shift += 8;
+    }
     for (unsigned k = 0; k < r; ++k) x &= x - 1;
-    return static_cast<unsigned>(std::countr_zero(x));
+    return shift + static_cast<unsigned>(std::countr_zero(x));
 }
 
 }  // namespace
@@ -52,6 +59,8 @@ EliasFanoView::EliasFanoView(const std::uint64_t* words, const EliasFanoShape& s
     const unsigned tail = static_cast<unsigned>(nbits & 63);
     if (ones != shape.n || (tail != 0 && (high_[nwords - 1] >> tail) != 0))
         throw std::runtime_error("learned: exception index is inconsistent");
+    if (nbits >= (std::uint64_t{1} << 32))
+        throw std::runtime_error("learned: exception set too large");
     // Every 2^kSampleLog-th zero, by a scan of the words.
     std::uint64_t zeros = 0;
     for (std::uint64_t w = 0; w < nwords; ++w) {
@@ -59,7 +68,8 @@ EliasFanoView::EliasFanoView(const std::uint64_t* words, const EliasFanoShape& s
         if (w + 1 == nwords && tail != 0) x &= (std::uint64_t{1} << tail) - 1;
         while (x) {
             if ((zeros & ((std::uint64_t{1} << kSampleLog) - 1)) == 0)
-                samples_.push_back(w * 64 + static_cast<std::uint64_t>(std::countr_zero(x)));
+                samples_.push_back(static_cast<std::uint32_t>(
+                    w * 64 + static_cast<std::uint64_t>(std::countr_zero(x))));
             ++zeros;
             x &= x - 1;
         }

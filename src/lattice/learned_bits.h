@@ -65,24 +65,25 @@ std::vector<std::uint64_t> elias_fano_encode(std::span<const std::uint64_t> keys
 
 class EliasFanoView {
 public:
-    static constexpr unsigned kSampleLog = 7;  // a select sample every 128 zeros
+    static constexpr unsigned kSampleLog = 6;  // a select sample every 64 zeros
 
     EliasFanoView() = default;
     // Over `shape.high_words() + shape.low_words()` words; throws std::runtime_error when the
-    // high part does not hold exactly n ones and buckets() zeros (so queries stay in range).
+    // high part does not hold exactly n ones and buckets() zeros (so queries stay in range), or
+    // is longer than 2^32 bits.
     EliasFanoView(const std::uint64_t* words, const EliasFanoShape& shape);
 
     // Whether `key` is in the set, and if so its rank.
     bool find(std::uint64_t key, std::uint64_t& rank) const;
     std::uint64_t size() const { return shape_.n; }
     // Bytes of the select samples built at open (not part of the payload).
-    std::uint64_t index_bytes() const { return samples_.size() * sizeof(std::uint64_t); }
+    std::uint64_t index_bytes() const { return samples_.size() * sizeof(std::uint32_t); }
 
 private:
     const std::uint64_t* high_ = nullptr;
     const std::uint64_t* low_ = nullptr;
     EliasFanoShape shape_;
-    std::vector<std::uint64_t> samples_;  // position of every 2^kSampleLog-th zero
+    std::vector<std::uint32_t> samples_;  // position of every 2^kSampleLog-th zero
 
     std::uint64_t select_zero(std::uint64_t j) const;
 };

@@ -216,9 +216,9 @@ ByteBuffer write_payload(const Fit& fit, const Trial& tr, const std::vector<Exce
     h.field = tr.shape;
     h.dense = tr.fit->dense;
     value_widths(fit, ex, h.ex_t, h.ex_n);
-    std::array<std::vector<std::uint64_t>, kKinds> keys;
-    for (const Exception& e : ex) keys[std::size_t(e.kind)].push_back(e.key);
-    for (std::size_t k = 0; k < kKinds; ++k) h.count[k] = keys[k].size();
+    std::vector<std::uint64_t> hit_keys, correction_keys;
+    for (const Exception& e : ex) (e.kind == kHit ? hit_keys : correction_keys).push_back(e.key);
+    h.hits = hit_keys.size(), h.corrections = correction_keys.size();
     const std::uint64_t universe = std::uint64_t(fit.grid.count()) * fit.grid.count();
     const Sections s = sections(h, universe);
     std::vector<std::uint64_t> out;
@@ -227,24 +227,31 @@ ByteBuffer write_payload(const Fit& fit, const Trial& tr, const std::vector<Exce
     out.insert(out.end(), head.begin(), head.end());
     for (const auto* part : {&tr.fit->dense_bits, &tr.fit->sign_bits, &tr.nodes})
         out.insert(out.end(), part->begin(), part->end());
-    for (std::size_t k = 0; k < kKinds; ++k) {
-        const auto ef = elias_fano_encode(keys[k], s.keys[k]);
+    for (const auto& [keys, shape] :
+         {std::pair{&hit_keys, s.hits}, std::pair{&correction_keys, s.corrections}}) {
+        const auto ef = elias_fano_encode(*keys, shape);
         out.insert(out.end(), ef.begin(), ef.end());
     }
-    for (const int kind : {kHit, kNormal, kT}) {
-        BitWriter values(h.count[std::size_t(kind)] * value_width(h, kind));
-        for (const Exception& e : ex) {
-            if (e.kind != kind) continue;
-            const RawHit& r = *fit.by_a[e.hit];
-            if (kind != kNormal) values.put(encode_value_t(r.t, h.ex_t), h.ex_t);
-            if (kind == kT) continue;
-            const Oct o = oct_encode_precise(fit.normal(r), static_cast<int>(h.ex_n));
-            values.put(o.u, h.ex_n);
-            values.put(o.v, h.ex_n);
+    BitWriter hit_values(h.hits * hit_width(h)), records(h.corrections * record_width(h));
+    const unsigned slot = record_width(h) - 2;
+    for (const Exception& e : ex) {
+        if (e.kind == kMiss) {
+            records.put(kMiss, 2 + slot);
+            continue;
         }
-        std::vector<std::uint64_t> w = values.words();
-        w.resize(s.values[std::size_t(kind)], 0);
-        out.insert(out.end(), w.begin(), w.end());
+        const RawHit& r = *fit.by_a[e.hit];
+        const std::uint64_t t = encode_value_t(r.t, h.ex_t);
+        const Oct o = oct_encode_precise(fit.normal(r), static_cast<int>(h.ex_n));
+        const std::uint64_t n = o.u | (std::uint64_t{o.v} << h.ex_n);
+        if (e.kind == kHit)
+            hit_values.put(t | (n << h.ex_t), hit_width(h));
+        else
+            records.put(std::uint64_t(e.kind) | ((e.kind == kT ? t : n) << 2), 2 + slot);
+    }
+    for (const auto* w : {&hit_values, &records}) {
+        std::vector<std::uint64_t> words = w->words();
+        words.resize(w == &hit_values ? s.hit_values : s.records, 0);
+        out.insert(out.end(), words.begin(), words.end());
     }
     out.resize(s.total(), 0);
     ByteBuffer payload(out.size() * 8);
@@ -254,8 +261,11 @@ ByteBuffer write_payload(const Fit& fit, const Trial& tr, const std::vector<Exce
         st->nodes_per_sigma = tr.m;
         st->dense_bricks = h.dense;
         st->ex_t = h.ex_t, st->ex_n = h.ex_n;
-        st->miss_exceptions = h.count[kMiss], st->hit_exceptions = h.count[kHit];
-        st->normal_exceptions = h.count[kNormal], st->t_exceptions = h.count[kT];
+        for (const Exception& e : ex) {
+            std::uint64_t* c[] = {&st->miss_exceptions, &st->hit_exceptions, &st->normal_exceptions,
+                                  &st->t_exceptions};
+            ++*c[e.kind];
+        }
         st->model_bytes = 8 * (kHeaderWords + 2 * s.bitmap + s.nodes);
         st->total_bytes = payload.size();
         st->exception_bytes = st->total_bytes - st->model_bytes;
@@ -298,8 +308,8 @@ ByteBuffer LearnedTable::build(const RawHits& hits, const TableContext& ctx,
         value_widths(fit, ex, et, en);
         Header h;
         h.field = tr.shape, h.dense = tr.fit->dense, h.ex_t = et, h.ex_n = en;
-        for (std::size_t k = 0; k < kKinds; ++k)
-            h.count[k] = std::uint64_t(double(count[k]) * scale);
+        h.hits = std::uint64_t(double(count[kHit]) * scale);
+        h.corrections = std::uint64_t(double(count[kMiss] + count[kNormal] + count[kT]) * scale);
         tr.estimate = 8 * sections(h, std::uint64_t(n) * n).total();
         char line[256];
         std::snprintf(line, sizeof line,

@@ -140,10 +140,15 @@ Vec3 FieldView::node_normal(std::uint64_t brick, int li, int lj, int lk) const {
                               std::uint64_t(node_of(li, lj, lk)) * s_.node_bits() + s_.dist_bits;
     const std::uint64_t c = read_bits(nodes_, pos, 2 * s_.normal_bits);
     const std::uint64_t mask = (std::uint64_t{1} << s_.normal_bits) - 1;
-    // Unit length, so that a voxel's normals weigh as its trilinear weights say.
-    return oct_decode(
-        {static_cast<std::uint32_t>(c & mask), static_cast<std::uint32_t>(c >> s_.normal_bits)},
-        static_cast<int>(s_.normal_bits));
+    // Unit length, so that a voxel's normals weigh as its trilinear weights say (one division
+    // instead of normalize's three: this runs eight times a lookup).
+    const double scale = 2.0 / double(mask);
+    const double px = double(c & mask) * scale - 1, py = double(c >> s_.normal_bits) * scale - 1;
+    const double pz = 1 - std::abs(px) - std::abs(py);
+    const Vec3 p = pz >= 0 ? Vec3{px, py, pz}
+                           : Vec3{(1 - std::abs(py)) * sign_not_zero(px),
+                                  (1 - std::abs(px)) * sign_not_zero(py), pz};
+    return p * (1 / std::sqrt(dot(p, p)));
 }
 
 double FieldView::value_at(Vec3 p, Vec3* n) const {
@@ -189,19 +194,21 @@ bool FieldView::voxel_root(std::uint64_t brick, const std::array<int, 3>& v, con
     if (!any) return false;  // trilinear values are convex combinations: no zero here
     const Vec3 corner{double(v[0]), double(v[1]), double(v[2])};
     const Vec3 p0 = g.o + g.d * t0 - corner, dp = g.d * (t1 - t0);
-    // The field along the segment is a cubic in s in [0, 1]: a product of linear factors per
-    // corner.
-    double k0 = 0, k1 = 0, k2 = 0, k3 = 0;
-    for (int c = 0; c < 8; ++c) {
-        double x0 = 1 - p0.x, x1 = -dp.x, y0 = 1 - p0.y, y1 = -dp.y, z0 = 1 - p0.z, z1 = -dp.z;
-        if (c & 1) x0 = p0.x, x1 = dp.x;
-        if ((c >> 1) & 1) y0 = p0.y, y1 = dp.y;
-        if (c >> 2) z0 = p0.z, z1 = dp.z;
-        k0 += val[c] * x0 * y0 * z0;
-        k1 += val[c] * (x1 * y0 * z0 + x0 * y1 * z0 + x0 * y0 * z1);
-        k2 += val[c] * (x1 * y1 * z0 + x1 * y0 * z1 + x0 * y1 * z1);
-        k3 += val[c] * x1 * y1 * z1;
-    }
+    // The trilinear field as a polynomial in the voxel's coordinates, then along the segment
+    // (x = x0 + x1 s, ...) a cubic in s in [0, 1].
+    const double a0 = val[0], ax = val[1] - val[0], ay = val[2] - val[0], az = val[4] - val[0];
+    const double axy = val[3] - val[2] - val[1] + val[0], axz = val[5] - val[4] - val[1] + val[0];
+    const double ayz = val[6] - val[4] - val[2] + val[0];
+    const double axyz = val[7] - val[6] - val[5] - val[3] + val[4] + val[2] + val[1] - val[0];
+    const double x0 = p0.x, y0 = p0.y, z0 = p0.z, x1 = dp.x, y1 = dp.y, z1 = dp.z;
+    const double k3 = axyz * x1 * y1 * z1;
+    const double k2 = axy * x1 * y1 + axz * x1 * z1 + ayz * y1 * z1 +
+                      axyz * (x0 * y1 * z1 + x1 * y0 * z1 + x1 * y1 * z0);
+    const double k1 = ax * x1 + ay * y1 + az * z1 + axy * (x0 * y1 + x1 * y0) +
+                      axz * (x0 * z1 + x1 * z0) + ayz * (y0 * z1 + y1 * z0) +
+                      axyz * (x1 * y0 * z0 + x0 * y1 * z0 + x0 * y0 * z1);
+    const double k0 = a0 + ax * x0 + ay * y0 + az * z0 + axy * x0 * y0 + axz * x0 * z0 +
+                      ayz * y0 * z0 + axyz * x0 * y0 * z0;
     auto f = [&](double s) { return ((k3 * s + k2) * s + k1) * s + k0; };
     // Monotone pieces between the cubic's critical points; the first piece ending at or below
     // zero holds the first zero.

@@ -1,13 +1,13 @@
 #pragma once
 // The learned encoding's payload, in little-endian 64-bit words (docs/encoding-learned.md):
-//   header      11 words: magic and version; cells; field and exception value widths; node
-//               spacing g; nodes per axis; dmax; dense bricks; the four exception counts
+//   header      9 words: magic and version; cells; field and exception value widths; node
+//               spacing g; nodes per axis; dmax; dense bricks; hits and corrections
 //   field       dense-brick bitmap, sign bitmap (one bit per brick each), the dense bricks'
 //               nodes (125 per brick, dist_bits + 2 normal_bits each)
-//   exceptions  per kind (miss, hit, normal, t): an Elias-Fano set of pair keys (high words,
-//               then low words)
-//   values      per kind with values, in key order: hit t (ex_t bits) and normal u, v (ex_n
-//               bits each); normal u, v; t
+//   hits        Elias-Fano set of the keys of "hit" exceptions (high words, then low words)
+//   corrections Elias-Fano set of the keys of the other exceptions
+//   values      per hit, in key order: t (ex_t bits), normal u, v (ex_n bits each); per
+//               correction: its kind (2 bits) and its value in a slot of max(ex_t, 2 ex_n) bits
 // Every section's size follows from the header and is checked against the payload's.
 #include <algorithm>
 #include <array>
@@ -21,28 +21,27 @@
 namespace lat::learned {
 
 inline constexpr std::uint32_t kMagic = 0x444E524C;  // "LRND"
-inline constexpr std::uint32_t kVersion = 3;
-inline constexpr std::size_t kHeaderWords = 11;
+inline constexpr std::uint32_t kVersion = 4;
+inline constexpr std::size_t kHeaderWords = 9;
 
-// What an exception corrects: the model hits a pair that misses (kMiss); the model misses or
-// both t and the normal are out of bounds (kHit: both stored); only the normal is (kNormal);
-// only t is (kT).
+// What an exception corrects: the model misses, or errs in both t and the normal (kHit: both
+// stored); the model hits a pair that misses (kMiss); it errs in the normal alone (kNormal) or
+// in t alone (kT). The last three are "corrections" of a predicted hit, in one set so that a
+// lookup searches it once.
 enum ExceptionKind { kMiss = 0, kHit = 1, kNormal = 2, kT = 3, kKinds = 4 };
 
 struct Header {
     std::array<int, 3> cells{};
     FieldShape field;
     unsigned ex_t = 0, ex_n = 0;
-    std::uint64_t dense = 0;
-    std::array<std::uint64_t, kKinds> count{};
+    std::uint64_t dense = 0, hits = 0, corrections = 0;
 };
 
-// Bits of one exception's values.
-inline std::uint64_t value_width(const Header& h, int kind) {
-    return kind == kHit      ? h.ex_t + 2 * h.ex_n
-           : kind == kNormal ? 2 * h.ex_n
-           : kind == kT      ? h.ex_t
-                             : 0;
+inline unsigned hit_width(const Header& h) {
+    return h.ex_t + 2 * h.ex_n;
+}
+inline unsigned record_width(const Header& h) {
+    return 2 + std::max(h.ex_t, 2 * h.ex_n);
 }
 
 inline std::array<std::uint64_t, kHeaderWords> encode_header(const Header& h) {
@@ -63,10 +62,8 @@ inline std::array<std::uint64_t, kHeaderWords> encode_header(const Header& h) {
             (std::uint64_t(f.nodes[2]) << 42),
         bits(f.dmax),
         h.dense,
-        h.count[0],
-        h.count[1],
-        h.count[2],
-        h.count[3]};
+        h.hits,
+        h.corrections};
 }
 
 // The fields as stored; the caller validates them.
@@ -88,31 +85,29 @@ inline Header decode_header(const std::uint64_t* w) {
                      int((w[4] >> 42) & 0x1FFFFF)};
     h.field.dmax = real(w[5]);
     h.dense = w[6];
-    for (int k = 0; k < kKinds; ++k) h.count[std::size_t(k)] = w[7 + k];
+    h.hits = w[7];
+    h.corrections = w[8];
     return h;
 }
 
 // Section sizes in words, for a header whose counts are already bounded (no overflow).
 struct Sections {
     std::uint64_t bitmap = 0, nodes = 0;  // each of the two bitmaps; the dense nodes
-    std::array<EliasFanoShape, kKinds> keys;
-    std::array<std::uint64_t, kKinds> values{};
+    EliasFanoShape hits, corrections;
+    std::uint64_t hit_values = 0, records = 0;
     std::uint64_t total() const {
-        std::uint64_t n = kHeaderWords + 2 * bitmap + nodes;
-        for (int k = 0; k < kKinds; ++k)
-            n += keys[std::size_t(k)].high_words() + keys[std::size_t(k)].low_words() +
-                 values[std::size_t(k)];
-        return n;
+        return kHeaderWords + 2 * bitmap + nodes + hits.high_words() + hits.low_words() +
+               corrections.high_words() + corrections.low_words() + hit_values + records;
     }
 };
 inline Sections sections(const Header& h, std::uint64_t universe) {
     Sections s;
     s.bitmap = words_for_bits(h.field.brick_count());
     s.nodes = words_for_bits(h.dense * h.field.brick_bits());
-    for (int k = 0; k < kKinds; ++k) {
-        s.keys[std::size_t(k)] = EliasFanoShape::for_keys(h.count[std::size_t(k)], universe);
-        s.values[std::size_t(k)] = words_for_bits(h.count[std::size_t(k)] * value_width(h, k));
-    }
+    s.hits = EliasFanoShape::for_keys(h.hits, universe);
+    s.corrections = EliasFanoShape::for_keys(h.corrections, universe);
+    s.hit_values = words_for_bits(h.hits * hit_width(h));
+    s.records = words_for_bits(h.corrections * record_width(h));
     return s;
 }
 

@@ -42,31 +42,27 @@ LearnedTable::LearnedTable(const std::uint8_t* payload, std::size_t size, std::u
     // Counts are bounded before sizes are multiplied, so nothing below can overflow.
     const std::uint64_t universe = std::uint64_t(grid_.count()) * grid_.count();
     constexpr std::uint64_t kLimit = std::uint64_t{1} << 48;
-    bool bad = f.brick_count() >= kLimit || h.dense > f.brick_count();
-    for (const std::uint64_t n : h.count) bad |= n > universe;
-    if (bad) throw std::runtime_error("learned: bad counts");
+    if (f.brick_count() >= kLimit || h.dense > f.brick_count() || h.hits > universe ||
+        h.corrections > universe)
+        throw std::runtime_error("learned: bad counts");
     const Sections s = sections(h, universe);
     if (s.total() != size / 8)
         throw std::runtime_error("learned: payload size does not match its header");
     const std::uint64_t* p = words + kHeaderWords;
     field_ = FieldView(f, p, p + s.bitmap, p + 2 * s.bitmap, h.dense);
     p += 2 * s.bitmap + s.nodes;
-    for (std::size_t k = 0; k < kKinds; ++k) {
-        ex_[k] = EliasFanoView(p, s.keys[k]);
-        p += s.keys[k].high_words() + s.keys[k].low_words();
-    }
-    for (std::size_t k = 0; k < kKinds; ++k) {
-        values_[k] = p;
-        p += s.values[k];
-    }
+    hits_ = EliasFanoView(p, s.hits);
+    p += s.hits.high_words() + s.hits.low_words();
+    corrections_ = EliasFanoView(p, s.corrections);
+    p += s.corrections.high_words() + s.corrections.low_words();
+    hit_values_ = p;
+    records_ = p + s.hit_values;
     ex_t_ = h.ex_t;
     ex_n_ = h.ex_n;
 }
 
 std::uint64_t LearnedTable::bytes() const {
-    std::uint64_t n = size_ + field_.index_bytes();
-    for (const EliasFanoView& e : ex_) n += e.index_bytes();
-    return n;
+    return size_ + field_.index_bytes() + hits_.index_bytes() + corrections_.index_bytes();
 }
 
 bool LearnedTable::predict(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
@@ -89,19 +85,29 @@ bool LearnedTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const
                           static_cast<int>(ex_n_));
     };
     std::uint64_t r;
-    if (ex_[kHit].find(key, r)) {
+    if (hits_.find(key, r)) {
         const unsigned w = ex_t_ + 2 * ex_n_;
-        const std::uint64_t code = read_bits(values_[kHit], r * w, w);
+        const std::uint64_t code = read_bits(hit_values_, r * w, w);
         hit.t = decode_value_t(code, ex_t_);
         hit.normal = normal_at(code >> ex_t_);
         return true;
     }
-    // The other kinds only ever correct a predicted hit.
-    if (!field_.predict(vec_of(pa), vec_of(pb), hit) || ex_[kMiss].find(key, r)) return false;
-    if (ex_[kNormal].find(key, r))
-        hit.normal = normal_at(read_bits(values_[kNormal], r * 2 * ex_n_, 2 * ex_n_));
-    else if (ex_[kT].find(key, r))
-        hit.t = decode_value_t(read_bits(values_[kT], r * ex_t_, ex_t_), ex_t_);
+    if (!field_.predict(vec_of(pa), vec_of(pb), hit)) return false;
+    if (!corrections_.find(key, r)) return true;
+    const unsigned w = 2 + std::max(ex_t_, 2 * ex_n_);
+    const std::uint64_t record = read_bits(records_, r * w, w);
+    switch (record & 3) {
+        case kMiss:
+            return false;
+        case kNormal:
+            hit.normal = normal_at(record >> 2);
+            break;
+        case kT:
+            hit.t = decode_value_t(record >> 2, ex_t_);
+            break;
+        default:
+            break;  // not written by the build
+    }
     return true;
 }
 

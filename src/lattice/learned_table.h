@@ -5,10 +5,10 @@
 // whole is within them (certify_table checks every pair).
 //   model       a signed distance field fitted to the hits, marched along the pair's segment
 //               (learned_field.h)
-//   exceptions  Elias-Fano sets of pair keys a * points + b: "miss" (the model hits, the pair
-//               does not), "hit" (the model misses, or errs in t and the normal: both stored),
-//               "normal" and "t" (the model errs in that alone: it is stored), the values at
-//               the narrowest widths that meet the bounds
+//   exceptions  two Elias-Fano sets of pair keys a * points + b: "hits" (the model misses, or
+//               errs in both t and the normal: both stored) and "corrections" of a predicted
+//               hit: a miss, or the normal or t alone; values at the narrowest widths that meet
+//               the bounds
 // The build tries several node spacings and widths and keeps the smallest table. Payload and
 // measurements: docs/encoding-learned.md.
 #include <array>
@@ -59,8 +59,8 @@ public:
     std::uint64_t bytes() const override;
 
     const FieldShape& field() const { return field_.shape(); }
-    // Exceptions of a kind: 0 miss, 1 hit, 2 normal, 3 t.
-    std::uint64_t exceptions(int kind) const { return ex_[std::size_t(kind)].size(); }
+    std::uint64_t hit_exceptions() const { return hits_.size(); }
+    std::uint64_t corrections() const { return corrections_.size(); }
     // The model's own answer, without the exceptions.
     bool predict(std::uint32_t a, std::uint32_t b, TableHit& hit) const;
 
@@ -68,8 +68,9 @@ private:
     BoundaryGrid grid_;
     FieldView field_;
     unsigned ex_t_ = 0, ex_n_ = 0;
-    std::array<EliasFanoView, 4> ex_;               // by kind
-    std::array<const std::uint64_t*, 4> values_{};  // by kind
+    EliasFanoView hits_, corrections_;
+    const std::uint64_t* hit_values_ = nullptr;
+    const std::uint64_t* records_ = nullptr;
     std::uint64_t entries_;
     std::size_t size_;
 };
