@@ -5,9 +5,11 @@
 
 #include <filesystem>
 #include <map>
+#include <random>
 #include <memory>
 #include <string>
 
+#include "lattice/boundary_grid.h"
 #include "lattice/encodings.h"
 #include "render/renderer.h"
 #include "scene/lattice_tables.h"
@@ -48,6 +50,82 @@ void BM_Rasterize(benchmark::State& state) {
 }
 BENCHMARK(BM_Rasterize)->Arg(1)->Arg(2)->Arg(4)->ArgName("sigma_inv")->Unit(benchmark::kMillisecond)
     ->UseRealTime()->Iterations(3);
+
+// Lookups: tables of the hair built in memory once per (encoding, sigma^-1); pairs drawn at
+// random among all valid pairs, or coherent (one entry point, exits along rows of a face).
+struct BuiltTable {
+    lat::ByteBuffer payload;
+    std::unique_ptr<lat::LatticeTable> table;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> random, coherent;
+};
+
+BuiltTable& built_table(const std::string& encoding, int k) {
+    static std::map<std::pair<std::string, int>, BuiltTable> cache;
+    auto key = std::make_pair(encoding, k);
+    auto it = cache.find(key);
+    if (it != cache.end()) return it->second;
+    static const lat::Scene scene = lat::load_scene(example("plate3-hair-closeup"));
+    const lat::Primitive& hair = scene.primitives.at(0);
+    BuiltTable& b = cache[key];
+    const lat::TableContext ctx{{7 * k, 7 * k, 20 * k}, 1.0 / k, 1.0, hair.shape.get()};
+    lat::RasterizeOptions ro;
+    ro.keep_hits = lat::encoding_info(encoding).needs_hits;
+    const lat::RasterizeResult r = lat::rasterize(*hair.shape, {ctx.cells, ctx.cell}, ro);
+    b.payload = lat::encode_table(encoding, r, ctx);
+    b.table = lat::open_table(encoding, b.payload.data(), b.payload.size(), r.hits, ctx);
+    const lat::BoundaryGrid grid(ctx.cells);
+    std::mt19937 rng(1);
+    std::uniform_int_distribution<std::uint32_t> pick(0, grid.count() - 1);
+    while (b.random.size() < (1u << 20)) {
+        const std::uint32_t x = pick(rng), y = pick(rng);
+        if (x != y && lat::BoundaryGrid::valid_pair(grid.faces(grid.point(x)), grid.faces(grid.point(y))))
+            b.random.push_back({x, y});
+    }
+    while (b.coherent.size() < (1u << 20)) {
+        const std::uint32_t x = pick(rng);
+        const lat::GridPoint p = grid.point(x);
+        // Exits along the face opposite to one of x's faces, row by row.
+        const int axis = (__builtin_ctz(grid.faces(p)) >> 1);
+        const int level = p[axis] == 0 ? ctx.cells[static_cast<std::size_t>(axis)] : 0;
+        const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+        for (int v = 0; v <= ctx.cells[static_cast<std::size_t>(va)]; ++v)
+            for (int u = 0; u <= ctx.cells[static_cast<std::size_t>(ua)]; ++u) {
+                lat::GridPoint q;
+                q[axis] = level, q[ua] = u, q[va] = v;
+                b.coherent.push_back({x, grid.id(q)});
+            }
+    }
+    return b;
+}
+
+void BM_Lookup(benchmark::State& state, const std::string& encoding, int k, bool coherent) {
+    BuiltTable& b = built_table(encoding, k);
+    const auto& pairs = coherent ? b.coherent : b.random;
+    std::size_t i = 0, hits = 0;
+    for (auto _ : state) {
+        const auto [x, y] = pairs[i++ & (pairs.size() - 1)];
+        lat::TableHit h;
+        lat::CandidateList c;
+        // Candidate tables answer the renderer with their lists; hit tables with the hit.
+        hits += b.table->kind() == lat::LatticeTable::Kind::kCandidates ? b.table->candidates(x, y, c)
+                                                                          : b.table->lookup(x, y, h);
+    }
+    state.counters["hit_share"] = double(hits) / double(state.iterations());
+    state.counters["bytes_per_hit"] = double(b.payload.size()) / double(b.table->entries());
+}
+
+int register_lookups() {
+    for (const lat::EncodingInfo& e : lat::table_encodings())
+        for (int k : {1, 2, 4})
+            for (bool coherent : {false, true})
+                benchmark::RegisterBenchmark(("lookup/" + e.name + "/sigma_inv:" + std::to_string(k) +
+                                              (coherent ? "/coherent" : "/random"))
+                                                 .c_str(),
+                                             BM_Lookup, e.name, k, coherent)
+                    ->Unit(benchmark::kNanosecond);
+    return 0;
+}
+const int lookups_registered = register_lookups();
 
 struct Prepared {
     lat::Scene scene;

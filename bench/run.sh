@@ -12,7 +12,9 @@ for exe in "$build"/bin/*_bench; do
   "$exe" --benchmark_out="$out/$name.json" --benchmark_out_format=json \
          --benchmark_counters_tabular=true
 done
-python3 "$here/summarize.py" "$out" > "$out/summary.md"
+echo "== encodings (through the lattice command)"
+python3 "$here/encodings.py" "$build/bin/lattice" "$out" > "$out/encodings.md"
+{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md"; } > "$out/summary.md"
 echo
 cat "$out/summary.md"
 echo "results: $out"

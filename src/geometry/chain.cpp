@@ -56,28 +56,19 @@ bool ChainShape::occluded(const Ray& r, double tmin, double tmax) const {
     return false;
 }
 
+void ChainShape::primitive_spans(std::size_t i, const Ray& r, SpanList& out) const {
+    const std::size_t before = out.size();
+    part(i).spans(r, out);
+    for (std::size_t k = before; k < out.size(); ++k) {
+        out[k].in.part = static_cast<std::uint32_t>(i << 2) | out[k].in.part;
+        out[k].out.part = static_cast<std::uint32_t>(i << 2) | out[k].out.part;
+    }
+}
+
 void ChainShape::spans(const Ray& r, SpanList& out) const {
-    // Union of the parts' spans: sort by entry, then merge overlapping intervals.
     const std::size_t first = out.size();
-    for (std::size_t i = 0; i < primitive_count(); ++i) {
-        const std::size_t before = out.size();
-        part(i).spans(r, out);
-        for (std::size_t k = before; k < out.size(); ++k) {
-            out[k].in.part = static_cast<std::uint32_t>(i << 2) | out[k].in.part;
-            out[k].out.part = static_cast<std::uint32_t>(i << 2) | out[k].out.part;
-        }
-    }
-    auto begin = out.begin() + static_cast<std::ptrdiff_t>(first);
-    std::sort(begin, out.end(), [](const Span& a, const Span& b) { return a.in.t < b.in.t; });
-    std::size_t w = first;
-    for (std::size_t k = first; k < out.size(); ++k) {
-        if (w > first && out[k].in.t <= out[w - 1].out.t) {
-            if (out[k].out.t > out[w - 1].out.t) out[w - 1].out = out[k].out;
-        } else {
-            out[w++] = out[k];
-        }
-    }
-    out.resize(w);
+    for (std::size_t i = 0; i < primitive_count(); ++i) primitive_spans(i, r, out);
+    merge_span_union(out, first);
 }
 
 Vec3 ChainShape::normal(const Ray& r, const Crossing& c) const {

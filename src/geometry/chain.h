@@ -49,6 +49,7 @@ public:
         return found;
     }
     void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
+    void primitive_spans(std::size_t i, const Ray& r, SpanList& out) const override;
     bool occluded_primitive(std::size_t i, const Ray& r, double tmin, double tmax) const override {
         return part(i).occluded(r, tmin, tmax);
     }

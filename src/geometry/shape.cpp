@@ -1,5 +1,6 @@
 #include "geometry/shape.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lat {
@@ -17,6 +18,20 @@ bool first_crossing(const SpanList& spans, double tmin, double tmax, Crossing& h
         }
     }
     return false;
+}
+
+void merge_span_union(SpanList& spans, std::size_t first) {
+    auto begin = spans.begin() + static_cast<std::ptrdiff_t>(first);
+    std::sort(begin, spans.end(), [](const Span& a, const Span& b) { return a.in.t < b.in.t; });
+    std::size_t w = first;
+    for (std::size_t k = first; k < spans.size(); ++k) {
+        if (w > first && spans[k].in.t <= spans[w - 1].out.t) {
+            if (spans[k].out.t > spans[w - 1].out.t) spans[w - 1].out = spans[k].out;
+        } else {
+            spans[w++] = spans[k];
+        }
+    }
+    spans.resize(w);
 }
 
 }  // namespace lat

@@ -87,6 +87,7 @@ public:
     virtual bool occluded_primitive(std::size_t, const Ray& r, double tmin, double tmax) const {
         return occluded(r, tmin, tmax);
     }
+    virtual void primitive_spans(std::size_t, const Ray& r, SpanList& out) const { spans(r, out); }
 
     // Spheres that together enclose primitive i (for culling by cones, as rasterization does);
     // by default the sphere around its box. Long parts give several smaller spheres.
@@ -98,6 +99,9 @@ public:
     // CSG trees carry a material tag per leaf; other shapes answer with the fallback.
     virtual std::uint32_t tag(const Crossing&, std::uint32_t fallback) const { return fallback; }
 };
+
+// Spans from `first` on, possibly overlapping: sorted and merged into their union.
+void merge_span_union(SpanList& spans, std::size_t first);
 
 // The first crossing of a span list with tmin < t < tmax, if any.
 bool first_crossing(const SpanList& spans, double tmin, double tmax, Crossing& hit);

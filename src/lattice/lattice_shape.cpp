@@ -1,16 +1,22 @@
 #include "lattice/lattice_shape.h"
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 
 namespace lat {
 
 LatticeShape::LatticeShape(std::shared_ptr<const LatticeTable> table, std::array<int, 3> cells,
-                           double cell)
+                           double cell, const Shape* primitive)
     : table_(std::move(table)),
       grid_(cells),
       cell_(cell),
       inv_cell_(1.0 / cell),
-      box_{{0, 0, 0}, Vec3{double(cells[0]), double(cells[1]), double(cells[2])} * cell} {}
+      box_{{0, 0, 0}, Vec3{double(cells[0]), double(cells[1]), double(cells[2])} * cell},
+      primitive_(primitive),
+      exact_(table_->kind() == LatticeTable::Kind::kCandidates) {
+    assert(!exact_ || primitive_);
+}
 
 bool LatticeShape::snap(const Ray& r, std::uint32_t& a, std::uint32_t& b, GridPoint& pa,
                         GridPoint& pb) const {
@@ -46,7 +52,13 @@ bool LatticeShape::snap(const Ray& r, std::uint32_t& a, std::uint32_t& b, GridPo
     pb = on_face(t1, ax1, d[static_cast<std::size_t>(ax1)] > 0);
     a = grid_.id(pa);
     b = grid_.id(pb);
-    return a != b;
+    return a != b || exact_;
+}
+
+bool LatticeShape::candidates(const Ray& r, CandidateList& list) const {
+    std::uint32_t a, b;
+    GridPoint pa, pb;
+    return snap(r, a, b, pa, pb) && table_->candidates(a, b, list);
 }
 
 namespace {
@@ -84,6 +96,17 @@ LatticeShape::LineHits LatticeShape::line_hits(const Ray& r) const {
 }
 
 bool LatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    if (exact_) {
+        CandidateList list;
+        if (!candidates(r, list)) return false;
+        bool found = false;
+        for (int k = 0; k < list.count; ++k)
+            if (primitive_->intersect_primitive(list.parts[k], r, tmin, tmax, hit)) {
+                tmax = hit.t;
+                found = true;
+            }
+        return found;
+    }
     const LineHits lh = line_hits(r);
     if (!lh.hit) return false;
     if (lh.t_first > tmin && lh.t_first < tmax) {
@@ -98,22 +121,39 @@ bool LatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& h
 }
 
 bool LatticeShape::occluded(const Ray& r, double tmin, double tmax) const {
+    if (exact_) {
+        CandidateList list;
+        if (!candidates(r, list)) return false;
+        for (int k = 0; k < list.count; ++k)
+            if (primitive_->occluded_primitive(list.parts[k], r, tmin, tmax)) return true;
+        return false;
+    }
     // The table knows the line's first and last crossings; between them it counts as solid.
     const LineHits lh = line_hits(r);
     return lh.hit && lh.t_last > tmin && lh.t_first < tmax;
 }
 
 void LatticeShape::spans(const Ray& r, SpanList& out) const {
+    if (exact_) {  // the union of the candidate parts' spans
+        CandidateList list;
+        if (!candidates(r, list)) return;
+        const std::size_t first = out.size();
+        for (int k = 0; k < list.count; ++k) primitive_->primitive_spans(list.parts[k], r, out);
+        merge_span_union(out, first);
+        return;
+    }
     const LineHits lh = line_hits(r);
     if (lh.hit && lh.t_first < lh.t_last) out.push_back({{lh.t_first, 0, 0}, {lh.t_last, 1, 0}});
 }
 
 Vec3 LatticeShape::normal(const Ray& r, const Crossing& c) const {
+    if (exact_) return primitive_->normal(r, c);
     const LineHits lh = line_hits(r);
     return c.part == 0 ? lh.n_first : lh.n_last;
 }
 
 Vec3 LatticeShape::position(const Ray& r, const Crossing& c) const {
+    if (exact_) return r.at(c.t);
     const LineHits lh = line_hits(r);
     return c.part == 0 ? lh.p_first : lh.p_last;
 }

@@ -5,6 +5,8 @@
 // the pair is looked up. The stored point (near, not on, the ray) is the hit's position; its
 // projection on the ray orders it against other objects. The reverse pair (p_o, p_i) gives
 // the last crossing, so a lattice is also a CSG leaf (one span per ray) and shadows itself.
+// With a candidate table (encoding `candidates`) the pair instead names the primitive's parts
+// the ray can meet, and those are intersected exactly with the real ray: an exact lattice.
 #include <memory>
 
 #include "geometry/shape.h"
@@ -15,8 +17,10 @@ namespace lat {
 
 class LatticeShape final : public Shape {
 public:
-    // cells: the lattice at its refinement; cell: the cell size in primitive units.
-    LatticeShape(std::shared_ptr<const LatticeTable> table, std::array<int, 3> cells, double cell);
+    // cells: the lattice at its refinement; cell: the cell size in primitive units; the
+    // primitive is needed by candidate tables (and kept alive by the caller).
+    LatticeShape(std::shared_ptr<const LatticeTable> table, std::array<int, 3> cells, double cell,
+                 const Shape* primitive = nullptr);
 
     const LatticeTable& table() const { return *table_; }
 
@@ -29,7 +33,8 @@ public:
     bool inside(Vec3 p) const override;
     // Rays leaving a point found through this lattice skip crossings within this distance of
     // it: the table's own error, which would otherwise shade the surface by itself (acne).
-    double surface_tolerance() const override { return 2.0 * cell_; }
+    // Exact (candidate) lattices need none.
+    double surface_tolerance() const override { return exact_ ? 0.0 : 2.0 * cell_; }
 
     // The two crossings of the ray's line (first and last), as ray parameters and points.
     struct LineHits {
@@ -46,8 +51,14 @@ private:
     double cell_, inv_cell_;
     Bounds3 box_;  // primitive units
 
-    // Snapped entry and exit point ids of the ray's line; false if it misses the box.
+    const Shape* primitive_;
+    bool exact_;  // a candidate table
+
+    // Snapped entry and exit point ids of the ray's line; false if it misses the box (or, for
+    // hit tables, when both snap to the same point).
     bool snap(const Ray& r, std::uint32_t& a, std::uint32_t& b, GridPoint& pa, GridPoint& pb) const;
+    // Candidate tables: the parts the ray can meet; false when none.
+    bool candidates(const Ray& r, CandidateList& list) const;
 };
 
 }  // namespace lat

@@ -9,6 +9,7 @@
 
 #include "geometry/chain.h"
 #include "lattice/boundary_grid.h"
+#include "lattice/face_cones.h"
 #include "lattice/octahedral.h"
 #include "util/progress.h"
 
@@ -17,18 +18,7 @@ namespace {
 
 constexpr std::uint32_t kBlock = 32;  // entry points per task
 
-struct FaceLayout {
-    int axis, level, ua, va, nu, nv;      // nu, nv: points along u and v
-    std::vector<std::uint8_t> mask;       // faces of each point
-    std::vector<std::uint8_t> canonical;  // 1 where this face is the point's lowest face
-    std::vector<std::uint32_t> ids;
-};
 
-struct PartSphere {
-    Vec3 c;  // lattice units
-    double r;
-    std::uint32_t part;
-};
 
 struct Counts {
     std::uint64_t enumerated = 0, traced = 0, hits = 0, counted = 0, tests = 0;
@@ -73,67 +63,11 @@ struct Scratch {
     HitArena arena;
 };
 
-// The face-grid rectangle that can hold exits of segments from p that meet the box b: the
-// central projection of b's corners from p onto the face plane; the whole face when the
-// projection is unbounded (a corner level with p or behind it).
-void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& u0, int& u1,
-                     int& v0, int& v1) {
-    u0 = 0, u1 = f.nu - 1, v0 = 0, v1 = f.nv - 1;
-    const auto ax = static_cast<std::size_t>(f.axis), ua = static_cast<std::size_t>(f.ua),
-               va = static_cast<std::size_t>(f.va);
-    const double num = f.level - p[ax];
-    if (num == 0) return;
-    double umin = kInfinity, umax = -kInfinity, vmin = kInfinity, vmax = -kInfinity;
-    for (int k = 0; k < 8; ++k) {
-        const Vec3 c = b.corner(k);
-        const double den = c[ax] - p[ax];
-        if (den * num <= 0) return;
-        const double s = num / den;
-        const double u = p[ua] + s * (c[ua] - p[ua]), v = p[va] + s * (c[va] - p[va]);
-        umin = std::min(umin, u), umax = std::max(umax, u);
-        vmin = std::min(vmin, v), vmax = std::max(vmax, v);
-    }
-    const double eps = 1e-9;
-    u0 = static_cast<int>(std::ceil(std::max(umin - eps, double(u0))));
-    u1 = static_cast<int>(std::floor(std::min(umax + eps, double(u1))));
-    v0 = static_cast<int>(std::ceil(std::max(vmin - eps, double(v0))));
-    v1 = static_cast<int>(std::floor(std::min(vmax + eps, double(v1))));
-}
-
-// Row v of face f: the u-interval of exits q whose segment from p can meet the sphere (c, r),
-// i.e. q inside the cone from p around the sphere. Conservative (padded against rounding);
-// returns false for an empty interval.
-bool cone_row(const Vec3& p, const PartSphere& s, const FaceLayout& f, int v, double& ulo,
-              double& uhi) {
-    const auto ax = static_cast<std::size_t>(f.axis), ua = static_cast<std::size_t>(f.ua),
-               va = static_cast<std::size_t>(f.va);
-    const Vec3 w = s.c - p;
-    const double k = length_squared(w) - s.r * s.r;
-    const double da = f.level - p[ax], dv = v - p[va];
-    const double alpha = da * w[ax] + dv * w[va], beta = w[ua];
-    const double gamma = da * da + dv * dv;
-    // g(u') = (alpha + beta u')^2 - k (gamma + u'^2) >= 0 with alpha + beta u' >= 0, u' = u - p_u.
-    const double A = beta * beta - k, B = alpha * beta, C = alpha * alpha - k * gamma;
-    if (k <= 0 || A >= 0) {  // p inside the sphere, or the cone opens along u: the whole row
-        ulo = -kInfinity, uhi = kInfinity;
-        return true;
-    }
-    const double disc = B * B - A * C;
-    if (disc < 0) return false;
-    const double sq = std::sqrt(disc);
-    const double r0 = (-B + sq) / A, r1 = (-B - sq) / A;  // r0 <= r1 since A < 0
-    if (alpha + beta * 0.5 * (r0 + r1) < 0) return false;  // the cone's far nappe
-    const double pad = 1e-7 * (1 + std::abs(r0) + std::abs(r1));
-    ulo = p[ua] + r0 - pad;
-    uhi = p[ua] + r1 + pad;
-    return true;
-}
-
 // Everything about the lattice that does not depend on the entry point.
 class Tracer {
 public:
     Tracer(const Shape& shape, const LatticeGrid& lg) : grid_(lg.cells), h_(lg.cell) {
-        for (int f = 0; f < 6; ++f) layout_face(f, lg);
+        for (int f = 0; f < 6; ++f) faces_[static_cast<std::size_t>(f)] = layout_face(grid_, f);
         count_sums();
         // The parts as bounding spheres in lattice units, grouped by part, padded beyond the
         // parts' touch tolerance so culling never drops a touching hit.
@@ -198,27 +132,6 @@ private:
     std::array<std::array<Sum, 6>, 64> sums_{};
     std::vector<PartSphere> spheres_;
 
-    void layout_face(int f, const LatticeGrid& lg) {
-        FaceLayout& fl = faces_[static_cast<std::size_t>(f)];
-        fl.axis = BoundaryGrid::face_axis(f);
-        fl.level = grid_.face_level(f);
-        fl.ua = (fl.axis + 1) % 3;
-        fl.va = (fl.axis + 2) % 3;
-        fl.nu = lg.cells[static_cast<std::size_t>(fl.ua)] + 1;
-        fl.nv = lg.cells[static_cast<std::size_t>(fl.va)] + 1;
-        const std::size_t n = static_cast<std::size_t>(fl.nu) * static_cast<std::size_t>(fl.nv);
-        fl.mask.resize(n), fl.canonical.resize(n), fl.ids.resize(n);
-        for (int v = 0; v < fl.nv; ++v)
-            for (int u = 0; u < fl.nu; ++u) {
-                GridPoint q;
-                q[fl.axis] = fl.level, q[fl.ua] = u, q[fl.va] = v;
-                const std::size_t k = static_cast<std::size_t>(v * fl.nu + u);
-                fl.mask[k] = grid_.faces(q);
-                fl.canonical[k] = (__builtin_ctz(fl.mask[k]) == f) ? 1 : 0;
-                fl.ids[k] = grid_.id(q);
-            }
-    }
-
     // For every face mask of an entry point and every exit face: how many exit points there
     // make a valid pair, and how many face pairs they stand for (the paper's count).
     void count_sums() {
@@ -246,34 +159,19 @@ private:
                 last_part = ps.part;
                 ++s.generation;  // marks "tested for this part" in s.tested
             }
-            int u0, u1, v0, v1;
-            const Vec3 rr{ps.r, ps.r, ps.r};
-            projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
-            for (int v = v0; v <= v1; ++v) {
-                double ulo, uhi;
-                if (!cone_row(p, ps, fl, v, ulo, uhi)) continue;
-                // Clamp in double first: the interval may be unbounded or huge.
-                const int ub = static_cast<int>(std::ceil(std::max(ulo, double(u0))));
-                const int ue = static_cast<int>(std::floor(std::min(uhi, double(u1))));
-                for (int u = ub; u <= ue; ++u) {
-                    const std::size_t k = static_cast<std::size_t>(v * fl.nu + u);
-                    if (!fl.canonical[k] || s.tested[k] == s.generation) continue;
-                    s.tested[k] = s.generation;
-                    Vec3 q;
-                    q[static_cast<std::size_t>(fl.axis)] = fl.level;
-                    q[static_cast<std::size_t>(fl.ua)] = u;
-                    q[static_cast<std::size_t>(fl.va)] = v;
-                    const Ray r{p * h_, (q - p) * h_};
-                    Crossing c;
-                    ++cnt.tests;
-                    const double tmax = std::min(s.best_t[k], 1.0 + 1e-12);
-                    if (shape.intersect_primitive(ps.part, r, 0.0, tmax, c)) {
-                        if (s.best_t[k] == kInfinity) s.touched.push_back(k);
-                        s.best_t[k] = c.t;
-                        s.best_c[k] = c;
-                    }
+            for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
+                if (s.tested[k] == s.generation) return;
+                s.tested[k] = s.generation;
+                const Ray r{p * h_, (q - p) * h_};
+                Crossing c;
+                ++cnt.tests;
+                const double tmax = std::min(s.best_t[k], 1.0 + 1e-12);
+                if (shape.intersect_primitive(ps.part, r, 0.0, tmax, c)) {
+                    if (s.best_t[k] == kInfinity) s.touched.push_back(k);
+                    s.best_t[k] = c.t;
+                    s.best_c[k] = c;
                 }
-            }
+            });
         }
     }
 

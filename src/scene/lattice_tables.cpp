@@ -248,7 +248,7 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const 
         if (!used[i]) continue;
         const Primitive& p = scene.primitives[i];
         const TableCache::Entry e = cache.get(p, spec, scene.file, progress);
-        out.shapes[i] = std::make_shared<LatticeShape>(e.table, e.header.cells, e.header.cell);
+        out.shapes[i] = std::make_shared<LatticeShape>(e.table, e.header.cells, e.header.cell, p.shape.get());
         out.table_bytes += e.table->bytes();
         out.table_entries += e.table->entries();
         out.built += e.built ? 1 : 0;

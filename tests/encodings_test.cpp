@@ -1,0 +1,150 @@
+// The compact encodings: dense meets its error targets with no false hits or misses, at the
+// sizes documented; candidates is exact (its images equal exact mode's).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "geometry/chain.h"
+#include "io/image_compare.h"
+#include "lattice/candidates_table.h"
+#include "lattice/certify.h"
+#include "lattice/dense_table.h"
+#include "lattice/encodings.h"
+#include "lattice/lattice_shape.h"
+#include "lattice/rasterizer.h"
+#include "render/renderer.h"
+#include "scene/lattice_tables.h"
+#include "scene/scene_loader.h"
+#include "temp_dir.h"
+#include "test_paths.h"
+
+namespace lat {
+namespace {
+
+const Scene& hair_scene() {
+    static const Scene s = load_scene(test::source_path("examples/plate3-hair-closeup.json"));
+    return s;
+}
+
+struct Built {
+    ByteBuffer payload;
+    std::unique_ptr<LatticeTable> table;
+    TableContext ctx;
+    RasterizeResult raster;
+};
+
+Built build(const std::string& encoding, int k, const EncodeOptions& opt = {}) {
+    const Primitive& p = hair_scene().primitives.at(0);
+    Built b;
+    b.ctx = {{7 * k, 7 * k, 20 * k}, 1.0 / k, 1.0, p.shape.get()};
+    b.raster = rasterize(*p.shape, {b.ctx.cells, b.ctx.cell});
+    b.payload = encode_table(encoding, b.raster, b.ctx, opt);
+    b.table = open_table(encoding, b.payload.data(), b.payload.size(), b.raster.hits, b.ctx);
+    return b;
+}
+
+TEST(EncodingDense, CertifiedWithinTargetsOnTheHair) {
+    for (int k : {1, 2}) {
+        const Built b = build("dense", k);
+        const CertifyReport r = certify_table(*b.table, b.ctx, false);
+        EXPECT_EQ(r.false_hits, 0u) << k;
+        EXPECT_EQ(r.false_misses, 0u) << k;
+        EXPECT_LE(r.max_point_error, 0.01) << k;
+        EXPECT_LE(r.max_normal_error_deg, 1.0) << k;
+        const double per_hit = double(b.payload.size()) / double(b.raster.hits);
+        EXPECT_LT(per_hit, 3.0) << k;  // measured 2.39 and 2.38 (payload only)
+    }
+}
+
+TEST(EncodingDense, OctahedralNormalsAndLooserTargets) {
+    EncodeOptions oct;
+    oct.normals = "oct";
+    const Built a = build("dense", 1, oct);
+    const CertifyReport ra = certify_table(*a.table, a.ctx, false);
+    EXPECT_LE(ra.max_point_error, 0.01);
+    EXPECT_LE(ra.max_normal_error_deg, 1.0);
+    EXPECT_EQ(static_cast<const DenseTable&>(*a.table).layout().normal_mode, 0u);
+    EncodeOptions loose;
+    loose.max_point_error = 0.05;
+    loose.max_normal_error_deg = 5;
+    const Built b = build("dense", 1, loose);
+    const CertifyReport rb = certify_table(*b.table, b.ctx, false);
+    EXPECT_LE(rb.max_point_error, 0.05);
+    EXPECT_LE(rb.max_normal_error_deg, 5.0);
+    EXPECT_EQ(rb.false_hits + rb.false_misses, 0u);
+    EXPECT_LT(b.payload.size(), a.payload.size());
+}
+
+TEST(EncodingDense, BothDirectionsFromOneRecord) {
+    const Built b = build("dense", 1);
+    for (const RawHit& h : b.raster.raw.flatten()) {
+        TableHit fwd, rev;
+        ASSERT_TRUE(b.table->lookup(h.a, h.b, fwd));
+        ASSERT_TRUE(b.table->lookup(h.b, h.a, rev));
+        EXPECT_LE(fwd.t, 1.0 - rev.t + 1e-3);  // the near hit comes before the far one
+    }
+}
+
+TEST(EncodingDense, RejectsCorruptPayloads) {
+    Built b = build("dense", 1);
+    const auto& ctx = b.ctx;
+    EXPECT_THROW(DenseTable(b.payload.data(), 40, 0, ctx), std::runtime_error);
+    EXPECT_THROW(DenseTable(b.payload.data(), b.payload.size() - 8, 0, ctx), std::runtime_error);
+    b.payload.data()[8] ^= 1;  // the point count
+    EXPECT_THROW(DenseTable(b.payload.data(), b.payload.size(), 0, ctx), std::runtime_error);
+}
+
+TEST(EncodingCandidates, ExactOnEveryPair) {
+    const Built b = build("candidates", 2);
+    const CertifyReport r = certify_table(*b.table, b.ctx, false);
+    EXPECT_EQ(r.false_hits, 0u);
+    EXPECT_EQ(r.false_misses, 0u);
+    EXPECT_LT(r.max_point_error, 1e-5);
+    EXPECT_LT(double(b.payload.size()) / double(b.raster.hits), 2.0);
+}
+
+TEST(EncodingCandidates, EveryPartARayMeetsIsACandidate) {
+    // Random rays through the hair's lattice: every part the real ray hits inside the box is in
+    // the candidate list of the pair it snaps to, so lattice answers equal exact ones.
+    const Built b = build("candidates", 1);
+    const Primitive& p = hair_scene().primitives.at(0);
+    const auto shared = std::shared_ptr<const LatticeTable>(b.table.get(), [](const LatticeTable*) {});
+    const LatticeShape ls(shared, b.ctx.cells, b.ctx.cell, p.shape.get());
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(0, 1);
+    int hits = 0;
+    for (int n = 0; n < 50000; ++n) {
+        const Vec3 target{7 * u(rng), 7 * u(rng), 20 * u(rng)};
+        const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+        const Ray ray{target - d * 30, d};
+        Crossing ce, cl;
+        const bool exact = p.shape->intersect(ray, 0, kInfinity, ce);
+        const bool lattice = ls.intersect(ray, 0, kInfinity, cl);
+        ASSERT_EQ(exact, lattice) << n;
+        if (exact) {
+            ++hits;
+            ASSERT_EQ(ce.t, cl.t) << n;
+        }
+        EXPECT_EQ(p.shape->occluded(ray, 0, kInfinity), ls.occluded(ray, 0, kInfinity)) << n;
+    }
+    EXPECT_GT(hits, 3000);
+}
+
+TEST(EncodingCandidates, PlatesRenderAsExact) {
+    test::TempDir dir;
+    const TableCache cache(dir.path().string(), true);
+    TableSpec spec;
+    spec.encoding = "candidates";
+    for (const char* plate : {"plate2-thistle", "plate4-fuzzy-sphere-1000"}) {
+        Scene s = load_scene(test::source_path(std::string("examples/") + plate + ".json"));
+        s.camera.width = s.camera.height = 160;
+        const SceneLattices l = scene_lattices(s, cache, spec, false);
+        const RenderScene lattice(s, [&](int i) { return l.shapes[static_cast<std::size_t>(i)]; });
+        const ImageDiffStats d = compare_images(render_image(RenderScene(s), {}).display,
+                                                render_image(lattice, {}).display);
+        EXPECT_EQ(d.max_abs_error, 0) << plate;
+    }
+}
+
+}  // namespace
+}  // namespace lat
