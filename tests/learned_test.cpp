@@ -200,6 +200,8 @@ TEST(LearnedTable, RejectsShortAndCorruptPayloads) {
              {2, words[2] & ~(std::uint64_t{0xFF} << 56)},
              {3, 0x7FF8000000000000ull},
              {3, 0},
+             {3, 1},                      // a denormal spacing
+             {3, 0x4059000000000000ull},  // 100 lattice units: not this grid
              {4, words[4] | 0x1FFFFF},
              {4, 0},
              {5, 0xFFF0000000000000ull},

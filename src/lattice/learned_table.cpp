@@ -36,8 +36,11 @@ LearnedTable::LearnedTable(const std::uint8_t* payload, std::size_t size, std::u
         throw std::runtime_error("learned: bad field widths");
     if (!(std::isfinite(f.g) && f.g > 0 && std::isfinite(f.dmax) && f.dmax > 0))
         throw std::runtime_error("learned: bad node spacing");
-    for (const int n : f.nodes)
-        if (n < 2) throw std::runtime_error("learned: bad node counts");
+    // The grid must be the one the build lays over these cells: that also keeps every
+    // coordinate a lookup computes finite.
+    for (std::size_t ax = 0; ax < 3; ++ax)
+        if (f.nodes[ax] < 2 || double(f.nodes[ax]) != std::ceil(h.cells[ax] / f.g - 1e-9) + 1)
+            throw std::runtime_error("learned: node grid does not fit the cells");
     grid_ = BoundaryGrid(h.cells);
     // Counts are bounded before sizes are multiplied, so nothing below can overflow.
     const std::uint64_t universe = std::uint64_t(grid_.count()) * grid_.count();
