@@ -144,6 +144,27 @@ TEST(LearnedTable, ExceptionsCorrectTheModel) {
     EXPECT_EQ(std::uint64_t(corrected), corrections);
 }
 
+TEST(LearnedTable, MissCorrectionsOverrideTheModel) {
+    // Every pair the model hits but the primitive misses must be a "miss" correction.
+    const Raster& x = hair_k1();
+    LearnedStats st;
+    const ByteBuffer payload = LearnedTable::build(x.r.raw, x.ctx, {}, &st);
+    const LearnedTable table(payload.data(), payload.size(), x.r.hits, x.ctx);
+    std::set<std::pair<std::uint32_t, std::uint32_t>> stored;
+    for (const RawHit& h : x.r.raw.flatten()) stored.insert({h.a, h.b});
+    const BoundaryGrid grid(x.ctx.cells);
+    std::uint64_t overridden = 0;
+    for (std::uint32_t a = 0; a < grid.count(); ++a)
+        for (std::uint32_t b = 0; b < grid.count(); ++b) {
+            TableHit model, answer;
+            if (stored.count({a, b}) || !table.predict(a, b, model)) continue;
+            EXPECT_FALSE(table.lookup(a, b, answer));
+            ++overridden;
+        }
+    EXPECT_GT(overridden, 0u);
+    EXPECT_EQ(overridden, st.miss_exceptions);
+}
+
 TEST(LearnedTable, SameBytesForAnyThreadCount) {
     const Raster& x = hook_k2();
     const ByteBuffer many = LearnedTable::build(x.r.raw, x.ctx, {});
