@@ -5,6 +5,7 @@
 #include "lattice/candidates_table.h"
 #include "lattice/dense_table.h"
 #include "lattice/hash14_table.h"
+#include "lattice/learned_table.h"
 #include "lattice/perfect_table.h"
 #include "util/error.h"
 
@@ -36,6 +37,12 @@ const std::vector<EncodingInfo>& table_encodings() {
          PerfectTable::kMaxPoints, 18.0, true},
         {"perfect7", "perfect5 with a 16-bit key fingerprint per entry (7 bytes)",
          PerfectTable::kMaxPoints, 19.0, true},
+        // Planned at the build's peak: the index of the hits by entry point (8 bytes per hit),
+        // the exception list and the table (a few bytes per hit at most).
+        {"learned",
+         "a distance field fitted to the hits, marched along the pair, plus exceptions where "
+         "it errs beyond the bounds",
+         LearnedTable::kMaxPoints, 12.0, true},
     };
     return list;
 }
@@ -56,6 +63,7 @@ ByteBuffer encode_table(const std::string& encoding, const RasterizeResult& r,
     if (encoding == "candidates") return CandidatesTable::build(ctx, false);
     if (const int fp = perfect_fingerprint_bits(encoding); fp >= 0)
         return PerfectTable::build(r.raw, fp);
+    if (encoding == "learned") return LearnedTable::build(r.raw, ctx, opt);
     throw std::invalid_argument("encode_table: unknown encoding " + encoding);
 }
 
@@ -67,6 +75,7 @@ std::unique_ptr<LatticeTable> open_table(const std::string& encoding, const std:
     if (encoding == "candidates") return std::make_unique<CandidatesTable>(payload, size, entries, ctx);
     if (const int fp = perfect_fingerprint_bits(encoding); fp >= 0)
         return std::make_unique<PerfectTable>(payload, size, entries, fp);
+    if (encoding == "learned") return std::make_unique<LearnedTable>(payload, size, entries, ctx);
     throw std::runtime_error("unknown table encoding '" + encoding + "'");
 }
 
