@@ -19,10 +19,12 @@ def main(results):
     print("# Benchmark results\n")
     for path in sorted(pathlib.Path(results).glob("*.json")):
         data = json.loads(path.read_text())
+        if "benchmarks" not in data:
+            continue  # not Google Benchmark output (encodings.json has its own summary)
         ctx = data.get("context", {})
         print(f"## {path.stem}\n")
         print(f"{ctx.get('date', '')}, {ctx.get('num_cpus', '?')} CPUs at "
-              f"{ctx.get('mhz_per_cpu', '?')} MHz, build {ctx.get('library_build_type', '?')}\n")
+              f"{ctx.get('mhz_per_cpu', '?')} MHz\n")
         rows = [b for b in data.get("benchmarks", []) if b.get("run_type") != "aggregate"
                 or b.get("aggregate_name") == "median"]
         counters = []

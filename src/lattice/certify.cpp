@@ -19,7 +19,7 @@ namespace {
 struct ExactHit {
     std::uint32_t b;
     float t;
-    std::uint32_t part, leaf;
+    Crossing crossing;
 };
 
 Vec3 point_of(const GridPoint& g) { return {double(g.x), double(g.y), double(g.z)}; }
@@ -34,7 +34,7 @@ CertifyReport certify_table(const LatticeTable& table, const TableContext& ctx, 
     // The exact hits by entry point, sorted by exit point.
     std::vector<std::vector<ExactHit>> by_entry(grid.count());
     for (const auto& chunk : exact.raw.chunks)
-        for (const RawHit& h : chunk) by_entry[h.a].push_back({h.b, h.t, h.part, h.leaf});
+        for (const RawHit& h : chunk) by_entry[h.a].push_back({h.b, h.t, h.crossing(double(h.t))});
     tbb::parallel_for(std::size_t{0}, by_entry.size(), [&](std::size_t a) {
         std::sort(by_entry[a].begin(), by_entry[a].end(),
                   [](const ExactHit& x, const ExactHit& y) { return x.b < y.b; });
@@ -73,7 +73,7 @@ CertifyReport certify_table(const LatticeTable& table, const TableContext& ctx, 
                 const double len = length(pb - pa) * ctx.cell / ctx.sigma;
                 const double perr = std::abs(th.t - double(e.t)) * len;
                 const Ray seg{pa * ctx.cell, (pb - pa) * ctx.cell};
-                const Vec3 n = shape.normal(seg, {double(e.t), e.part, e.leaf});
+                const Vec3 n = shape.normal(seg, e.crossing);
                 const double c = std::clamp(dot(n, th.normal), -1.0, 1.0);
                 const double nerr = std::acos(c) * 180.0 / M_PI;
                 ++part.both;

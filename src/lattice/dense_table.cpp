@@ -92,7 +92,7 @@ ByteBuffer DenseTable::build(const RawHits& raw, const TableContext& ctx, const 
     while (t_bits < 30 && 0.5 / double((1ull << t_bits) - 1) * lmax > opt.max_point_error) ++t_bits;
 
     // Part codes: the normal re-evaluated at the decoded point; t may need more bits for it.
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> code_of;
+    std::map<std::pair<std::uint16_t, std::uint16_t>, std::uint32_t> code_of;
     std::vector<std::uint32_t> codes;
     bool part_possible = ctx.primitive != nullptr && opt.normals != "oct";
     std::uint32_t part_t_bits = t_bits, part_bits = 0;
@@ -100,12 +100,13 @@ ByteBuffer DenseTable::build(const RawHits& raw, const TableContext& ctx, const 
         for (const auto& chunk : raw.chunks)
             for (const RawHit& h : chunk)
                 if (code_of.emplace(std::make_pair(h.part, h.leaf), std::uint32_t(code_of.size())).second) {
-                    codes.push_back(h.part);
-                    codes.push_back(h.leaf);
+                    const Crossing c = h.crossing(0);
+                    codes.push_back(c.part);
+                    codes.push_back(c.leaf);
                 }
         while ((1ull << part_bits) < code_of.size()) ++part_bits;
         auto normal_at = [&](const RawHit& h, double t) {
-            return normalize(ctx.primitive->normal(segment(h), {t, h.part, h.leaf}));
+            return normalize(ctx.primitive->normal(segment(h), h.crossing(t)));
         };
         for (;; ++part_t_bits) {
             if (part_t_bits > 30) {

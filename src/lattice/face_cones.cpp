@@ -51,30 +51,4 @@ void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& 
     v1 = static_cast<int>(std::floor(std::min(vmax + eps, double(v1))));
 }
 
-bool cone_row(const Vec3& p, const PartSphere& s, const FaceLayout& f, int v, double& ulo,
-              double& uhi) {
-    const auto ax = static_cast<std::size_t>(f.axis), ua = static_cast<std::size_t>(f.ua),
-               va = static_cast<std::size_t>(f.va);
-    const Vec3 w = s.c - p;
-    const double k = length_squared(w) - s.r * s.r;
-    const double da = f.level - p[ax], dv = v - p[va];
-    const double alpha = da * w[ax] + dv * w[va], beta = w[ua];
-    const double gamma = da * da + dv * dv;
-    // g(u') = (alpha + beta u')^2 - k (gamma + u'^2) >= 0 with alpha + beta u' >= 0, u' = u - p_u.
-    const double A = beta * beta - k, B = alpha * beta, C = alpha * alpha - k * gamma;
-    if (k <= 0 || A >= 0) {  // p inside the sphere, or the cone opens along u: the whole row
-        ulo = -kInfinity, uhi = kInfinity;
-        return true;
-    }
-    const double disc = B * B - A * C;
-    if (disc < 0) return false;
-    const double sq = std::sqrt(disc);
-    const double r0 = (-B + sq) / A, r1 = (-B - sq) / A;   // r0 <= r1 since A < 0
-    if (alpha + beta * 0.5 * (r0 + r1) < 0) return false;  // the cone's far nappe
-    const double pad = 1e-7 * (1 + std::abs(r0) + std::abs(r1));
-    ulo = p[ua] + r0 - pad;
-    uhi = p[ua] + r1 + pad;
-    return true;
-}
-
 }  // namespace lat

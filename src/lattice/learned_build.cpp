@@ -51,7 +51,7 @@ struct Fit {
         if (!ctx.primitive) return oct_decode({h.nu, h.nv}, kRawNormalBits);
         const Vec3 pa = vec_of(pts[h.a]), pb = vec_of(pts[h.b]);
         return ctx.primitive->normal({pa * ctx.cell, (pb - pa) * ctx.cell},
-                                     {double(h.t), h.part, h.leaf});
+                                     h.crossing(double(h.t)));
     }
     // As certify_table measures it.
     double length_sigma(std::uint32_t a, std::uint32_t b) const {

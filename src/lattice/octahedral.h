@@ -25,8 +25,9 @@ inline Vec2 oct_fold(Vec3 n) {
 inline Oct oct_encode(Vec3 n, int bits) {
     const auto [px, py] = oct_fold(n);
     const double scale = static_cast<double>((1u << bits) - 1);
-    return {static_cast<std::uint32_t>(std::lround((px * 0.5 + 0.5) * scale)),
-            static_cast<std::uint32_t>(std::lround((py * 0.5 + 0.5) * scale))};
+    // Non-negative values: adding one half and truncating rounds them (no libm call).
+    return {static_cast<std::uint32_t>((px * 0.5 + 0.5) * scale + 0.5),
+            static_cast<std::uint32_t>((py * 0.5 + 0.5) * scale + 0.5)};
 }
 
 inline Vec3 oct_decode(Oct o, int bits) {

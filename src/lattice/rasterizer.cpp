@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 
@@ -190,7 +191,9 @@ private:
             c = nearest_crossing(shape, r);
         }
         const Oct o = oct_encode(shape.normal(r, c), kRawNormalBits);
-        return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v), c.part, c.leaf};
+        assert(c.part <= RawHit::kMaxPart && c.leaf_index() <= RawHit::kMaxLeaf);
+        return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v),
+                static_cast<std::uint16_t>(c.part), RawHit::pack_leaf(c.leaf)};
     }
 
     static Crossing nearest_crossing(const Shape& shape, const Ray& r) {

@@ -12,6 +12,7 @@
 
 #include "util/big_buffer.h"
 
+#include "geometry/shape.h"
 #include "math/vec.h"
 
 namespace lat {
@@ -25,9 +26,20 @@ struct TableHit {
 struct RawHit {
     std::uint32_t a = 0, b = 0;  // boundary point ids of p_i and p_o
     float t = 0;
-    std::uint16_t nu = 0, nv = 0;     // octahedral normal, 16 bits each
-    std::uint32_t part = 0, leaf = 0;  // the primitive's Crossing (which surface was hit)
+    std::uint16_t nu = 0, nv = 0;  // octahedral normal, 16 bits each
+    // The primitive's Crossing (which surface was hit), packed: the part, and the CSG leaf in
+    // the low 15 bits with its flip bit on top (20 bytes a hit: tens of millions are kept).
+    std::uint16_t part = 0, leaf = 0;
+
+    static constexpr std::uint32_t kMaxPart = 0xFFFF, kMaxLeaf = 0x7FFF;
+    static std::uint16_t pack_leaf(std::uint32_t leaf) {
+        return static_cast<std::uint16_t>((leaf & kMaxLeaf) | ((leaf & Crossing::kFlipBit) ? 0x8000u : 0u));
+    }
+    Crossing crossing(double at) const {
+        return {at, part, (leaf & kMaxLeaf) | ((leaf & 0x8000u) ? Crossing::kFlipBit : 0u)};
+    }
 };
+static_assert(sizeof(RawHit) == 20);
 inline constexpr int kRawNormalBits = 16;
 
 // Rasterized hits in chunks (one per block of entry points, in a fixed order) that point into
@@ -48,8 +60,6 @@ struct RawHits {
         return out;
     }
 };
-
-class Shape;
 
 // What a table knows besides its payload: the lattice, and the primitive (encodings that
 // intersect it exactly, or re-evaluate its normals, need it).
