@@ -39,7 +39,9 @@ int run_inspect(const InspectArgs& a) {
                     static_cast<unsigned long long>(h.pairs), static_cast<unsigned long long>(h.entries),
                     human_bytes(double(t.table->bytes())).c_str(),
                     static_cast<unsigned long long>(t.table->bytes()), per_hit);
+        if (!t.table->details().empty()) std::printf("  %s\n", t.table->details().c_str());
     }
+    j["details"] = t.table->details();
     if (a.certify) {
         const TableContext ctx{h.cells, h.cell, h.sigma, prim.shape.get()};
         const CertifyReport r = certify_table(*t.table, ctx, !a.json && ProgressBar::stderr_is_terminal());

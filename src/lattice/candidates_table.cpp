@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <unordered_map>
@@ -239,6 +240,13 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
     for (std::uint32_t i = 0; i < sets_; ++i)
         if (nparts < 64 && (masks_[i] >> nparts) != 0)
             throw std::runtime_error("candidates: a part set names parts the primitive does not have");
+}
+
+std::string CandidatesTable::details() const {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "%llu pairs with candidates, %u distinct part sets (%u bits a pair)",
+                  static_cast<unsigned long long>(occupied_), sets_, set_bits_);
+    return buf;
 }
 
 bool CandidatesTable::candidates(std::uint32_t a, std::uint32_t b, CandidateList& out) const {

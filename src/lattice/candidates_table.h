@@ -31,6 +31,7 @@ public:
     bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const override;
     bool candidates(std::uint32_t a, std::uint32_t b, CandidateList& out) const override;
     std::string encoding() const override { return "candidates"; }
+    std::string details() const override;
     std::uint64_t entries() const override { return entries_; }
     std::uint64_t bytes() const override { return size_; }
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <stdexcept>
@@ -225,6 +226,21 @@ DenseTable::DenseTable(const std::uint8_t* payload, std::size_t size, std::uint6
     records_ = reinterpret_cast<const std::uint64_t*>(payload + sec.records);
     part_codes_ = reinterpret_cast<const std::uint32_t*>(payload + sec.codes);
     t_scale_ = 1.0 / double((1ull << l_.t_bits) - 1);
+}
+
+std::string DenseTable::details() const {
+    const std::uint64_t nwords = words_for_bits(l_.domain);
+    char buf[400];
+    std::snprintf(buf, sizeof buf,
+                  "%llu of %llu pairs stored; t %u bits, normals %s %u bits%s; occupancy %llu bytes, "
+                  "rank directory %llu bytes, records %llu bytes",
+                  static_cast<unsigned long long>(l_.occupied), static_cast<unsigned long long>(l_.domain),
+                  l_.t_bits, l_.normal_mode ? "as part codes" : "octahedral", l_.normal_bits,
+                  l_.normal_mode ? (" (" + std::to_string(l_.parts) + " codes)").c_str() : "",
+                  static_cast<unsigned long long>(nwords * 8),
+                  static_cast<unsigned long long>(RankIndex::count_entries(nwords) * 4),
+                  static_cast<unsigned long long>((l_.occupied * 2 * (l_.t_bits + l_.normal_bits) + 7) / 8));
+    return buf;
 }
 
 bool DenseTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {

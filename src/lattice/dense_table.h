@@ -24,6 +24,7 @@ public:
 
     bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const override;
     std::string encoding() const override { return "dense"; }
+    std::string details() const override;
     std::uint64_t entries() const override { return entries_; }
     std::uint64_t bytes() const override { return size_; }
 

@@ -94,6 +94,8 @@ public:
     virtual bool candidates(std::uint32_t, std::uint32_t, CandidateList&) const { return false; }
 
     virtual std::string encoding() const = 0;
+    // Encoding-specific facts for `lattice inspect` (widths, counts), one line; may be empty.
+    virtual std::string details() const { return {}; }
     // Stored hits, and every byte the table occupies (payload, indices, headers).
     virtual std::uint64_t entries() const = 0;
     virtual std::uint64_t bytes() const = 0;

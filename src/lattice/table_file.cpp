@@ -136,6 +136,7 @@ public:
         return table_->candidates(a, b, out);
     }
     std::string encoding() const override { return table_->encoding(); }
+    std::string details() const override { return table_->details(); }
     std::uint64_t entries() const override { return table_->entries(); }
     std::uint64_t bytes() const override { return table_->bytes() + kTableHeaderBytes + meta_; }
     void set_meta_bytes(std::uint64_t n) { meta_ = n; }
