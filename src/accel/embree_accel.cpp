@@ -118,84 +118,50 @@ struct EmbreeAccel::Impl {
         rh->hit.u = rh->hit.v = 0;
     }
 
-    static void direct_intersect(const RTCIntersectFunctionNArguments* args) {
-        if (!args->valid[0]) return;
-        auto* ctx = reinterpret_cast<QueryContext*>(args->context);
-        const Impl* self = ctx->accel;
-        const std::uint32_t obj = self->direct[args->primID];
-        const AccelObject& o = self->objects[obj];
-        const Ray local = o.xf->is_identity() ? ctx->ray : o.xf->inverse_ray(ctx->ray);
-        const double tmax = ctx->found ? ctx->hit->t : ctx->tmax;
-        Crossing c;
-        if (o.shape->intersect(local, ctx->tmin, tmax, c))
-            self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), obj, c, args->geomID,
-                         args->primID, RTC_INVALID_GEOMETRY_ID);
+    // The three kinds of user geometry: one primitive per object (direct), the parts of a
+    // prototype placed by Embree instances (proto), and parts of objects in world space (flat).
+    enum class Kind { kDirect, kProto, kFlat };
+    struct Target {
+        std::uint32_t object;
+        std::size_t part;
+    };
+    template <Kind K>
+    Target target(unsigned prim, unsigned inst) const {
+        if constexpr (K == Kind::kDirect) return {direct[prim], 0};
+        if constexpr (K == Kind::kProto) return {inst_object[inst], prim};
+        return {flat[prim].object, flat[prim].part};
     }
 
-    static void direct_occluded(const RTCOccludedFunctionNArguments* args) {
-        if (!args->valid[0]) return;
-        auto* ctx = reinterpret_cast<QueryContext*>(args->context);
-        const Impl* self = ctx->accel;
-        const std::uint32_t obj = self->direct[args->primID];
-        const AccelObject& o = self->objects[obj];
-        const Ray local = o.xf->is_identity() ? ctx->ray : o.xf->inverse_ray(ctx->ray);
-        if (o.shape->occluded(local, self->occlusion_tmin(ctx, obj, local), ctx->tmax)) {
-            ctx->found = true;
-            reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
-        }
-    }
-
-    static void proto_intersect(const RTCIntersectFunctionNArguments* args) {
+    template <Kind K>
+    static void intersect_cb(const RTCIntersectFunctionNArguments* args) {
         if (!args->valid[0]) return;
         auto* ctx = reinterpret_cast<QueryContext*>(args->context);
         const Impl* self = ctx->accel;
         const unsigned inst = args->context->instID[0];
-        const std::uint32_t obj = self->inst_object[inst];
-        const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
-        const Ray& local = self->local_ray(ctx, obj);
+        const Target t = self->template target<K>(args->primID, inst);
+        const Shape& shape = *self->objects[t.object].shape;
+        const Ray& local = self->local_ray(ctx, t.object);
         const double tmax = ctx->found ? ctx->hit->t : ctx->tmax;
         Crossing c;
-        if (shape->intersect_primitive(args->primID, local, ctx->tmin, tmax, c))
-            self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), obj, c, args->geomID,
-                         args->primID, inst);
+        const bool hit = K == Kind::kDirect ? shape.intersect(local, ctx->tmin, tmax, c)
+                                            : shape.intersect_primitive(t.part, local, ctx->tmin, tmax, c);
+        if (hit)
+            self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), t.object, c, args->geomID,
+                         args->primID, K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
     }
 
-    static void proto_occluded(const RTCOccludedFunctionNArguments* args) {
+    template <Kind K>
+    static void occluded_cb(const RTCOccludedFunctionNArguments* args) {
         if (!args->valid[0]) return;
         auto* ctx = reinterpret_cast<QueryContext*>(args->context);
         const Impl* self = ctx->accel;
-        const unsigned inst = args->context->instID[0];
-        const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
-        const std::uint32_t obj = self->inst_object[inst];
-        const Ray& local = self->local_ray(ctx, obj);
-        if (shape->occluded_primitive(args->primID, local, self->occlusion_tmin(ctx, obj, local),
-                                      ctx->tmax)) {
-            ctx->found = true;
-            reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
-        }
-    }
-
-    static void flat_intersect(const RTCIntersectFunctionNArguments* args) {
-        if (!args->valid[0]) return;
-        auto* ctx = reinterpret_cast<QueryContext*>(args->context);
-        const Impl* self = ctx->accel;
-        const FlatPrim fp = self->flat[args->primID];
-        const Ray& local = self->local_ray(ctx, fp.object);
-        const double tmax = ctx->found ? ctx->hit->t : ctx->tmax;
-        Crossing c;
-        if (self->objects[fp.object].shape->intersect_primitive(fp.part, local, ctx->tmin, tmax, c))
-            self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), fp.object, c,
-                         args->geomID, args->primID, RTC_INVALID_GEOMETRY_ID);
-    }
-
-    static void flat_occluded(const RTCOccludedFunctionNArguments* args) {
-        if (!args->valid[0]) return;
-        auto* ctx = reinterpret_cast<QueryContext*>(args->context);
-        const Impl* self = ctx->accel;
-        const FlatPrim fp = self->flat[args->primID];
-        const Ray& local = self->local_ray(ctx, fp.object);
-        if (self->objects[fp.object].shape->occluded_primitive(
-                fp.part, local, self->occlusion_tmin(ctx, fp.object, local), ctx->tmax)) {
+        const Target t = self->template target<K>(args->primID, args->context->instID[0]);
+        const Shape& shape = *self->objects[t.object].shape;
+        const Ray& local = self->local_ray(ctx, t.object);
+        const double tmin = self->occlusion_tmin(ctx, t.object, local);
+        const bool hit = K == Kind::kDirect ? shape.occluded(local, tmin, ctx->tmax)
+                                            : shape.occluded_primitive(t.part, local, tmin, ctx->tmax);
+        if (hit) {
             ctx->found = true;
             reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
         }
@@ -239,7 +205,7 @@ struct EmbreeAccel::Impl {
         RTCScene s = rtcNewScene(device);
         rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
         attach_user_geometry(s, shape->primitive_count(), const_cast<Shape*>(shape), bounds_proto,
-                             proto_intersect, proto_occluded);
+                             intersect_cb<Kind::kProto>, occluded_cb<Kind::kProto>);
         rtcCommitScene(s);
         prototypes[shape] = {shape, s};
         return s;
@@ -296,10 +262,11 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
     }
     if (!m.direct.empty())
         m.attach_user_geometry(m.scene, m.direct.size(), &m, Impl::bounds_direct,
-                               Impl::direct_intersect, Impl::direct_occluded);
+                               Impl::intersect_cb<Impl::Kind::kDirect>,
+                               Impl::occluded_cb<Impl::Kind::kDirect>);
     if (!m.flat.empty())
-        m.attach_user_geometry(m.scene, m.flat.size(), &m, Impl::bounds_flat, Impl::flat_intersect,
-                               Impl::flat_occluded);
+        m.attach_user_geometry(m.scene, m.flat.size(), &m, Impl::bounds_flat,
+                               Impl::intersect_cb<Impl::Kind::kFlat>, Impl::occluded_cb<Impl::Kind::kFlat>);
     rtcCommitScene(m.scene);
     if (!m.error.empty()) throw std::runtime_error("Embree: " + m.error);
 }
