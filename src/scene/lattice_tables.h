@@ -13,7 +13,7 @@
 namespace lat {
 
 // Bump when rasterization semantics change, so cached tables are rebuilt.
-inline constexpr int kRasterizerVersion = 2;
+inline constexpr int kRasterizerVersion = 3;
 
 // Which table of a primitive: refinement, encoding and its error targets.
 struct TableSpec {
