@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "io/image_compare.h"
+#include "lattice/encodings.h"
+#include "lattice/lattice_shape.h"
 #include "render/renderer.h"
 #include "scene/lattice_tables.h"
 #include "scene/scene_loader.h"
@@ -20,7 +22,9 @@ Scene small(const char* name, int size) {
     return s;
 }
 
-Image8 render_exact(const Scene& s) { return render_image(RenderScene(s), {}).display; }
+Image8 render_exact(const Scene& s) {
+    return render_image(RenderScene(s), {}).display;
+}
 
 Image8 render_lattice(const Scene& s, const TableCache& cache, int sigma_inv,
                       const std::string& encoding = "hash14") {
@@ -43,8 +47,8 @@ TEST_F(LatticeRender, PlatesAreCloseToExact) {
         const char* plate;
         double min_psnr;
     };
-    for (const Case c : {Case{"plate1-thistle-no-self-shading", 20}, Case{"plate3-hair-closeup", 28},
-                         Case{"plate4-fuzzy-sphere-1000", 20}}) {
+    for (const Case c : {Case{"plate1-thistle-no-self-shading", 20},
+                         Case{"plate3-hair-closeup", 28}, Case{"plate4-fuzzy-sphere-1000", 20}}) {
         const Scene s = small(c.plate, 128);
         const ImageDiffStats d = compare_images(render_exact(s), render_lattice(s, cache, 1));
         EXPECT_GT(d.psnr_db, c.min_psnr) << c.plate;
@@ -68,7 +72,8 @@ TEST_F(LatticeRender, LatticesAreCsgLeaves) {
       "camera": {"eye": [30, -45, 22], "look_at": [3.5, 3.5, 10], "fov_y_deg": 30, "width": 128, "height": 128},
       "lights": [{"position": [60, -60, 60], "intensity": 0.9}],
       "materials": {"fur": {"color": [0.55, 0.35, 0.15]}, "cut": {"color": [0.2, 0.5, 0.9]}},
-      "primitives": {"hair": )" + std::string("PRIM") + R"(},
+      "primitives": {"hair": )" +
+                             std::string("PRIM") + R"(},
       "objects": [{"type": "csg", "op": "difference", "material": "fur", "children": [
           {"type": "csg", "op": "intersection", "children": [
             {"type": "instance", "primitive": "hair"},
@@ -89,6 +94,52 @@ TEST_F(LatticeRender, LatticesAreCsgLeaves) {
     EXPECT_LT(d.psnr_db, 60) << "the instance leaf was not traced through its lattice";
 }
 
+// The lattice is culled by boxes around its primitive's parts, grown by the snapping distance
+// and the table's error, instead of by its lattice box: no answer may change. (Candidate
+// tables are always culled by their parts; they must equal exact mode.)
+TEST_F(LatticeRender, CullingByThePrimitiveChangesNoPixel) {
+    for (const char* plate :
+         {"plate2-thistle", "plate3-hair-closeup", "plate4-fuzzy-sphere-1000"}) {
+        const Scene s = small(plate, 128);
+        const bool thin = std::string(plate) == "plate2-thistle";  // spikes fill their boxes
+        for (const std::string encoding : {"hash14", "dense", "candidates"}) {
+            TableSpec spec;
+            spec.encoding = encoding;
+            std::vector<std::shared_ptr<const Shape>> culled(s.primitives.size()),
+                boxed(s.primitives.size());
+            for (std::size_t i = 0; i < s.primitives.size(); ++i) {
+                const Primitive& p = s.primitives[i];
+                const TableCache::Entry e = cache.get(p, spec, s.file, false);
+                const TableContext ctx{e.header.cells, e.header.cell, e.header.sigma,
+                                       p.shape.get()};
+                culled[i] = std::make_shared<LatticeShape>(
+                    e.table, e.header.cells, e.header.cell, p.shape.get(),
+                    hit_error_bound(encoding, ctx, spec.options));
+                boxed[i] = std::make_shared<LatticeShape>(e.table, e.header.cells, e.header.cell,
+                                                          p.shape.get());
+                std::vector<Bounds3> cb;
+                culled[i]->cull_boxes(cb);
+                double volume = 0;
+                for (const Bounds3& b : cb) volume += b.extent().x * b.extent().y * b.extent().z;
+                const Vec3 box = culled[i]->bounds().extent();
+                if (thin) {
+                    EXPECT_EQ(cb.size(), 1u) << plate << " " << encoding;
+                } else {
+                    EXPECT_GT(cb.size(), 1u) << plate << " " << encoding;
+                    EXPECT_LT(volume, 0.9 * box.x * box.y * box.z) << plate << " " << encoding;
+                }
+            }
+            auto render = [&](const std::vector<std::shared_ptr<const Shape>>& shapes) {
+                const RenderScene rs(s, [&](int p) { return shapes[static_cast<std::size_t>(p)]; });
+                return render_image(rs, {}).display;
+            };
+            const Image8 reference = encoding == "candidates" ? render_exact(s) : render(boxed);
+            EXPECT_EQ(compare_images(reference, render(culled)).max_abs_error, 0)
+                << plate << " " << encoding;
+        }
+    }
+}
+
 TEST_F(LatticeRender, RefiningTheLatticeApproachesExact) {
     const Scene s = small("plate3-hair-closeup", 128);
     const Image8 exact = render_exact(s);
@@ -107,7 +158,8 @@ TEST_F(LatticeRender, ThistlesShadowEachOtherOnlyInPlate2) {
     // none is brighter.
     int darker = 0, brighter = 0;
     for (std::size_t i = 0; i < a.rgb.size(); i += 3) {
-        const int da = a.rgb[i] + a.rgb[i + 1] + a.rgb[i + 2], db = b.rgb[i] + b.rgb[i + 1] + b.rgb[i + 2];
+        const int da = a.rgb[i] + a.rgb[i + 1] + a.rgb[i + 2],
+                  db = b.rgb[i] + b.rgb[i + 1] + b.rgb[i + 2];
         darker += db < da - 24;
         brighter += db > da;
     }
@@ -124,7 +176,9 @@ TEST_F(LatticeRender, NoSelfShadowAcne) {
     off.shadows = false;
     const Image8 eo = render_exact(on), ef = render_exact(off);
     const Image8 lo = render_lattice(on, cache, 1), lf = render_lattice(off, cache, 1);
-    auto sum = [](const Image8& img, std::size_t i) { return img.rgb[i] + img.rgb[i + 1] + img.rgb[i + 2]; };
+    auto sum = [](const Image8& img, std::size_t i) {
+        return img.rgb[i] + img.rgb[i + 1] + img.rgb[i + 2];
+    };
     int exact_shadowed = 0, lattice_only = 0;
     for (std::size_t i = 0; i < eo.rgb.size(); i += 3) {
         exact_shadowed += sum(ef, i) > sum(eo, i) + 24;

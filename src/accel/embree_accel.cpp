@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <map>
@@ -24,6 +25,18 @@ struct QueryContext {
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;
+    // Objects culled by several boxes that this query has already tested: a second box of the
+    // same object can add nothing (its answer for a shorter range is no closer). A small ring;
+    // an object that falls out of it is merely tested again.
+    std::uint32_t tested[8];
+    unsigned n_tested = 0;
+    bool first_test(std::uint32_t obj) {
+        const unsigned n = std::min(n_tested, 8u);
+        for (unsigned i = 0; i < n; ++i)
+            if (tested[i] == obj) return false;
+        tested[n_tested++ % 8] = obj;
+        return true;
+    }
 };
 
 // A float bound that surely contains the double one, so that Embree's float traversal never
@@ -68,7 +81,13 @@ struct EmbreeAccel::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<AccelObject> objects;
-    std::vector<std::uint32_t> direct;       // primID -> object, for the top-level user geometry
+    // The top-level user geometry of single-part objects: one primitive per cull box.
+    struct DirectPrim {
+        std::uint32_t object;
+        bool shared;     // one of several boxes of its object
+        Bounds3 bounds;  // world space
+    };
+    std::vector<DirectPrim> direct;
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
     std::vector<std::uint32_t> inst_object;  // top-level geomID -> object, for instances
     struct FlatPrim {
@@ -127,7 +146,7 @@ struct EmbreeAccel::Impl {
     };
     template <Kind K>
     Target target(unsigned prim, unsigned inst) const {
-        if constexpr (K == Kind::kDirect) return {direct[prim], 0};
+        if constexpr (K == Kind::kDirect) return {direct[prim].object, 0};
         if constexpr (K == Kind::kProto) return {inst_object[inst], prim};
         return {flat[prim].object, flat[prim].part};
     }
@@ -139,12 +158,15 @@ struct EmbreeAccel::Impl {
         const Impl* self = ctx->accel;
         const unsigned inst = args->context->instID[0];
         const Target t = self->template target<K>(args->primID, inst);
+        if constexpr (K == Kind::kDirect)
+            if (self->direct[args->primID].shared && !ctx->first_test(t.object)) return;
         const Shape& shape = *self->objects[t.object].shape;
         const Ray& local = self->local_ray(ctx, t.object);
         const double tmax = ctx->found ? ctx->hit->t : ctx->tmax;
         Crossing c;
-        const bool hit = K == Kind::kDirect ? shape.intersect(local, ctx->tmin, tmax, c)
-                                            : shape.intersect_primitive(t.part, local, ctx->tmin, tmax, c);
+        const bool hit = K == Kind::kDirect
+                             ? shape.intersect(local, ctx->tmin, tmax, c)
+                             : shape.intersect_primitive(t.part, local, ctx->tmin, tmax, c);
         if (hit)
             self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), t.object, c, args->geomID,
                          args->primID, K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
@@ -156,11 +178,14 @@ struct EmbreeAccel::Impl {
         auto* ctx = reinterpret_cast<QueryContext*>(args->context);
         const Impl* self = ctx->accel;
         const Target t = self->template target<K>(args->primID, args->context->instID[0]);
+        if constexpr (K == Kind::kDirect)
+            if (self->direct[args->primID].shared && !ctx->first_test(t.object)) return;
         const Shape& shape = *self->objects[t.object].shape;
         const Ray& local = self->local_ray(ctx, t.object);
         const double tmin = self->occlusion_tmin(ctx, t.object, local);
-        const bool hit = K == Kind::kDirect ? shape.occluded(local, tmin, ctx->tmax)
-                                            : shape.occluded_primitive(t.part, local, tmin, ctx->tmax);
+        const bool hit = K == Kind::kDirect
+                             ? shape.occluded(local, tmin, ctx->tmax)
+                             : shape.occluded_primitive(t.part, local, tmin, ctx->tmax);
         if (hit) {
             ctx->found = true;
             reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
@@ -176,8 +201,7 @@ struct EmbreeAccel::Impl {
 
     static void bounds_direct(const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
-        const AccelObject& o = self->objects[self->direct[args->primID]];
-        *args->bounds_o = to_rtc_bounds(o.xf->bounds(o.shape->bounds()));
+        *args->bounds_o = to_rtc_bounds(self->direct[args->primID].bounds);
     }
 
     static void bounds_proto(const RTCBoundsFunctionArguments* args) {
@@ -187,7 +211,8 @@ struct EmbreeAccel::Impl {
 
     // One user geometry of n primitives with these callbacks, attached to scene s.
     void attach_user_geometry(RTCScene s, std::size_t n, void* user, RTCBoundsFunction bounds,
-                              RTCIntersectFunctionN intersect, RTCOccludedFunctionN occluded) const {
+                              RTCIntersectFunctionN intersect,
+                              RTCOccludedFunctionN occluded) const {
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
         rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(n));
         rtcSetGeometryUserData(g, user);
@@ -247,7 +272,8 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             float xfm[12];
             for (int r = 0; r < 3; ++r) {
                 for (int c = 0; c < 3; ++c)
-                    xfm[r * 4 + c] = static_cast<float>(a.m.r[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)]);
+                    xfm[r * 4 + c] = static_cast<float>(
+                        a.m.r[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)]);
                 xfm[r * 4 + 3] = static_cast<float>(a.t[static_cast<std::size_t>(r)]);
             }
             rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xfm);
@@ -257,7 +283,11 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             if (m.inst_object.size() <= id) m.inst_object.resize(id + 1, 0);
             m.inst_object[id] = i;
         } else {
-            m.direct.push_back(i);
+            std::vector<Bounds3> boxes;
+            o.shape->cull_boxes(boxes);
+            std::erase_if(boxes, [](const Bounds3& b) { return b.empty(); });
+            for (const Bounds3& b : boxes)
+                m.direct.push_back({i, boxes.size() > 1, boxes.size() > 1 ? o.xf->bounds(b) : wb});
         }
     }
     if (!m.direct.empty())
@@ -266,14 +296,17 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
                                Impl::occluded_cb<Impl::Kind::kDirect>);
     if (!m.flat.empty())
         m.attach_user_geometry(m.scene, m.flat.size(), &m, Impl::bounds_flat,
-                               Impl::intersect_cb<Impl::Kind::kFlat>, Impl::occluded_cb<Impl::Kind::kFlat>);
+                               Impl::intersect_cb<Impl::Kind::kFlat>,
+                               Impl::occluded_cb<Impl::Kind::kFlat>);
     rtcCommitScene(m.scene);
     if (!m.error.empty()) throw std::runtime_error("Embree: " + m.error);
 }
 
 EmbreeAccel::~EmbreeAccel() = default;
 
-bool EmbreeAccel::flattened() const { return impl_->flatten; }
+bool EmbreeAccel::flattened() const {
+    return impl_->flatten;
+}
 
 bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hit) const {
     const Impl& m = *impl_;

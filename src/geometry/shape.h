@@ -96,6 +96,12 @@ public:
         out.push_back({b.center(), 0.5 * length(b.extent())});
     }
 
+    // Boxes (shape coordinates) that the accelerator culls with: a ray gets a crossing from
+    // this shape only at a point inside one of them (and a shadow ray is occluded only if it
+    // passes through one). By default the bounds; a lattice gives a few boxes hugging its
+    // primitive, much tighter than its lattice box.
+    virtual void cull_boxes(std::vector<Bounds3>& out) const { out.push_back(bounds()); }
+
     // CSG trees carry a material tag per leaf; other shapes answer with the fallback.
     virtual std::uint32_t tag(const Crossing&, std::uint32_t fallback) const { return fallback; }
 };

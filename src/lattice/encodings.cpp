@@ -1,5 +1,6 @@
 #include "lattice/encodings.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "lattice/candidates_table.h"
@@ -25,8 +26,9 @@ const std::vector<EncodingInfo>& table_encodings() {
     static const std::vector<EncodingInfo> list = {
         {"hash14", "the paper's hash table, 14-byte entries with key and overflow chain",
          Hash14Table::kMaxPoints, 15.0, true},
-        {"dense", "no hashing: occupancy bits with a rank directory, both directions per record, "
-                  "bit widths chosen per table for the error targets",
+        {"dense",
+         "no hashing: occupancy bits with a rank directory, both directions per record, "
+         "bit widths chosen per table for the error targets",
          0xFFFFFFFFull, 4.0, true},
         {"candidates", "exact: per pair the parts a ray can meet, intersected exactly at render",
          0xFFFFFFFFull, 2.0, false},
@@ -67,12 +69,24 @@ ByteBuffer encode_table(const std::string& encoding, const RasterizeResult& r,
     throw std::invalid_argument("encode_table: unknown encoding " + encoding);
 }
 
+double hit_error_bound(const std::string& encoding, const TableContext& ctx,
+                       const EncodeOptions& opt) {
+    if (encoding == "candidates") return 0.0;  // exact hits on the real ray
+    if (encoding == "hash14") {                // t rounded to 1/65535 of a segment
+        const double diagonal = std::hypot(ctx.cells[0], ctx.cells[1], ctx.cells[2]) * ctx.cell;
+        return diagonal / 65535.0;
+    }
+    if (encoding == "dense" || encoding == "learned") return opt.max_point_error * ctx.sigma;
+    return kInfinity;  // perfect hashes answer missing keys with some stored hit
+}
+
 std::unique_ptr<LatticeTable> open_table(const std::string& encoding, const std::uint8_t* payload,
                                          std::size_t size, std::uint64_t entries,
                                          const TableContext& ctx) {
     if (encoding == "hash14") return std::make_unique<Hash14Table>(payload, size, entries);
     if (encoding == "dense") return std::make_unique<DenseTable>(payload, size, entries, ctx);
-    if (encoding == "candidates") return std::make_unique<CandidatesTable>(payload, size, entries, ctx);
+    if (encoding == "candidates")
+        return std::make_unique<CandidatesTable>(payload, size, entries, ctx);
     if (const int fp = perfect_fingerprint_bits(encoding); fp >= 0)
         return std::make_unique<PerfectTable>(payload, size, entries, fp);
     if (encoding == "learned") return std::make_unique<LearnedTable>(payload, size, entries, ctx);

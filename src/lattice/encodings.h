@@ -35,6 +35,11 @@ const EncodingInfo& encoding_info(const std::string& name);
 // Builds the payload. `r` holds the rasterized hits for encodings that need them.
 ByteBuffer encode_table(const std::string& encoding, const RasterizeResult& r,
                         const TableContext& ctx, const EncodeOptions& opt = {});
+// How far (primitive units) a hit stored by the encoding can lie from the primitive's surface
+// at most; infinity when it can answer pairs whose segment misses (perfect hashing). The
+// renderer culls rays far from the primitive by it without changing any answer.
+double hit_error_bound(const std::string& encoding, const TableContext& ctx,
+                       const EncodeOptions& opt);
 // The table over a payload (which must outlive it); throws std::runtime_error if inconsistent.
 std::unique_ptr<LatticeTable> open_table(const std::string& encoding, const std::uint8_t* payload,
                                          std::size_t size, std::uint64_t entries,

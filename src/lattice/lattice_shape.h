@@ -18,9 +18,11 @@ namespace lat {
 class LatticeShape final : public Shape {
 public:
     // cells: the lattice at its refinement; cell: the cell size in primitive units; the
-    // primitive is needed by candidate tables (and kept alive by the caller).
+    // primitive is needed by candidate tables and for culling (kept alive by the caller);
+    // hit_error: how far a stored hit can lie from the primitive (hit_error_bound), infinity
+    // when unknown, which culls with the lattice box alone.
     LatticeShape(std::shared_ptr<const LatticeTable> table, std::array<int, 3> cells, double cell,
-                 const Shape* primitive = nullptr);
+                 const Shape* primitive = nullptr, double hit_error = kInfinity);
 
     const LatticeTable& table() const { return *table_; }
 
@@ -31,6 +33,7 @@ public:
     Vec3 normal(const Ray& r, const Crossing& c) const override;
     Vec3 position(const Ray& r, const Crossing& c) const override;
     bool inside(Vec3 p) const override;
+    void cull_boxes(std::vector<Bounds3>& out) const override;
     // Rays leaving a point found through this lattice skip crossings within this distance of
     // it: the table's own error, which would otherwise shade the surface by itself (acne).
     // Exact (candidate) lattices need none.
@@ -43,7 +46,9 @@ public:
         Vec3 p_first, p_last;  // primitive units
         Vec3 n_first, n_last;
     };
-    LineHits line_hits(const Ray& r) const;
+    // The last crossing is only looked up when the first is at or before need_last_below
+    // (else t_last = t_first and p_last, n_last are unset).
+    LineHits line_hits(const Ray& r, double need_last_below = kInfinity) const;
 
 private:
     std::shared_ptr<const LatticeTable> table_;
@@ -52,11 +57,15 @@ private:
     Bounds3 box_;  // primitive units
 
     const Shape* primitive_;
-    bool exact_;  // a candidate table
+    bool exact_;                 // a candidate table
+    std::vector<Bounds3> cull_;  // see make_cull_boxes
 
     // Snapped entry and exit point ids of the ray's line; false if it misses the box (or, for
     // hit tables, when both snap to the same point).
     bool snap(const Ray& r, std::uint32_t& a, std::uint32_t& b, GridPoint& pa, GridPoint& pb) const;
+    // A few boxes around the primitive grown by the snapping distance and the table's error:
+    // no ray outside them can get a hit (see lattice_shape.cpp).
+    void make_cull_boxes(double hit_error);
     // Candidate tables: the parts the ray can meet; false when none.
     bool candidates(const Ray& r, CandidateList& list) const;
 };

@@ -30,11 +30,14 @@ std::string where(const Primitive& p, const std::string& file) {
     return located_message(file, p.where, "");
 }
 
-LatticeGrid grid_of(const TableHeader& h) { return {h.cells, h.cell}; }
+LatticeGrid grid_of(const TableHeader& h) {
+    return {h.cells, h.cell};
+}
 
 }  // namespace
 
-TableHeader lattice_header(const Primitive& p, const TableSpec& spec, const std::string& scene_file) {
+TableHeader lattice_header(const Primitive& p, const TableSpec& spec,
+                           const std::string& scene_file) {
     const int sigma_inv = spec.sigma_inv;
     if (!p.lattice)
         throw InputError(where(p, scene_file) + "primitive '" + p.name +
@@ -64,9 +67,11 @@ TableHeader lattice_header(const Primitive& p, const TableSpec& spec, const std:
                         .add(spec.options.normals)
                         .add(kRasterizerVersion)
                         .value();
-    h.metadata = nlohmann::json{{"primitive", p.name}, {"definition", nlohmann::json::parse(p.definition)},
-                                {"scene", scene_file}}
-                     .dump();
+    h.metadata = nlohmann::json{
+        {"primitive", p.name},
+        {"definition", nlohmann::json::parse(p.definition)},
+        {"scene",
+         scene_file}}.dump();
     return h;
 }
 
@@ -74,14 +79,16 @@ TableContext table_context(const Primitive& p, const TableHeader& h) {
     return {h.cells, h.cell, h.sigma, p.shape.get()};
 }
 
-void check_table_buildable(const Primitive& p, const TableSpec& spec, const std::string& scene_file) {
+void check_table_buildable(const Primitive& p, const TableSpec& spec,
+                           const std::string& scene_file) {
     const TableHeader h = lattice_header(p, spec, scene_file);
     const int sigma_inv = spec.sigma_inv;
     const std::string& encoding = spec.encoding;
     const std::string at = where(p, scene_file);
     // The primitive must lie in its box: the table cannot see what sticks out.
     const Bounds3 b = p.shape->bounds();
-    const double X = p.lattice->cells[0] * p.lattice->sigma, Y = p.lattice->cells[1] * p.lattice->sigma,
+    const double X = p.lattice->cells[0] * p.lattice->sigma,
+                 Y = p.lattice->cells[1] * p.lattice->sigma,
                  Z = p.lattice->cells[2] * p.lattice->sigma;
     const double tol = 1e-9 * std::max({X, Y, Z});
     if (!b.finite() || b.lo.x < -tol || b.lo.y < -tol || b.lo.z < -tol || b.hi.x > X + tol ||
@@ -100,8 +107,8 @@ void check_table_buildable(const Primitive& p, const TableSpec& spec, const std:
     const long double points = 2 * (xy + yz + zx);  // an upper bound (edges counted twice)
     const EncodingInfo& enc = encoding_info(encoding);
     const std::string size = std::to_string(h.cells[0]) + " x " + std::to_string(h.cells[1]) +
-                             " x " + std::to_string(h.cells[2]) + " cells (sigma^-1 = " +
-                             std::to_string(sigma_inv) + ")";
+                             " x " + std::to_string(h.cells[2]) +
+                             " cells (sigma^-1 = " + std::to_string(sigma_inv) + ")";
     const double avail = static_cast<double>(available_memory_bytes());
     auto refuse = [&](double hit_rate, double bytes, bool lower_bound) {
         char buf[512];
@@ -109,10 +116,11 @@ void check_table_buildable(const Primitive& p, const TableSpec& spec, const std:
                       "the %s table of primitive '%s' at %s would need %s %s (%.3Lg point pairs, "
                       "%s %.0f %% of them %s, at %.1f bytes per hit while building), more than the "
                       "%s of memory available",
-                      encoding.c_str(), p.name.c_str(), size.c_str(), lower_bound ? "at least" : "about",
-                      human_bytes(bytes).c_str(), pairs,
+                      encoding.c_str(), p.name.c_str(), size.c_str(),
+                      lower_bound ? "at least" : "about", human_bytes(bytes).c_str(), pairs,
                       lower_bound ? "even if only" : "an estimated", hit_rate * 100,
-                      lower_bound ? "were hits" : "hits", enc.bytes_per_hit + sizeof(RawHit), human_bytes(avail).c_str());
+                      lower_bound ? "were hits" : "hits", enc.bytes_per_hit + sizeof(RawHit),
+                      human_bytes(avail).c_str());
         throw InputError(at + buf);
     };
     const double per_hit = enc.bytes_per_hit + sizeof(RawHit);
@@ -131,7 +139,8 @@ void check_table_buildable(const Primitive& p, const TableSpec& spec, const std:
     opt.keep_hits = false;
     opt.entry_stride = std::max<std::uint32_t>(1, grid.count() / 512);
     const RasterizeResult sample = rasterize(*p.shape, grid_of(h), opt);
-    const double rate = sample.pairs_traced ? double(sample.hits) / double(sample.pairs_traced) : 0.0;
+    const double rate =
+        sample.pairs_traced ? double(sample.hits) / double(sample.pairs_traced) : 0.0;
     const double need = static_cast<double>(pairs) * rate * per_hit;
     if (avail > 0 && need > 0.8 * avail) refuse(rate, need, false);
 }
@@ -172,15 +181,16 @@ Primitive primitive_from_metadata(const TableHeader& h, const std::string& path)
     const std::vector<Primitive> no_primitives;
     const ObjectParser parser(no_materials, no_primitives);
     Primitive p = parse_primitive(def, meta["primitive"].get<std::string>(), &parser);
-    p.lattice = LatticeSpec{h.sigma, {h.cells[0] / h.sigma_inv, h.cells[1] / h.sigma_inv,
-                                      h.cells[2] / h.sigma_inv}};
+    p.lattice = LatticeSpec{
+        h.sigma, {h.cells[0] / h.sigma_inv, h.cells[1] / h.sigma_inv, h.cells[2] / h.sigma_inv}};
     return p;
 }
 
 std::string default_cache_dir() {
     if (const char* d = std::getenv("LATTICE_CACHE_DIR"); d && *d) return d;
     if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/lattice";
-    if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/lattice";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return std::string(home) + "/.cache/lattice";
     return ".lattice-cache";
 }
 
@@ -188,10 +198,12 @@ TableCache::TableCache(const std::string& dir, bool explicit_dir) : dir_(dir) {
     struct stat st {};
     if (::stat(dir_.c_str(), &st) != 0) {
         if (explicit_dir)
-            throw InputError(dir_ + ": lattice cache directory does not exist: " + std::strerror(errno));
+            throw InputError(dir_ +
+                             ": lattice cache directory does not exist: " + std::strerror(errno));
         std::error_code ec;
         std::filesystem::create_directories(dir_, ec);
-        if (ec) throw InputError(dir_ + ": cannot create the lattice cache directory: " + ec.message());
+        if (ec)
+            throw InputError(dir_ + ": cannot create the lattice cache directory: " + ec.message());
     } else if (!S_ISDIR(st.st_mode)) {
         throw InputError(dir_ + ": lattice cache is not a directory");
     }
@@ -204,7 +216,8 @@ std::string TableCache::path_for(const Primitive& p, const TableSpec& spec,
                                  const std::string& scene_file) const {
     const TableHeader h = lattice_header(p, spec, scene_file);
     std::string safe;
-    for (char c : p.name) safe += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
+    for (char c : p.name)
+        safe += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
     char tail[64];
     std::snprintf(tail, sizeof tail, "-s%d-%s-%016llx.lht", spec.sigma_inv, spec.encoding.c_str(),
                   static_cast<unsigned long long>(h.fingerprint));
@@ -220,7 +233,8 @@ TableCache::Entry TableCache::get(const Primitive& p, const TableSpec& spec,
     if (::stat(e.path.c_str(), &st) != 0) {
         const auto t0 = std::chrono::steady_clock::now();
         build_table_file(p, spec, e.path, scene_file, progress);
-        e.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        e.build_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         e.built = true;
     }
     try {
@@ -248,7 +262,10 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const 
         if (!used[i]) continue;
         const Primitive& p = scene.primitives[i];
         const TableCache::Entry e = cache.get(p, spec, scene.file, progress);
-        out.shapes[i] = std::make_shared<LatticeShape>(e.table, e.header.cells, e.header.cell, p.shape.get());
+        const TableContext ctx{e.header.cells, e.header.cell, e.header.sigma, p.shape.get()};
+        out.shapes[i] =
+            std::make_shared<LatticeShape>(e.table, e.header.cells, e.header.cell, p.shape.get(),
+                                           hit_error_bound(e.header.encoding, ctx, spec.options));
         out.table_bytes += e.table->bytes();
         out.table_entries += e.table->entries();
         out.built += e.built ? 1 : 0;
