@@ -11,19 +11,6 @@ BoundaryGrid::BoundaryGrid(std::array<int, 3> cells) : n_(cells) {
     count_ = 2 * full_ + static_cast<std::uint32_t>(n_[2] - 1) * ring_;
 }
 
-// Layout: the z = 0 layer in full, then the rings of the inner layers, then z = nz in full.
-std::uint32_t BoundaryGrid::id(const GridPoint& p) const {
-    const auto nx = static_cast<std::uint32_t>(n_[0]), ny = static_cast<std::uint32_t>(n_[1]);
-    const auto x = static_cast<std::uint32_t>(p.x), y = static_cast<std::uint32_t>(p.y);
-    if (p.z == 0) return y * (nx + 1) + x;
-    if (p.z == n_[2]) return full_ + static_cast<std::uint32_t>(n_[2] - 1) * ring_ + y * (nx + 1) + x;
-    const std::uint32_t base = full_ + static_cast<std::uint32_t>(p.z - 1) * ring_;
-    if (y == 0) return base + x;
-    if (y == ny) return base + (nx + 1) + x;
-    assert(x == 0 || x == nx);
-    return base + 2 * (nx + 1) + 2 * (y - 1) + (x == 0 ? 0 : 1);
-}
-
 GridPoint BoundaryGrid::point(std::uint32_t id) const {
     const auto nx = static_cast<std::uint32_t>(n_[0]), ny = static_cast<std::uint32_t>(n_[1]);
     if (id < full_) return {static_cast<int>(id % (nx + 1)), static_cast<int>(id / (nx + 1)), 0};

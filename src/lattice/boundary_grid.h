@@ -4,6 +4,7 @@
 // two or three faces and still has one id. Faces are numbered 0..5: x = 0, x = nx, y = 0,
 // y = ny, z = 0, z = nz.
 #include <array>
+#include <cassert>
 #include <cstdint>
 
 namespace lat {
@@ -54,5 +55,18 @@ private:
     std::uint32_t ring_ = 0;  // points in an inner z layer, 2(nx+1) + 2(ny-1)
     std::uint32_t count_ = 0;
 };
+
+// Layout: the z = 0 layer in full, then the rings of the inner layers, then z = nz in full.
+inline std::uint32_t BoundaryGrid::id(const GridPoint& p) const {
+    const auto nx = static_cast<std::uint32_t>(n_[0]), ny = static_cast<std::uint32_t>(n_[1]);
+    const auto x = static_cast<std::uint32_t>(p.x), y = static_cast<std::uint32_t>(p.y);
+    if (p.z == 0) return y * (nx + 1) + x;
+    if (p.z == n_[2]) return full_ + static_cast<std::uint32_t>(n_[2] - 1) * ring_ + y * (nx + 1) + x;
+    const std::uint32_t base = full_ + static_cast<std::uint32_t>(p.z - 1) * ring_;
+    if (y == 0) return base + x;
+    if (y == ny) return base + (nx + 1) + x;
+    assert(x == 0 || x == nx);
+    return base + 2 * (nx + 1) + 2 * (y - 1) + (x == 0 ? 0 : 1);
+}
 
 }  // namespace lat
