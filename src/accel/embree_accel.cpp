@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstddef>
+#include <type_traits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -15,6 +17,11 @@ namespace {
 // Per-query state. Embree hands our callbacks the RTCIntersectContext; ours extends it with
 // the double-precision ray and the best hit so far (the documented way to pass query data).
 struct QueryContext {
+    QueryContext(const EmbreeAccel::Impl& m, const Ray& r, double t0, double t1, AccelHit& h)
+        : accel(&m), ray(r), tmin(t0), tmax(t1), hit(&h) {
+        rtcInitIntersectContext(&rtc);
+    }
+
     RTCIntersectContext rtc;
     const EmbreeAccel::Impl* accel;
     Ray ray;  // world space, double
@@ -38,6 +45,8 @@ struct QueryContext {
         return true;
     }
 };
+// Callbacks cast Embree's context pointer back to ours.
+static_assert(std::is_standard_layout_v<QueryContext> && offsetof(QueryContext, rtc) == 0);
 
 // A float bound that surely contains the double one, so that Embree's float traversal never
 // prunes a primitive the double test would hit.
@@ -310,13 +319,7 @@ bool EmbreeAccel::flattened() const {
 
 bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hit) const {
     const Impl& m = *impl_;
-    QueryContext ctx;
-    rtcInitIntersectContext(&ctx.rtc);
-    ctx.accel = &m;
-    ctx.ray = r;
-    ctx.tmin = tmin;
-    ctx.tmax = tmax;
-    ctx.hit = &hit;
+    QueryContext ctx(m, r, tmin, tmax, hit);
 
     alignas(16) RTCRayHit rh;
     set_rtc_ray(rh.ray, r, tmin, tmax);
@@ -339,13 +342,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t self) const {
     const Impl& m = *impl_;
     AccelHit unused;
-    QueryContext ctx;
-    rtcInitIntersectContext(&ctx.rtc);
-    ctx.accel = &m;
-    ctx.ray = r;
-    ctx.tmin = tmin;
-    ctx.tmax = tmax;
-    ctx.hit = &unused;
+    QueryContext ctx(m, r, tmin, tmax, unused);
     ctx.self = self;
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
