@@ -6,10 +6,10 @@
 #include <cassert>
 #include <cmath>
 #include <cstddef>
-#include <type_traits>
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace lat {
 namespace {

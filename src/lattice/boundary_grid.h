@@ -61,7 +61,8 @@ inline std::uint32_t BoundaryGrid::id(const GridPoint& p) const {
     const auto nx = static_cast<std::uint32_t>(n_[0]), ny = static_cast<std::uint32_t>(n_[1]);
     const auto x = static_cast<std::uint32_t>(p.x), y = static_cast<std::uint32_t>(p.y);
     if (p.z == 0) return y * (nx + 1) + x;
-    if (p.z == n_[2]) return full_ + static_cast<std::uint32_t>(n_[2] - 1) * ring_ + y * (nx + 1) + x;
+    if (p.z == n_[2])
+        return full_ + static_cast<std::uint32_t>(n_[2] - 1) * ring_ + y * (nx + 1) + x;
     const std::uint32_t base = full_ + static_cast<std::uint32_t>(p.z - 1) * ring_;
     if (y == 0) return base + x;
     if (y == ny) return base + (nx + 1) + x;
