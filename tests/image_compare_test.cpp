@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "input_error.h"
 #include "io/image.h"
 #include "io/image_compare.h"
 #include "temp_dir.h"
@@ -17,15 +18,7 @@ Image8 filled(int w, int h, std::uint8_t v) {
     return Image8{w, h, std::vector<std::uint8_t>(3 * static_cast<std::size_t>(w) * h, v)};
 }
 
-template <class F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::error_of;
 
 TEST(ImageCompare, IdenticalImagesHaveInfinitePsnr) {
     Image8 a = filled(3, 2, 40);

@@ -16,6 +16,7 @@
 #include <random>
 #include <sstream>
 
+#include "input_error.h"
 #include "io/image.h"
 #include "temp_dir.h"
 #include "util/error.h"
@@ -57,16 +58,7 @@ ImageF noiseF(int w, int h) {
     return img;
 }
 
-// The message of the InputError that f throws, or "" if it throws none.
-template <class F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::error_of;
 
 TEST(ImageIo, ToByteRoundsAndClamps) {
     EXPECT_EQ(to_byte(0.0), 0);
@@ -231,7 +223,7 @@ TEST(ImageIo, CheckWritableLeavesNothingBehind) {
 // Makes writes beyond `bytes` fail with EFBIG ("File too large") for this process, so that a
 // writer fails half-way through its temporary file.
 class FileSizeLimit {
-  public:
+public:
     explicit FileSizeLimit(rlim_t bytes) {
         ::getrlimit(RLIMIT_FSIZE, &saved_);
         old_handler_ = std::signal(SIGXFSZ, SIG_IGN);  // else the process is killed
@@ -244,7 +236,7 @@ class FileSizeLimit {
         std::signal(SIGXFSZ, old_handler_);
     }
 
-  private:
+private:
     rlimit saved_{};
     void (*old_handler_)(int) = nullptr;
 };
