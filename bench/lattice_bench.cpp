@@ -10,9 +10,10 @@
 #include <string>
 
 #include "lattice/boundary_grid.h"
-#include "lattice/encodings.h"
+#include "lattice/encoding.h"
 #include "render/renderer.h"
-#include "scene/lattice_tables.h"
+#include "lattice/cache/table_build.h"
+#include "render/scene_lattices.h"
 #include "scene/scene_loader.h"
 
 namespace {
@@ -38,7 +39,8 @@ void BM_Rasterize(benchmark::State& state) {
     lat::TableBuild b;
     lat::TableSpec spec;
     spec.sigma_inv = k;
-    for (auto _ : state) b = lat::build_table_file(hair, spec, path, scene.file, false);
+    const lat::TablePlan plan = lat::plan_table(hair, spec, scene.file);
+    for (auto _ : state) b = lat::build_table_file(plan, path, false);
     const double pairs = static_cast<double>(b.raster.pairs_eq2);
     state.counters["pairs"] = pairs;
     state.counters["stored_hits"] = static_cast<double>(b.raster.hits);
@@ -69,10 +71,11 @@ BuiltTable& built_table(const std::string& encoding, int k) {
     BuiltTable& b = cache[key];
     const lat::TableContext ctx{{7 * k, 7 * k, 20 * k}, 1.0 / k, 1.0, hair.shape.get()};
     lat::RasterizeOptions ro;
-    ro.keep_hits = lat::encoding_info(encoding).needs_hits;
-    const lat::RasterizeResult r = lat::rasterize(*hair.shape, {ctx.cells, ctx.cell}, ro);
-    b.payload = lat::encode_table(encoding, r, ctx);
-    b.table = lat::open_table(encoding, b.payload.data(), b.payload.size(), r.hits, ctx);
+    const lat::Encoding& e = lat::find_encoding(encoding);
+    ro.keep_hits = e.needs_hits;
+    const lat::RasterizeResult r = lat::rasterize(ctx, ro);
+    b.payload = e.build(r.raw, ctx, {});
+    b.table = e.open(b.payload.data(), b.payload.size(), r.hits, ctx);
     const lat::BoundaryGrid grid(ctx.cells);
     std::mt19937 rng(1);
     std::uniform_int_distribution<std::uint32_t> pick(0, grid.count() - 1);
@@ -115,13 +118,13 @@ void BM_Lookup(benchmark::State& state, const std::string& encoding, int k, bool
 }
 
 int register_lookups() {
-    for (const lat::EncodingInfo& e : lat::table_encodings())
+    for (const lat::Encoding* e : lat::encodings())
         for (int k : {1, 2, 4})
             for (bool coherent : {false, true})
-                benchmark::RegisterBenchmark(("lookup/" + e.name + "/sigma_inv:" + std::to_string(k) +
-                                              (coherent ? "/coherent" : "/random"))
+                benchmark::RegisterBenchmark(("lookup/" + std::string(e->name) + "/sigma_inv:" +
+                                              std::to_string(k) + (coherent ? "/coherent" : "/random"))
                                                  .c_str(),
-                                             BM_Lookup, e.name, k, coherent)
+                                             BM_Lookup, std::string(e->name), k, coherent)
                     ->Unit(benchmark::kNanosecond);
     return 0;
 }

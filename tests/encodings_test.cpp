@@ -6,14 +6,14 @@
 
 #include "geometry/chain.h"
 #include "io/image_compare.h"
-#include "lattice/candidates_table.h"
+#include "lattice/encodings/candidates/candidates_table.h"
 #include "lattice/certify.h"
-#include "lattice/dense_table.h"
-#include "lattice/encodings.h"
+#include "lattice/encodings/dense/dense_table.h"
+#include "lattice/encoding.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/rasterizer.h"
 #include "render/renderer.h"
-#include "scene/lattice_tables.h"
+#include "render/scene_lattices.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 #include "test_paths.h"
@@ -37,9 +37,10 @@ Built build(const std::string& encoding, int k, const EncodeOptions& opt = {}) {
     const Primitive& p = hair_scene().primitives.at(0);
     Built b;
     b.ctx = {{7 * k, 7 * k, 20 * k}, 1.0 / k, 1.0, p.shape.get()};
-    b.raster = rasterize(*p.shape, {b.ctx.cells, b.ctx.cell});
-    b.payload = encode_table(encoding, b.raster, b.ctx, opt);
-    b.table = open_table(encoding, b.payload.data(), b.payload.size(), b.raster.hits, b.ctx);
+    b.raster = rasterize(b.ctx);
+    const Encoding& e = find_encoding(encoding);
+    b.payload = e.build(b.raster.raw, b.ctx, opt);
+    b.table = e.open(b.payload.data(), b.payload.size(), b.raster.hits, b.ctx);
     return b;
 }
 
@@ -109,7 +110,7 @@ TEST(EncodingCandidates, EveryPartARayMeetsIsACandidate) {
     const Built b = build("candidates", 1);
     const Primitive& p = hair_scene().primitives.at(0);
     const auto shared = std::shared_ptr<const LatticeTable>(b.table.get(), [](const LatticeTable*) {});
-    const LatticeShape ls(shared, b.ctx.cells, b.ctx.cell, p.shape.get());
+    const auto ls = make_lattice_shape(shared, b.ctx, 0.0);
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> u(0, 1);
     int hits = 0;
@@ -119,13 +120,13 @@ TEST(EncodingCandidates, EveryPartARayMeetsIsACandidate) {
         const Ray ray{target - d * 30, d};
         Crossing ce, cl;
         const bool exact = p.shape->intersect(ray, 0, kInfinity, ce);
-        const bool lattice = ls.intersect(ray, 0, kInfinity, cl);
+        const bool lattice = ls->intersect(ray, 0, kInfinity, cl);
         ASSERT_EQ(exact, lattice) << n;
         if (exact) {
             ++hits;
             ASSERT_EQ(ce.t, cl.t) << n;
         }
-        EXPECT_EQ(p.shape->occluded(ray, 0, kInfinity), ls.occluded(ray, 0, kInfinity)) << n;
+        EXPECT_EQ(p.shape->occluded(ray, 0, kInfinity), ls->occluded(ray, 0, kInfinity)) << n;
     }
     EXPECT_GT(hits, 3000);
 }

@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 
 #include "io/image_compare.h"
-#include "lattice/encodings.h"
+#include "lattice/encoding.h"
 #include "lattice/lattice_shape.h"
 #include "render/renderer.h"
-#include "scene/lattice_tables.h"
+#include "render/scene_lattices.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 #include "test_paths.h"
@@ -108,15 +108,10 @@ TEST_F(LatticeRender, CullingByThePrimitiveChangesNoPixel) {
             std::vector<std::shared_ptr<const Shape>> culled(s.primitives.size()),
                 boxed(s.primitives.size());
             for (std::size_t i = 0; i < s.primitives.size(); ++i) {
-                const Primitive& p = s.primitives[i];
-                const TableCache::Entry e = cache.get(p, spec, s.file, false);
-                const TableContext ctx{e.header.cells, e.header.cell, e.header.sigma,
-                                       p.shape.get()};
-                culled[i] = std::make_shared<LatticeShape>(
-                    e.table, e.header.cells, e.header.cell, p.shape.get(),
-                    hit_error_bound(encoding, ctx, spec.options));
-                boxed[i] = std::make_shared<LatticeShape>(e.table, e.header.cells, e.header.cell,
-                                                          p.shape.get());
+                const TablePlan plan = plan_table(s.primitives[i], spec, s.file);
+                const TableCache::Entry e = cache.get(plan, false);
+                culled[i] = make_lattice_shape(e.table, plan.context, plan.error_bound());
+                boxed[i] = make_lattice_shape(e.table, plan.context, kInfinity);
                 std::vector<Bounds3> cb;
                 culled[i]->cull_boxes(cb);
                 double volume = 0;

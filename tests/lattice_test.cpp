@@ -12,8 +12,8 @@
 
 #include "geometry/chain.h"
 #include "lattice/boundary_grid.h"
-#include "lattice/encodings.h"
-#include "lattice/hash14_table.h"
+#include "lattice/encoding.h"
+#include "lattice/encodings/hash14/hash14_table.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/octahedral.h"
 #include "lattice/rasterizer.h"
@@ -30,7 +30,7 @@ ChainShape hook() {
                       {{0, 1, 0.5}, {1, 2, 0.5}, {2, 3, 0.5}});
 }
 
-TEST(LatticeGrid, IdsRoundTripAndCounts) {
+TEST(BoundaryGridTest, IdsRoundTripAndCounts) {
     const BoundaryGrid g({4, 2, 5});
     std::set<std::uint32_t> seen;
     int boundary = 0;
@@ -50,7 +50,7 @@ TEST(LatticeGrid, IdsRoundTripAndCounts) {
     EXPECT_EQ(g.faces({4, 1, 5}), 0b100010);
 }
 
-TEST(LatticeGrid, PaperFigure1PairCount) {
+TEST(BoundaryGridTest, PaperFigure1PairCount) {
     // Paper 2.2: a 4 x 2 x 4 lattice has N_lpxy = 15, N_lpyz = 15, N_lpzx = 25, N_lp = 9,950.
     const BoundaryGrid g({4, 2, 4});
     EXPECT_EQ(g.face_points(4), 15u);
@@ -60,7 +60,7 @@ TEST(LatticeGrid, PaperFigure1PairCount) {
 }
 
 // Every valid pair traced exactly against every part, the slow way.
-std::map<std::pair<std::uint32_t, std::uint32_t>, double> brute_force(const Shape& s, const LatticeGrid& lg) {
+std::map<std::pair<std::uint32_t, std::uint32_t>, double> brute_force(const Shape& s, const TableContext& lg) {
     const BoundaryGrid g(lg.cells);
     std::map<std::pair<std::uint32_t, std::uint32_t>, double> hits;
     for (std::uint32_t a = 0; a < g.count(); ++a)
@@ -81,8 +81,8 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, double> brute_force(const Shap
 TEST(LatticeRasterize, MatchesBruteForceOnTheHook) {
     const ChainShape s = hook();
     for (int k : {1, 2}) {
-        const LatticeGrid lg{{4 * k, 2 * k, 4 * k}, 1.0 / k};
-        const RasterizeResult r = rasterize(s, lg);
+        const TableContext lg{{4 * k, 2 * k, 4 * k}, 1.0 / k, 1.0, &s};
+        const RasterizeResult r = rasterize(lg);
         const auto expected = brute_force(s, lg);
         ASSERT_EQ(r.raw.size(), expected.size()) << "k=" << k;
         EXPECT_EQ(r.pairs_eq2, r.pairs_enumerated);
@@ -102,22 +102,22 @@ TEST(LatticeRasterize, MatchesBruteForceOnARandomChain) {
     for (int i = 0; i < 6; ++i) spheres.push_back({{u(rng), u(rng), u(rng)}, rr(rng)});
     for (int i = 0; i + 1 < 6; ++i) cyl.push_back({i, i + 1, std::min(spheres[i].radius, spheres[i + 1].radius)});
     const ChainShape s(spheres, cyl);
-    const LatticeGrid lg{{6, 6, 6}, 1.0};
-    const RasterizeResult r = rasterize(s, lg);
+    const TableContext lg{{6, 6, 6}, 1.0, 1.0, &s};
+    const RasterizeResult r = rasterize(lg);
     EXPECT_EQ(r.raw.size(), brute_force(s, lg).size());
     EXPECT_LT(r.tests, 4 * r.hits);  // the cone culling does its job
 }
 
 TEST(LatticeRasterize, IndependentOfThreadCount) {
     const ChainShape s = hook();
-    const LatticeGrid lg{{8, 4, 8}, 0.5};
+    const TableContext lg{{8, 4, 8}, 0.5, 1.0, &s};
     const RasterizeResult one = [&] {
         tbb::task_arena arena(1);
         RasterizeResult r;
-        arena.execute([&] { r = rasterize(s, lg); });
+        arena.execute([&] { r = rasterize(lg); });
         return r;
     }();
-    const RasterizeResult two = rasterize(s, lg);
+    const RasterizeResult two = rasterize(lg);
     const std::vector<RawHit> h1 = one.raw.flatten(), h2 = two.raw.flatten();
     ASSERT_EQ(h1.size(), h2.size());
     for (std::size_t i = 0; i < h1.size(); ++i) {
@@ -129,8 +129,8 @@ TEST(LatticeRasterize, IndependentOfThreadCount) {
 
 TEST(LatticeHash14, StoredPairsComeBackWithinQuantisation) {
     const ChainShape s = hook();
-    const LatticeGrid lg{{8, 4, 8}, 0.5};
-    const RasterizeResult r = rasterize(s, lg);
+    const TableContext lg{{8, 4, 8}, 0.5, 1.0, &s};
+    const RasterizeResult r = rasterize(lg);
     const ByteBuffer payload = Hash14Table::build(r.raw);
     const Hash14Table table(payload.data(), payload.size(), r.raw.size());
     EXPECT_LT(double(table.bytes()) / double(r.raw.size()), 16.0);
@@ -163,8 +163,8 @@ protected:
     std::string path;
     void SetUp() override {
         const ChainShape s = hook();
-        const LatticeGrid lg{{4, 2, 4}, 1.0};
-        RasterizeResult r = rasterize(s, lg);
+        const TableContext lg{{4, 2, 4}, 1.0, 1.0, &s};
+        RasterizeResult r = rasterize(lg);
         header.encoding = "hash14";
         header.cells = lg.cells;
         header.cell = 1.0;
@@ -172,7 +172,7 @@ protected:
         header.pairs = r.pairs_eq2;
         header.entries = r.hits;
         path = (dir.path() / "hook.lht").string();
-        write_table_file(path, header, encode_table("hash14", r, {}));
+        write_table_file(path, header, find_encoding("hash14").build(r.raw, lg, {}));
     }
     std::string load_error(const TableHeader* expected = nullptr) {
         try {
@@ -234,11 +234,11 @@ TEST(LatticeShapeTest, AgreesWithExactUpToACell) {
     const ChainShape s = hook();
     const int k = 4;
     const double cell = 1.0 / k;
-    const LatticeGrid lg{{4 * k, 2 * k, 4 * k}, cell};
-    const RasterizeResult r = rasterize(s, lg);
-    const auto payload = encode_table("hash14", r, {});
+    const TableContext lg{{4 * k, 2 * k, 4 * k}, cell, 1.0, &s};
+    const RasterizeResult r = rasterize(lg);
+    const auto payload = find_encoding("hash14").build(r.raw, lg, {});
     auto table = std::make_shared<Hash14Table>(payload.data(), payload.size(), r.hits);
-    const LatticeShape ls(table, lg.cells, lg.cell);
+    const auto ls = make_lattice_shape(table, lg, kInfinity);
     const ChainShape thin = grown_hook(-cell), thick = grown_hook(cell);
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1, 1);
@@ -249,7 +249,7 @@ TEST(LatticeShapeTest, AgreesWithExactUpToACell) {
         const Vec3 d = normalize(Vec3{u(rng), u(rng), u(rng)});
         const Ray ray{target - d * 10, d};
         Crossing cl, c_thin, c_thick, ce;
-        const bool lattice = ls.intersect(ray, 0, kInfinity, cl);
+        const bool lattice = ls->intersect(ray, 0, kInfinity, cl);
         const bool in_thin = thin.intersect(ray, 0, kInfinity, c_thin);
         const bool in_thick = thick.intersect(ray, 0, kInfinity, c_thick);
         if (in_thin) {
@@ -260,7 +260,7 @@ TEST(LatticeShapeTest, AgreesWithExactUpToACell) {
             // Where the lattice and the exact hit agree, so do their normals, but for hits
             // near the junctions of spheres and flat cylinder ends.
             if (s.intersect(ray, 0, kInfinity, ce) && std::abs(ce.t - cl.t) < 0.5 * cell) {
-                const double c = dot(ls.normal(ray, cl), s.normal(ray, ce));
+                const double c = dot(ls->normal(ray, cl), s.normal(ray, ce));
                 cos_sum += c;
                 far_off += c < 0.3;
                 ++normals_checked;

@@ -10,9 +10,9 @@
 
 #include "geometry/chain.h"
 #include "lattice/certify.h"
-#include "lattice/encodings.h"
-#include "lattice/learned_bits.h"
-#include "lattice/learned_table.h"
+#include "lattice/encoding.h"
+#include "lattice/bits/elias_fano.h"
+#include "lattice/encodings/learned/learned_table.h"
 #include "lattice/rasterizer.h"
 #include "scene/scene_loader.h"
 #include "test_paths.h"
@@ -37,7 +37,7 @@ Raster raster(std::shared_ptr<const Shape> shape, std::array<int, 3> cells, int 
     Raster x;
     x.shape = std::move(shape);
     x.ctx = {{cells[0] * k, cells[1] * k, cells[2] * k}, 1.0 / k, 1.0, x.shape.get()};
-    x.r = rasterize(*x.shape, {x.ctx.cells, x.ctx.cell});
+    x.r = rasterize(x.ctx);
     return x;
 }
 
@@ -177,10 +177,11 @@ TEST(LearnedTable, SameBytesForAnyThreadCount) {
 
 TEST(LearnedTable, ThroughTheRegistry) {
     const Raster& x = hook_k2();
-    const ByteBuffer payload = encode_table("learned", x.r, x.ctx, bounds(0.05, 5));
-    const auto table = open_table("learned", payload.data(), payload.size(), x.r.hits, x.ctx);
+    const Encoding& e = find_encoding("learned");
+    const ByteBuffer payload = e.build(x.r.raw, x.ctx, bounds(0.05, 5));
+    const auto table = e.open(payload.data(), payload.size(), x.r.hits, x.ctx);
     EXPECT_EQ(table->encoding(), "learned");
-    EXPECT_EQ(encoding_info("learned").name, "learned");
+    EXPECT_EQ(e.name, "learned");
     TableHit h;
     const RawHit first = x.r.raw.flatten().front();
     EXPECT_TRUE(table->lookup(first.a, first.b, h));

@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "geometry/chain.h"
-#include "lattice/bbhash.h"
+#include "lattice/bits/bbhash.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/certify.h"
-#include "lattice/encodings.h"
+#include "lattice/encoding.h"
 #include "lattice/octahedral.h"
-#include "lattice/perfect_table.h"
+#include "lattice/encodings/perfect/perfect_table.h"
 #include "lattice/rasterizer.h"
 #include "lattice/table_file.h"
 #include "temp_dir.h"
@@ -139,7 +139,8 @@ TEST(Perfect5Mphf, RejectsDuplicateKeysAndCorruptWords) {
 }
 
 RasterizeResult hook_hits(int k) {
-    return rasterize(hook(), {{4 * k, 2 * k, 4 * k}, 1.0 / k});
+    static const ChainShape shape = hook();
+    return rasterize({{4 * k, 2 * k, 4 * k}, 1.0 / k, 1.0, &shape});
 }
 
 TEST(Perfect5Table, StoredPairsComeBackWithinQuantisation) {
@@ -176,11 +177,12 @@ TEST(Perfect5Table, CertifiedFalseHitsAreThePredictedShareOfMisses) {
     const ChainShape s = hook();
     const int k = 4;
     const RasterizeResult r = hook_hits(k);
-    const TableContext ctx{r.grid.cells, r.grid.cell, 1.0, &s};
+    const TableContext ctx{{4 * k, 2 * k, 4 * k}, 1.0 / k, 1.0, &s};
     for (const int fp : {0, 8, 16}) {
         const std::string name = PerfectTable::name(fp);
-        const ByteBuffer payload = encode_table(name, r, ctx);
-        const auto table = open_table(name, payload.data(), payload.size(), r.raw.size(), ctx);
+        const Encoding& e = find_encoding(name);
+        const ByteBuffer payload = e.build(r.raw, ctx, {});
+        const auto table = e.open(payload.data(), payload.size(), r.raw.size(), ctx);
         const CertifyReport rep = certify_table(*table, ctx, false);
         const auto& perfect = dynamic_cast<const PerfectTable&>(*table);
         EXPECT_EQ(rep.false_misses, 0u) << name;
@@ -229,16 +231,16 @@ TEST(Perfect5Table, RejectsShortOrCorruptPayloads) {
 TEST(Perfect5Table, RoundTripsThroughATableFile) {
     test::TempDir dir;
     const RasterizeResult r = hook_hits(2);
-    EXPECT_TRUE(encoding_info("perfect5").needs_hits);
+    EXPECT_TRUE(find_encoding("perfect5").needs_hits);
     TableHeader h;
     h.encoding = "perfect7";
-    h.cells = r.grid.cells;
+    h.cells = {8, 4, 8};
     h.sigma_inv = 2;
-    h.cell = r.grid.cell;
+    h.cell = 0.5;
     h.pairs = r.pairs_eq2;
     h.entries = r.hits;
     const std::string path = dir.file("hook.lht");
-    write_table_file(path, h, encode_table("perfect7", r, {}));
+    write_table_file(path, h, find_encoding("perfect7").build(r.raw, h.context(nullptr), {}));
     const LoadedTable t = load_table_file(path, &h);
     EXPECT_EQ(t.table->encoding(), "perfect7");
     EXPECT_EQ(t.table->entries(), r.raw.size());

@@ -1,6 +1,8 @@
 // lattice compare A.png B.png [--diff D.png] [--threshold N] [--json]
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "io/image_compare.h"

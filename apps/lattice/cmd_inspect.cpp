@@ -1,8 +1,13 @@
 // lattice inspect FILE.lht [--json] [--no-certify]: what a table holds, and its certified error.
+#include <CLI/CLI.hpp>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "common.h"
 #include "lattice/certify.h"
+#include "lattice/table_file.h"
+#include "scene/table_metadata.h"
 #include "util/memory.h"
 #include "util/progress.h"
 
@@ -16,11 +21,11 @@ struct InspectArgs {
 };
 
 int run_inspect(const InspectArgs& a) {
-    const auto limit = limit_threads(a.threads);
+    const ThreadLimit limit(a.threads);
     const TableHeader h = read_table_header(a.file);
     const Primitive prim = primitive_from_metadata(h, a.file);
     const LoadedTable t = load_table_file(a.file, nullptr, prim.shape.get());
-    const double per_hit = h.entries ? double(t.table->bytes()) / double(h.entries) : 0.0;
+    const double per_hit = h.entries ? double(t.bytes) / double(h.entries) : 0.0;
     nlohmann::json j = {{"file", a.file},
                         {"encoding", h.encoding},
                         {"primitive", prim.name},
@@ -29,7 +34,7 @@ int run_inspect(const InspectArgs& a) {
                         {"sigma_inv", h.sigma_inv},
                         {"N_lp", h.pairs},
                         {"stored_hits", h.entries},
-                        {"bytes", t.table->bytes()},
+                        {"bytes", t.bytes},
                         {"bytes_per_stored_hit", per_hit}};
     if (!a.json) {
         std::printf("%s: %s table of primitive '%s', %d x %d x %d cells (sigma %g, sigma^-1 %d)\n",
@@ -37,14 +42,13 @@ int run_inspect(const InspectArgs& a) {
                     h.cells[2], h.sigma, h.sigma_inv);
         std::printf("  N_lp %llu, %llu stored hits, %s (%llu bytes), %.3f bytes per stored hit\n",
                     static_cast<unsigned long long>(h.pairs), static_cast<unsigned long long>(h.entries),
-                    human_bytes(double(t.table->bytes())).c_str(),
-                    static_cast<unsigned long long>(t.table->bytes()), per_hit);
+                    human_bytes(double(t.bytes)).c_str(),
+                    static_cast<unsigned long long>(t.bytes), per_hit);
         if (!t.table->details().empty()) std::printf("  %s\n", t.table->details().c_str());
     }
     j["details"] = t.table->details();
     if (a.certify) {
-        const TableContext ctx{h.cells, h.cell, h.sigma, prim.shape.get()};
-        const CertifyReport r = certify_table(*t.table, ctx, !a.json && ProgressBar::stderr_is_terminal());
+        const CertifyReport r = certify_table(*t.table, h.context(prim.shape.get()), !a.json && ProgressBar::stderr_is_terminal());
         j["certified"] = {{"pairs", r.pairs},
                           {"exact_hits", r.exact_hits},
                           {"false_hits", r.false_hits},

@@ -1,9 +1,12 @@
 // lattice rasterize SCENE.json --primitive NAME [--sigma-inv K] [-o FILE.lht] [--encoding E]
+#include <CLI/CLI.hpp>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "lattice/encodings.h"
-#include "scene/lattice_tables.h"
+#include "common.h"
+#include "lattice/cache/table_build.h"
+#include "lattice/cache/table_cache.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -30,15 +33,16 @@ int run_rasterize(const RasterizeArgs& a) {
     if (!prim)
         throw InputError(a.scene + ": no primitive named '" + a.primitive + "'" +
                          (known.empty() ? " (the scene defines none)" : " (it has: " + known + ")"));
+    const TablePlan plan = plan_table(*prim, a.spec, a.scene);
     std::string path = a.output;
     if (path.empty()) {
         const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
                                !a.lattice_dir.empty());
-        path = cache.path_for(*prim, a.spec, a.scene);
+        path = cache.path_for(plan);
     }
-    const auto limit = limit_threads(a.threads);
-    const TableBuild b = build_table_file(*prim, a.spec, path, a.scene,
-                                          !a.quiet && ProgressBar::stderr_is_terminal());
+    const ThreadLimit limit(a.threads);
+    const TableBuild b =
+        build_table_file(plan, path, !a.quiet && ProgressBar::stderr_is_terminal());
     const RasterizeResult& r = b.raster;
     const double seconds = r.seconds + b.encode_seconds;
     const double per_entry = r.hits ? double(b.bytes) / double(r.hits) : 0.0;

@@ -1,15 +1,14 @@
 // lattice render SCENE.json -o OUT.png [--threads N] [--spp N] [--stats FILE.json] [--mode M]
-#include <tbb/global_control.h>
-
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "common.h"
 #include "io/image.h"
 #include "render/renderer.h"
-#include "scene/lattice_tables.h"
+#include "render/scene_lattices.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -40,7 +39,7 @@ int run_render(const RenderArgs& a) {
     if (!a.stats.empty()) check_writable(a.stats);
 
     const Scene scene = load_scene(a.scene);
-    const auto limit = limit_threads(a.threads);
+    const ThreadLimit limit(a.threads);
     const bool progress = !a.quiet && ProgressBar::stderr_is_terminal();
     const auto t1 = clock::now();
     SceneLattices lattices;

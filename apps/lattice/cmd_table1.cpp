@@ -1,7 +1,10 @@
 // lattice table1 FILE.json [--json] [--threads N]: the paper's Table 1, recomputed.
+#include <CLI/CLI.hpp>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "common.h"
 #include "scene/table1.h"
 #include "util/progress.h"
 
@@ -15,7 +18,7 @@ struct Table1Args {
 };
 
 int run_table1(const Table1Args& a) {
-    const auto limit = limit_threads(a.threads);
+    const ThreadLimit limit(a.threads);
     const auto rows = compute_table1(a.file, !a.json && ProgressBar::stderr_is_terminal());
     if (a.json) std::printf("%s\n", table1_json(rows).dump(2).c_str());
     else std::printf("%s", table1_text(rows).c_str());

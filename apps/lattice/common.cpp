@@ -1,17 +1,24 @@
+#include "common.h"
+
+#include <tbb/global_control.h>
+
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
-#include "commands.h"
+#include "lattice/cache/table_spec.h"
 #include "util/error.h"
 
 namespace lat::cli {
 
 void add_table_options(CLI::App& app, TableSpec& spec) {
+    // Its range is checked where the table is planned (plan_table), the one place for it.
     app.add_option("--sigma-inv", spec.sigma_inv,
-                   "Refine the lattice K times: K x the cells at sigma / K, same box")
-        ->check(CLI::Range(1, 1 << 20));
+                   "Refine the lattice K times: K x the cells at sigma / K, same box (1 to " +
+                       std::to_string(kMaxSigmaInv) + ")");
     std::string names;
-    for (const EncodingInfo& e : table_encodings()) names += (names.empty() ? "" : ", ") + e.name;
+    for (const Encoding* e : encodings()) names += (names.empty() ? "" : ", ") + std::string(e->name);
     app.add_option("--encoding", spec.encoding, "Lattice table encoding: " + names);
     app.add_option("--max-point-error", spec.options.max_point_error,
                    "Quantising encodings: largest point error, in units of sigma")
@@ -25,11 +32,17 @@ void add_table_options(CLI::App& app, TableSpec& spec) {
         ->check(CLI::IsMember({"auto", "oct", "part"}));
 }
 
-std::unique_ptr<tbb::global_control> limit_threads(int n) {
-    if (n <= 0) return nullptr;
-    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                 static_cast<std::size_t>(n));
+struct ThreadLimit::Impl {
+    tbb::global_control control;
+};
+
+ThreadLimit::ThreadLimit(int n) {
+    if (n > 0)
+        impl_ = std::make_unique<Impl>(Impl{tbb::global_control(
+            tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(n))});
 }
+
+ThreadLimit::~ThreadLimit() = default;
 
 void write_json_file(const std::string& path, const nlohmann::json& j) {
     const std::string tmp = path + ".tmp";

@@ -1,4 +1,5 @@
 // `lattice`: one binary, several subcommands (render, rasterize, table1, compare, inspect).
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <new>

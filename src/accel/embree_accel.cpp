@@ -313,10 +313,6 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
 
 EmbreeAccel::~EmbreeAccel() = default;
 
-bool EmbreeAccel::flattened() const {
-    return impl_->flatten;
-}
-
 bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hit) const {
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, hit);

@@ -40,8 +40,6 @@ class EmbreeAccel {
 public:
     explicit EmbreeAccel(std::span<const AccelObject> objects, const AccelOptions& opt = {});
 
-    // How the multi-part objects were placed.
-    bool flattened() const;
     ~EmbreeAccel();
     EmbreeAccel(const EmbreeAccel&) = delete;
     EmbreeAccel& operator=(const EmbreeAccel&) = delete;

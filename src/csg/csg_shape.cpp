@@ -185,9 +185,20 @@ bool CsgShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) 
 Vec3 CsgShape::normal(const Ray& r, const Crossing& c) const {
     const CsgLeaf& leaf = leaves_[c.leaf_index()].leaf;
     const Ray local = leaf.xf.is_identity() ? r : leaf.xf.inverse_ray(r);
-    Vec3 n = leaf.shape->normal(local, {c.t, c.part, 0});
+    Crossing in_leaf = c;
+    in_leaf.leaf = 0;
+    Vec3 n = leaf.shape->normal(local, in_leaf);
     if (!leaf.xf.is_identity()) n = normalize(leaf.xf.normal(n));
     return c.flipped() ? -n : n;
+}
+
+SurfacePoint CsgShape::surface(const Ray& r, const Crossing& c) const {
+    if (!c.has_stored) return {r.at(c.t), normal(r, c)};
+    const Transform& xf = leaves_[c.leaf_index()].leaf.xf;
+    SurfacePoint s = c.stored;
+    if (!xf.is_identity()) s = {xf.point(s.p), normalize(xf.normal(s.n))};
+    if (c.flipped()) s.n = -s.n;
+    return s;
 }
 
 bool CsgShape::inside(int ref, Vec3 p) const {

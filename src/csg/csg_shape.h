@@ -32,8 +32,6 @@ public:
     // Ends construction; the tree must be non-empty.
     void set_root(int ref);
 
-    std::size_t leaf_count() const { return leaves_.size(); }
-
     // The scene primitives that instance leaves refer to (with repeats).
     std::vector<int> leaf_primitives() const;
     // A copy whose instance leaves trace shape(primitive) instead (lattice mode); null when
@@ -45,6 +43,8 @@ public:
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
+    // A leaf's stored surface point (lattices) is carried to CSG coordinates.
+    SurfacePoint surface(const Ray& r, const Crossing& c) const override;
     bool inside(Vec3 p) const override { return inside(root_, p); }
     // The largest of the leaves' (lattices have one), in this shape's units.
     double surface_tolerance() const override { return tolerance_; }

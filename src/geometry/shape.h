@@ -1,6 +1,6 @@
 #pragma once
 // The solid-shape interface: every leaf of the scene (quartic, sphere, sphere/cylinder chain,
-// later lattices) and every CSG tree implements it in its own coordinates.
+// lattice instance) and every CSG tree implements it in its own coordinates.
 #include <cstdint>
 #include <string_view>
 #include <vector>
@@ -20,15 +20,29 @@ struct BoundingSphere {
     double radius;
 };
 
+// A hit's place on its surface and the outward unit normal there.
+struct SurfacePoint {
+    Vec3 p, n;
+};
+
 // A point where a ray crosses a shape's boundary. `part` tells the shape which surface it was
 // (so the normal can be computed later, only for the hit that is shaded); `leaf` names the
-// CSG leaf, with kFlipBit set when the surface belongs to a subtracted solid.
+// CSG leaf, with kFlipBit set when the surface belongs to a subtracted solid. Shapes that learn
+// the surface point together with the crossing (lattice tables, whose stored point lies near,
+// not on, the ray) keep it in `stored`, so shading it needs no second lookup.
 struct Crossing {
     static constexpr std::uint32_t kFlipBit = 1u << 31;
+
+    Crossing() = default;
+    Crossing(double t_, std::uint32_t part_, std::uint32_t leaf_) : t(t_), part(part_), leaf(leaf_) {}
+    Crossing(double t_, std::uint32_t part_, const SurfacePoint& s)
+        : t(t_), part(part_), has_stored(true), stored(s) {}
 
     double t = 0;
     std::uint32_t part = 0;
     std::uint32_t leaf = 0;
+    bool has_stored = false;
+    SurfacePoint stored;  // when has_stored: in the coordinates of the shape that found it
 
     std::uint32_t leaf_index() const { return leaf & ~kFlipBit; }
     bool flipped() const { return (leaf & kFlipBit) != 0; }
@@ -60,9 +74,11 @@ public:
     virtual void spans(const Ray& r, SpanList& out) const = 0;
     // Outward unit normal at a crossing this shape reported for ray r.
     virtual Vec3 normal(const Ray& r, const Crossing& c) const = 0;
-    // The surface point of a crossing: on the ray for exact shapes; lattices return the point
-    // stored in their table, which lies near, not on, the ray.
-    virtual Vec3 position(const Ray& r, const Crossing& c) const { return r.at(c.t); }
+    // The surface point and normal of a crossing this shape reported for ray r: the stored one
+    // when the crossing carries it, else the ray's point and normal().
+    virtual SurfacePoint surface(const Ray& r, const Crossing& c) const {
+        return c.has_stored ? c.stored : SurfacePoint{r.at(c.t), normal(r, c)};
+    }
     // Shadow rays leaving a surface point of this shape ignore this shape's crossings closer
     // than this (object units): zero for exact shapes, the table error for lattices.
     virtual double surface_tolerance() const { return 0.0; }

@@ -7,6 +7,8 @@
 #include <cassert>
 #include <cstdint>
 
+#include "math/vec.h"
+
 namespace lat {
 
 struct GridPoint {
@@ -15,6 +17,16 @@ struct GridPoint {
     int& operator[](int a) { return a == 0 ? x : (a == 1 ? y : z); }
     bool operator==(const GridPoint&) const = default;
 };
+
+// The point in lattice units.
+inline Vec3 to_vec(const GridPoint& g) {
+    return {double(g.x), double(g.y), double(g.z)};
+}
+
+// Rounding a ray's entry or exit point to the nearest grid point on its face moves it by at
+// most sqrt(2)/2 cells (two coordinates rounded by half a cell each), so every point of the
+// snapped segment lies within this of the ray (lattice units, with slack for rounding).
+inline constexpr double kSnapReach = 0.70711 + 1e-6;
 
 class BoundaryGrid {
 public:
@@ -37,6 +49,8 @@ public:
     std::uint64_t face_points(int face) const;
     // Ordered pairs of face points on different faces, counted as the paper's eq. (2) does.
     std::uint64_t pairs_eq2() const;
+    // The same for any cells, in floating point, so that absurd lattices cannot overflow it.
+    static long double pair_count(const std::array<int, 3>& cells);
 
     // A pair of boundary points can carry a ray through the lattice only if they are on
     // different faces: not both on the same single face.

@@ -19,10 +19,9 @@ namespace {
 struct ExactHit {
     std::uint32_t b;
     float t;
-    Crossing crossing;
+    std::uint16_t part, leaf;  // packed as in RawHit
+    Crossing crossing() const { return RawHit{0, b, t, 0, 0, part, leaf}.crossing(double(t)); }
 };
-
-Vec3 point_of(const GridPoint& g) { return {double(g.x), double(g.y), double(g.z)}; }
 
 }  // namespace
 
@@ -30,11 +29,11 @@ CertifyReport certify_table(const LatticeTable& table, const TableContext& ctx, 
     const auto start = std::chrono::steady_clock::now();
     const Shape& shape = *ctx.primitive;
     const BoundaryGrid grid(ctx.cells);
-    const RasterizeResult exact = rasterize(shape, {ctx.cells, ctx.cell});
+    const RasterizeResult exact = rasterize(ctx);
     // The exact hits by entry point, sorted by exit point.
     std::vector<std::vector<ExactHit>> by_entry(grid.count());
     for (const auto& chunk : exact.raw.chunks)
-        for (const RawHit& h : chunk) by_entry[h.a].push_back({h.b, h.t, h.crossing(double(h.t))});
+        for (const RawHit& h : chunk) by_entry[h.a].push_back({h.b, h.t, h.part, h.leaf});
     tbb::parallel_for(std::size_t{0}, by_entry.size(), [&](std::size_t a) {
         std::sort(by_entry[a].begin(), by_entry[a].end(),
                   [](const ExactHit& x, const ExactHit& y) { return x.b < y.b; });
@@ -52,7 +51,7 @@ CertifyReport certify_table(const LatticeTable& table, const TableContext& ctx, 
     tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, grid.count(), 16), [&](const auto& range) {
         Partial part;
         for (std::uint32_t a = range.begin(); a != range.end(); ++a) {
-            const Vec3 pa = point_of(grid.point(a));
+            const Vec3 pa = to_vec(grid.point(a));
             const auto& hits = by_entry[a];
             std::size_t next = 0;
             for (std::uint32_t b = 0; b < grid.count(); ++b) {
@@ -69,11 +68,11 @@ CertifyReport certify_table(const LatticeTable& table, const TableContext& ctx, 
                 }
                 if (!exact_hit) continue;
                 const ExactHit& e = hits[next];
-                const Vec3 pb = point_of(grid.point(b));
+                const Vec3 pb = to_vec(grid.point(b));
                 const double len = length(pb - pa) * ctx.cell / ctx.sigma;
                 const double perr = std::abs(th.t - double(e.t)) * len;
                 const Ray seg{pa * ctx.cell, (pb - pa) * ctx.cell};
-                const Vec3 n = shape.normal(seg, e.crossing);
+                const Vec3 n = shape.normal(seg, e.crossing());
                 const double c = std::clamp(dot(n, th.normal), -1.0, 1.0);
                 const double nerr = std::acos(c) * 180.0 / M_PI;
                 ++part.both;

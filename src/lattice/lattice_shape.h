@@ -1,13 +1,13 @@
 #pragma once
 // A lattice instance's shape (paper 2.1, 3.2.2): rays are answered by the table, not by the
 // primitive. In the primitive's coordinates the ray is scaled to lattice units, clipped to the
-// box, its entry and exit points are rounded to the nearest grid points on their faces, and
-// the pair is looked up. The stored point (near, not on, the ray) is the hit's position; its
-// projection on the ray orders it against other objects. The reverse pair (p_o, p_i) gives
-// the last crossing, so a lattice is also a CSG leaf (one span per ray) and shadows itself.
-// With a candidate table (encoding `candidates`) the pair instead names the primitive's parts
-// the ray can meet, and those are intersected exactly with the real ray: an exact lattice.
+// box, and its entry and exit points are rounded to the nearest grid points on their faces
+// (LatticeFrame::snap); the pair is then looked up. Two shapes do that, one per kind of table:
+//   HitTableShape        the table stores the pair's hit (lattice/hit_table_shape.h);
+//   CandidateTableShape  the table names the primitive's parts the ray can meet, which are
+//                        intersected exactly with the real ray (lattice/candidate_table_shape.h).
 #include <memory>
+#include <vector>
 
 #include "geometry/shape.h"
 #include "lattice/boundary_grid.h"
@@ -15,59 +15,40 @@
 
 namespace lat {
 
-class LatticeShape final : public Shape {
+// The box, its boundary grid, the snapping of rays to grid point pairs, and the boxes a
+// lattice is culled with: what both lattice shapes share.
+class LatticeFrame {
 public:
-    // cells: the lattice at its refinement; cell: the cell size in primitive units; the
-    // primitive is needed by candidate tables and for culling (kept alive by the caller);
-    // hit_error: how far a stored hit can lie from the primitive (hit_error_bound), infinity
-    // when unknown, which culls with the lattice box alone.
-    LatticeShape(std::shared_ptr<const LatticeTable> table, std::array<int, 3> cells, double cell,
-                 const Shape* primitive = nullptr, double hit_error = kInfinity);
+    // ctx.primitive, when set, lets the cull boxes hug the primitive; hit_error: how far a
+    // stored hit can lie from the primitive (Encoding::error_bound), infinity when unknown,
+    // which culls with the lattice box alone.
+    LatticeFrame(const TableContext& ctx, double hit_error);
 
-    const LatticeTable& table() const { return *table_; }
+    const Bounds3& box() const { return box_; }
+    const std::vector<Bounds3>& cull_boxes() const { return cull_; }
+    double cell() const { return cell_; }
 
-    Bounds3 bounds() const override { return box_; }
-    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
-    bool occluded(const Ray& r, double tmin, double tmax) const override;
-    void spans(const Ray& r, SpanList& out) const override;
-    Vec3 normal(const Ray& r, const Crossing& c) const override;
-    Vec3 position(const Ray& r, const Crossing& c) const override;
-    bool inside(Vec3 p) const override;
-    void cull_boxes(std::vector<Bounds3>& out) const override;
-    // Rays leaving a point found through this lattice skip crossings within this distance of
-    // it: the table's own error, which would otherwise shade the surface by itself (acne).
-    // Exact (candidate) lattices need none.
-    double surface_tolerance() const override { return exact_ ? 0.0 : 2.0 * cell_; }
-
-    // The two crossings of the ray's line (first and last), as ray parameters and points.
-    struct LineHits {
-        bool hit = false;
-        double t_first = 0, t_last = 0;
-        Vec3 p_first, p_last;  // primitive units
-        Vec3 n_first, n_last;
+    // The ray's line in lattice units, and its snapped entry and exit points.
+    struct Snap {
+        Vec3 o, d;                 // the ray, lattice units
+        std::uint32_t a = 0, b = 0;  // grid point ids of the entry and exit points
+        GridPoint pa, pb;
     };
-    // The last crossing is only looked up when the first is at or before need_last_below
-    // (else t_last = t_first and p_last, n_last are unset).
-    LineHits line_hits(const Ray& r, double need_last_below = kInfinity) const;
+    // False when the line misses the box.
+    bool snap(const Ray& r, Snap& s) const;
 
 private:
-    std::shared_ptr<const LatticeTable> table_;
     BoundaryGrid grid_;
     double cell_, inv_cell_;
-    Bounds3 box_;  // primitive units
-
-    const Shape* primitive_;
-    bool exact_;                 // a candidate table
+    Bounds3 box_;                // primitive units
     std::vector<Bounds3> cull_;  // see make_cull_boxes
 
-    // Snapped entry and exit point ids of the ray's line; false if it misses the box (or, for
-    // hit tables, when both snap to the same point).
-    bool snap(const Ray& r, std::uint32_t& a, std::uint32_t& b, GridPoint& pa, GridPoint& pb) const;
-    // A few boxes around the primitive grown by the snapping distance and the table's error:
-    // no ray outside them can get a hit (see lattice_shape.cpp).
-    void make_cull_boxes(double hit_error);
-    // Candidate tables: the parts the ray can meet; false when none.
-    bool candidates(const Ray& r, CandidateList& list) const;
+    void make_cull_boxes(const Shape* primitive, double hit_error);
 };
+
+// The shape for a table of either kind; ctx.primitive must be set (candidate tables intersect
+// it; both cull by it) and outlive the shape.
+std::shared_ptr<const Shape> make_lattice_shape(std::shared_ptr<const LatticeTable> table,
+                                                const TableContext& ctx, double hit_error);
 
 }  // namespace lat

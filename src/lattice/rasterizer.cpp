@@ -67,7 +67,7 @@ struct Scratch {
 // Everything about the lattice that does not depend on the entry point.
 class Tracer {
 public:
-    Tracer(const Shape& shape, const LatticeGrid& lg) : grid_(lg.cells), h_(lg.cell) {
+    Tracer(const Shape& shape, const TableContext& lg) : grid_(lg.cells), h_(lg.cell) {
         for (int f = 0; f < 6; ++f) faces_[static_cast<std::size_t>(f)] = layout_face(grid_, f);
         count_sums();
         // The parts as bounding spheres in lattice units, grouped by part, padded beyond the
@@ -210,9 +210,11 @@ private:
 
 }  // namespace
 
-RasterizeResult rasterize(const Shape& shape, const LatticeGrid& lg, const RasterizeOptions& opt) {
+RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) {
+    assert(ctx.primitive);
     const auto start = std::chrono::steady_clock::now();
-    const Tracer tracer(shape, lg);
+    const Shape& shape = *ctx.primitive;
+    const Tracer tracer(shape, ctx);
     // Chains (the common primitive) are traced through their concrete type, without virtual
     // calls in the innermost loop.
     const auto* chain = dynamic_cast<const ChainShape*>(&shape);
@@ -241,7 +243,6 @@ RasterizeResult rasterize(const Shape& shape, const LatticeGrid& lg, const Raste
     bar.finish();
 
     RasterizeResult res;
-    res.grid = lg;
     res.pairs_eq2 = tracer.grid().pairs_eq2();
     for (const Counts& c : block_counts) {
         res.pairs_enumerated += c.enumerated;

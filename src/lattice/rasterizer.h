@@ -11,11 +11,6 @@
 
 namespace lat {
 
-struct LatticeGrid {
-    std::array<int, 3> cells{1, 1, 1};  // at the chosen refinement
-    double cell = 1;                    // cell size in the primitive's units (sigma / K)
-};
-
 struct RasterizeOptions {
     bool keep_hits = true;  // false: only count (Table 1)
     bool progress = false;
@@ -24,7 +19,6 @@ struct RasterizeOptions {
 };
 
 struct RasterizeResult {
-    LatticeGrid grid;
     std::uint64_t pairs_eq2 = 0;         // N_lp by the paper's eq. (2)
     std::uint64_t pairs_enumerated = 0;  // N_lp by enumeration, counted as eq. (2) counts
     std::uint64_t pairs_traced = 0;      // distinct (p_i, p_o) segments considered
@@ -35,7 +29,7 @@ struct RasterizeResult {
     RawHits raw;  // when keep_hits: in entry point order, the same for any thread count
 };
 
-RasterizeResult rasterize(const Shape& primitive, const LatticeGrid& grid,
-                          const RasterizeOptions& opt = {});
+// The lattice and the primitive (which must be set) are ctx's.
+RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt = {});
 
 }  // namespace lat

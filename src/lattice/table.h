@@ -1,8 +1,7 @@
 #pragma once
 // The Lattice Hash Table interface (paper 2.3): for an ordered pair (p_i, p_o) of boundary grid
 // points, the intersection closest to p_i of the segment p_i -> p_o with the primitive, if any.
-// The renderer only sees this interface; encodings (the paper's 14-byte hash table, and others
-// later) live behind it.
+// The renderer only sees this interface; the encodings (lattice/encoding.h) live behind it.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -61,12 +60,13 @@ struct RawHits {
     }
 };
 
-// What a table knows besides its payload: the lattice, and the primitive (encodings that
-// intersect it exactly, or re-evaluate its normals, need it).
+// The lattice a table is for, at its refinement, and the primitive: what rasterizing, building,
+// opening and tracing a table need besides its payload (encodings that intersect the primitive
+// exactly, or re-evaluate its normals, use it). Derived once from a table's header.
 struct TableContext {
-    std::array<int, 3> cells{};      // at the refinement
-    double cell = 1;                 // primitive units per lattice unit (sigma / sigma^-1)
-    double sigma = 1;                // the primitive's own grid spacing
+    std::array<int, 3> cells{};  // at the refinement
+    double cell = 1;             // primitive units per lattice unit (sigma / sigma^-1)
+    double sigma = 1;            // the primitive's own grid spacing
     const Shape* primitive = nullptr;
 };
 
@@ -96,9 +96,15 @@ public:
     virtual std::string encoding() const = 0;
     // Encoding-specific facts for `lattice inspect` (widths, counts), one line; may be empty.
     virtual std::string details() const { return {}; }
-    // Stored hits, and every byte the table occupies (payload, indices, headers).
+    // Stored hits, and every byte the table occupies (payload and indices built at open).
     virtual std::uint64_t entries() const = 0;
     virtual std::uint64_t bytes() const = 0;
+
+    // Keeps what the payload lives in (a file mapping) alive as long as the table.
+    void hold(std::shared_ptr<const void> storage) { storage_ = std::move(storage); }
+
+private:
+    std::shared_ptr<const void> storage_;
 };
 
 }  // namespace lat

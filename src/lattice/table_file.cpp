@@ -11,7 +11,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "lattice/encodings.h"
+#include "lattice/encoding.h"
 #include "util/error.h"
 #include "util/hash.h"
 
@@ -70,13 +70,6 @@ std::array<std::uint8_t, kTableHeaderBytes> encode_header(const TableHeader& h,
     return b;
 }
 
-std::string describe(const TableHeader& h) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%s, %d x %d x %d cells (sigma %g, sigma^-1 %d)",
-                  h.encoding.c_str(), h.cells[0], h.cells[1], h.cells[2], h.sigma, h.sigma_inv);
-    return buf;
-}
-
 TableHeader decode_header(const std::uint8_t* b, std::size_t file_size, const std::string& path,
                           std::uint64_t& payload_checksum, std::uint64_t& meta_bytes) {
     auto bad = [&](const std::string& what) -> InputError {
@@ -124,30 +117,14 @@ struct Mapping {
     }
 };
 
-class MappedTable final : public LatticeTable {
-public:
-    MappedTable(std::shared_ptr<Mapping> m, std::unique_ptr<LatticeTable> t)
-        : mapping_(std::move(m)), table_(std::move(t)) {}
-    Kind kind() const override { return table_->kind(); }
-    bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const override {
-        return table_->lookup(a, b, hit);
-    }
-    bool candidates(std::uint32_t a, std::uint32_t b, CandidateList& out) const override {
-        return table_->candidates(a, b, out);
-    }
-    std::string encoding() const override { return table_->encoding(); }
-    std::string details() const override { return table_->details(); }
-    std::uint64_t entries() const override { return table_->entries(); }
-    std::uint64_t bytes() const override { return table_->bytes() + kTableHeaderBytes + meta_; }
-    void set_meta_bytes(std::uint64_t n) { meta_ = n; }
-
-private:
-    std::shared_ptr<Mapping> mapping_;
-    std::unique_ptr<LatticeTable> table_;
-    std::uint64_t meta_ = 0;
-};
-
 }  // namespace
+
+std::string TableHeader::describe() const {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s, %d x %d x %d cells (sigma %g, sigma^-1 %d)",
+                  encoding.c_str(), cells[0], cells[1], cells[2], sigma, sigma_inv);
+    return buf;
+}
 
 void write_table_file(const std::string& path, const TableHeader& h0,
                       const ByteBuffer& payload) {
@@ -220,8 +197,8 @@ LoadedTable load_table_file(const std::string& path, const TableHeader* expected
     if (expected) {
         if (h.encoding != expected->encoding || h.cells != expected->cells ||
             h.sigma_inv != expected->sigma_inv || h.cell != expected->cell)
-            throw InputError(path + ": lattice table is for " + describe(h) + ", expected " +
-                             describe(*expected));
+            throw InputError(path + ": lattice table is for " + h.describe() + ", expected " +
+                             expected->describe());
         if (h.fingerprint != expected->fingerprint)
             throw InputError(path + ": lattice table was built for another primitive "
                              "(its geometry fingerprint differs); rebuild it");
@@ -231,12 +208,12 @@ LoadedTable load_table_file(const std::string& path, const TableHeader* expected
     if (hash_bytes(meta, meta_bytes, hash_bytes(payload, h.payload_bytes)) != checksum)
         throw InputError(path + ": not a valid lattice table: payload checksum mismatch (corrupt)");
     h.metadata.assign(reinterpret_cast<const char*>(meta), meta_bytes);
-    const TableContext ctx{h.cells, h.cell, h.sigma, primitive};
     try {
-        auto mapped = std::make_shared<MappedTable>(
-            m, open_table(h.encoding, payload, h.payload_bytes, h.entries, ctx));
-        mapped->set_meta_bytes(meta_bytes);
-        out.table = mapped;
+        std::unique_ptr<LatticeTable> table = find_encoding(h.encoding).open(
+            payload, h.payload_bytes, h.entries, h.context(primitive));
+        table->hold(m);
+        out.table = std::move(table);
+        out.bytes = out.table->bytes() + kTableHeaderBytes + meta_bytes;
     } catch (const std::exception& e) {
         throw InputError(path + ": not a valid lattice table: " + e.what());
     }

@@ -31,6 +31,10 @@ struct TableHeader {
     // JSON, after the payload: the primitive's name and definition and the scene it came from,
     // so that a table file can be inspected on its own.
     std::string metadata;
+
+    TableContext context(const Shape* primitive) const { return {cells, cell, sigma, primitive}; }
+    // "hash14, 28 x 12 x 28 cells (sigma 0.1, sigma^-1 4)", for messages.
+    std::string describe() const;
 };
 
 inline constexpr std::uint32_t kTableFormatVersion = 1;
@@ -44,6 +48,7 @@ void write_table_file(const std::string& path, const TableHeader& h,
 struct LoadedTable {
     TableHeader header;
     std::shared_ptr<const LatticeTable> table;
+    std::uint64_t bytes = 0;  // the table's, with the file's header and metadata
 };
 
 // Reads just the header (validated); throws InputError.

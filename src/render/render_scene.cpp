@@ -32,12 +32,13 @@ bool RenderScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& 
     hit.object = h.object;
     hit.material = shape.tag(h.crossing, o.material);
     if (o.xf.is_identity()) {
-        hit.p = shape.position(r, h.crossing);
-        hit.n = shape.normal(r, h.crossing);
+        const SurfacePoint s = shape.surface(r, h.crossing);
+        hit.p = s.p;
+        hit.n = s.n;
     } else {
-        const Ray local = o.xf.inverse_ray(r);
-        hit.p = o.xf.point(shape.position(local, h.crossing));
-        hit.n = normalize(o.xf.normal(shape.normal(local, h.crossing)));
+        const SurfacePoint s = shape.surface(o.xf.inverse_ray(r), h.crossing);
+        hit.p = o.xf.point(s.p);
+        hit.n = normalize(o.xf.normal(s.n));
     }
     return true;
 }

@@ -8,6 +8,7 @@
 
 #include "geometry/chain.h"
 #include "geometry/shape.h"
+#include "lattice/primitive.h"
 #include "math/transform.h"
 
 namespace lat {
@@ -27,23 +28,6 @@ struct Material {
     std::string name;
     Vec3 color{0.8, 0.8, 0.8};
     double ka = 0.1, kd = 0.7, ks = 0.2, shininess = 20;
-};
-
-// The lattice around a primitive: box [0, nx*sigma] x [0, ny*sigma] x [0, nz*sigma].
-struct LatticeSpec {
-    double sigma = 1;
-    std::array<int, 3> cells{1, 1, 1};
-};
-
-// A named small object that instances refer to (paper: the lattice primitive): a chain of
-// spheres and cylinders, or any object (quartic, CSG) given as "object".
-struct Primitive {
-    std::string name;
-    std::string where;  // e.g. "primitives.hair", for messages
-    std::shared_ptr<const Shape> shape;
-    std::uint64_t fingerprint = 0;  // of the geometry as written, to key lattice tables
-    std::string definition;         // the geometry as written (JSON), stored with its tables
-    std::optional<LatticeSpec> lattice;
 };
 
 struct SceneObject {

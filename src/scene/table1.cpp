@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "lattice/boundary_grid.h"
+#include "lattice/cache/table_spec.h"
 #include "lattice/rasterizer.h"
 #include "scene/json_reader.h"
 #include "scene/scene_loader.h"
@@ -10,6 +12,10 @@
 
 namespace lat {
 namespace {
+
+// Counting is exhaustive: beyond this many pairs (minutes of work) a row is refused.
+constexpr double kMaxTable1Pairs = 1e11;
+constexpr double kMaxTable1Box = 4096;
 
 // Two significant digits, as the paper prints them.
 double round2(double v) {
@@ -58,8 +64,9 @@ std::vector<Table1Row> compute_table1(const std::string& path, bool progress) {
         const Vec3 b = box.vec3();
         for (std::size_t a = 0; a < 3; ++a) {
             row.box[a] = b[a];
-            if (!(b[a] >= 1 && b[a] == std::floor(b[a])))
-                box[a].fail("the box must be a whole number of units (sigma = 1) along each axis");
+            if (!(b[a] >= 1 && b[a] <= kMaxTable1Box && b[a] == std::floor(b[a])))
+                box[a].fail("the box must be a whole number of units (sigma = 1) along each axis, "
+                            "at most 4096");
         }
         const JsonValue paper = r.at("paper");
         for (std::size_t k = 0; k < paper.size(); ++k) {
@@ -67,18 +74,20 @@ std::vector<Table1Row> compute_table1(const std::string& path, bool progress) {
             p.allow_keys({"sigma_inv", "N_lp", "N_ix", "ratio"});
             Table1Cell c;
             c.sigma_inv = p.at("sigma_inv").integer();
-            if (c.sigma_inv < 1 || c.sigma_inv > 64) p.at("sigma_inv").fail("must be between 1 and 64");
+            if (const std::string e = sigma_inv_error(c.sigma_inv); !e.empty()) p.at("sigma_inv").fail(e);
             c.paper_n_lp = p.at("N_lp").number();
             c.paper_n_ix = p.at("N_ix").number();
             c.paper_ratio = p.at("ratio").number();
-            LatticeGrid g;
+            TableContext g{{}, 1.0 / c.sigma_inv, 1.0, prim.shape.get()};
             for (std::size_t a = 0; a < 3; ++a) g.cells[a] = static_cast<int>(b[a]) * c.sigma_inv;
-            g.cell = 1.0 / c.sigma_inv;
             c.cells = g.cells;
+            if (BoundaryGrid::pair_count(g.cells) > kMaxTable1Pairs)
+                p.at("sigma_inv").fail("the lattice has too many point pairs to count here (more than " +
+                                       paper_notation(kMaxTable1Pairs) + ")");
             RasterizeOptions opt;
             opt.keep_hits = false;
             opt.progress = progress;
-            const RasterizeResult res = rasterize(*prim.shape, g, opt);
+            const RasterizeResult res = rasterize(g, opt);
             c.n_lp_eq2 = res.pairs_eq2;
             c.n_lp_enumerated = res.pairs_enumerated;
             c.n_ix = res.hits_counted;

@@ -1,0 +1,36 @@
+#pragma once
+// What several subcommands share: the table options, the thread limit, JSON output files.
+#include <memory>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace lat {
+struct TableSpec;
+}
+
+namespace lat::cli {
+
+// --sigma-inv, --encoding and the encodings' error targets, shared by render and rasterize.
+void add_table_options(CLI::App& app, TableSpec& spec);
+
+// Caps oneTBB (and so Embree's builds) at n threads for its lifetime; 0 = all cores.
+class ThreadLimit {
+public:
+    explicit ThreadLimit(int n);
+    ~ThreadLimit();
+    ThreadLimit(const ThreadLimit&) = delete;
+    ThreadLimit& operator=(const ThreadLimit&) = delete;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// Writes JSON atomically (temporary + rename); throws InputError naming the path.
+void write_json_file(const std::string& path, const nlohmann::json& j);
+
+}  // namespace lat::cli

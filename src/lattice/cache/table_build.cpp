@@ -1,0 +1,118 @@
+#include "lattice/cache/table_build.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "lattice/boundary_grid.h"
+#include "util/error.h"
+#include "util/memory.h"
+
+namespace lat {
+namespace {
+
+// The primitive must lie in its box: the table cannot see what sticks out.
+void check_inside_box(const TablePlan& plan) {
+    const Primitive& p = *plan.primitive;
+    const Bounds3 b = p.shape->bounds();
+    const double X = p.lattice->cells[0] * p.lattice->sigma,
+                 Y = p.lattice->cells[1] * p.lattice->sigma,
+                 Z = p.lattice->cells[2] * p.lattice->sigma;
+    const double tol = 1e-9 * std::max({X, Y, Z});
+    if (b.finite() && b.lo.x >= -tol && b.lo.y >= -tol && b.lo.z >= -tol && b.hi.x <= X + tol &&
+        b.hi.y <= Y + tol && b.hi.z <= Z + tol)
+        return;
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "primitive '%s' reaches outside its lattice box [0, %g] x [0, %g] x [0, %g] "
+                  "(its bounds are [%g, %g] x [%g, %g] x [%g, %g])",
+                  p.name.c_str(), X, Y, Z, b.lo.x, b.hi.x, b.lo.y, b.hi.y, b.lo.z, b.hi.z);
+    throw InputError(plan.place + buf);
+}
+
+std::string lattice_size(const TableHeader& h) {
+    return std::to_string(h.cells[0]) + " x " + std::to_string(h.cells[1]) + " x " +
+           std::to_string(h.cells[2]) + " cells (sigma^-1 = " + std::to_string(h.sigma_inv) + ")";
+}
+
+long double pair_count(const TableHeader& h) {
+    return BoundaryGrid::pair_count(h.cells);
+}
+
+[[noreturn]] void refuse_memory(const TablePlan& plan, double hit_rate, double bytes,
+                                bool lower_bound) {
+    const double per_hit = plan.encoding->bytes_per_hit + sizeof(RawHit);
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "the %s table of primitive '%s' at %s would need %s %s (%.3Lg point pairs, "
+                  "%s %.0f %% of them %s, at %.1f bytes per hit while building), more than the "
+                  "%s of memory available",
+                  plan.header.encoding.c_str(), plan.primitive->name.c_str(),
+                  lattice_size(plan.header).c_str(), lower_bound ? "at least" : "about",
+                  human_bytes(bytes).c_str(), pair_count(plan.header),
+                  lower_bound ? "even if only" : "an estimated", hit_rate * 100,
+                  lower_bound ? "were hits" : "hits", per_hit,
+                  human_bytes(static_cast<double>(available_memory_bytes())).c_str());
+    throw InputError(plan.place + buf);
+}
+
+void check_points(const TablePlan& plan) {
+    const TableHeader& h = plan.header;
+    const long double nx = h.cells[0], ny = h.cells[1], nz = h.cells[2];
+    // An upper bound (edges counted twice).
+    const long double points = 2 * ((nx + 1) * (ny + 1) + (ny + 1) * (nz + 1) + (nz + 1) * (nx + 1));
+    if (points >= static_cast<long double>(0xFFFFFFFFu))
+        throw InputError(plan.place + "a lattice of " + lattice_size(h) +
+                         " has too many boundary points to index");
+    const std::uint64_t count = BoundaryGrid(h.cells).count();
+    if (count > plan.encoding->max_points)
+        throw InputError(plan.place + "the " + h.encoding + " encoding keys at most " +
+                         std::to_string(plan.encoding->max_points) + " boundary points; a lattice of " +
+                         lattice_size(h) + " has " + std::to_string(count));
+}
+
+}  // namespace
+
+void check_buildable(const TablePlan& plan) {
+    check_inside_box(plan);
+    if (plan.encoding->refuses)
+        if (const std::string why = plan.encoding->refuses(*plan.primitive->shape); !why.empty())
+            throw InputError(plan.place + "primitive '" + plan.primitive->name + "': " + why);
+    const double pairs = static_cast<double>(pair_count(plan.header));
+    const double per_hit = plan.encoding->bytes_per_hit + sizeof(RawHit);
+    const double avail = static_cast<double>(available_memory_bytes());
+    // Even a 1 % hit rate is too much: refuse without tracing anything.
+    if (avail > 0 && pairs * 0.01 * per_hit > 0.8 * avail)
+        refuse_memory(plan, 0.01, pairs * 0.01 * per_hit, true);
+    check_points(plan);
+    // Estimate the hit rate by tracing every n-th entry point.
+    RasterizeOptions opt;
+    opt.keep_hits = false;
+    opt.entry_stride = std::max<std::uint32_t>(1, BoundaryGrid(plan.header.cells).count() / 512);
+    const RasterizeResult sample = rasterize(plan.context, opt);
+    const double rate =
+        sample.pairs_traced ? double(sample.hits) / double(sample.pairs_traced) : 0.0;
+    const double need = pairs * rate * per_hit;
+    if (avail > 0 && need > 0.8 * avail) refuse_memory(plan, rate, need, false);
+}
+
+TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool progress) {
+    check_buildable(plan);
+    TableBuild b;
+    b.header = plan.header;
+    RasterizeOptions opt;
+    opt.progress = progress;
+    opt.keep_hits = plan.encoding->needs_hits;
+    b.raster = rasterize(plan.context, opt);
+    const auto t0 = std::chrono::steady_clock::now();
+    const ByteBuffer payload = plan.encoding->build(b.raster.raw, plan.context, plan.options);
+    b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    b.raster.raw = {};
+    b.header.pairs = b.raster.pairs_eq2;
+    b.header.entries = b.raster.hits;
+    write_table_file(path, b.header, payload);
+    b.bytes = payload.size() + kTableHeaderBytes + b.header.metadata.size();
+    return b;
+}
+
+}  // namespace lat

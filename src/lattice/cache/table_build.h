@@ -1,0 +1,27 @@
+#pragma once
+// Building a primitive's table file: the checks made before any long work, rasterizing,
+// encoding and writing.
+#include <string>
+
+#include "lattice/cache/table_spec.h"
+#include "lattice/rasterizer.h"
+
+namespace lat {
+
+// Throws InputError (naming the scene file and the primitive), before any long work, when the
+// table cannot be built here: the primitive leaves its lattice box, the encoding cannot key
+// that many points or refuses the primitive, or the table would not fit in memory (the message
+// gives the size it would need).
+void check_buildable(const TablePlan& plan);
+
+struct TableBuild {
+    TableHeader header;
+    RasterizeResult raster;  // counts and timing (hits not kept)
+    double encode_seconds = 0;
+    std::uint64_t bytes = 0;  // the whole file
+};
+
+// Checks, rasterizes the primitive, encodes the table and writes it to `path` atomically.
+TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool progress);
+
+}  // namespace lat

@@ -1,0 +1,78 @@
+#include "lattice/cache/table_cache.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include "lattice/cache/table_build.h"
+#include "util/error.h"
+
+namespace lat {
+
+std::string default_cache_dir() {
+    if (const char* d = std::getenv("LATTICE_CACHE_DIR"); d && *d) return d;
+    if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/lattice";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return std::string(home) + "/.cache/lattice";
+    return ".lattice-cache";
+}
+
+TableCache::TableCache(const std::string& dir, bool explicit_dir) : dir_(dir) {
+    struct stat st {};
+    if (::stat(dir_.c_str(), &st) != 0) {
+        if (explicit_dir)
+            throw InputError(dir_ +
+                             ": lattice cache directory does not exist: " + std::strerror(errno));
+        std::error_code ec;
+        std::filesystem::create_directories(dir_, ec);
+        if (ec)
+            throw InputError(dir_ + ": cannot create the lattice cache directory: " + ec.message());
+    } else if (!S_ISDIR(st.st_mode)) {
+        throw InputError(dir_ + ": lattice cache is not a directory");
+    }
+    if (::access(dir_.c_str(), R_OK | W_OK | X_OK) != 0)
+        throw InputError(dir_ + ": lattice cache directory is not readable and writable: " +
+                         std::strerror(errno));
+}
+
+std::string TableCache::path_for(const TablePlan& plan) const {
+    const TableHeader& h = plan.header;
+    std::string safe;
+    for (char c : plan.primitive->name)
+        safe += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
+    char tail[64];
+    std::snprintf(tail, sizeof tail, "-s%d-%s-%016llx.lht", h.sigma_inv, h.encoding.c_str(),
+                  static_cast<unsigned long long>(h.fingerprint));
+    return dir_ + "/" + safe.substr(0, 64) + tail;
+}
+
+TableCache::Entry TableCache::get(const TablePlan& plan, bool progress) const {
+    Entry e;
+    e.path = path_for(plan);
+    struct stat st {};
+    if (::stat(e.path.c_str(), &st) != 0) {
+        const auto t0 = std::chrono::steady_clock::now();
+        build_table_file(plan, e.path, progress);
+        e.build_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        e.built = true;
+    }
+    try {
+        LoadedTable lt = load_table_file(e.path, &plan.header, plan.context.primitive);
+        e.table = lt.table;
+        e.header = lt.header;
+        e.bytes = lt.bytes;
+    } catch (const InputError& err) {
+        throw InputError(std::string(err.what()) + " (delete the file to rebuild it)");
+    }
+    return e;
+}
+
+}  // namespace lat

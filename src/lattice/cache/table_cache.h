@@ -1,0 +1,38 @@
+#pragma once
+// The on-disk cache of lattice tables that `render` uses, so that a lattice-mode render builds
+// each table once and then reuses it. A table's file name carries its plan's fingerprint.
+#include <memory>
+#include <string>
+
+#include "lattice/cache/table_spec.h"
+
+namespace lat {
+
+// The default cache directory: $LATTICE_CACHE_DIR, else $XDG_CACHE_HOME/lattice, else
+// ~/.cache/lattice.
+std::string default_cache_dir();
+
+class TableCache {
+public:
+    // An explicit directory must exist and be writable; the default one is created.
+    TableCache(const std::string& dir, bool explicit_dir);
+
+    const std::string& dir() const { return dir_; }
+    std::string path_for(const TablePlan& plan) const;
+
+    struct Entry {
+        std::shared_ptr<const LatticeTable> table;
+        TableHeader header;
+        std::string path;
+        std::uint64_t bytes = 0;  // the table's, with its file's header and metadata
+        bool built = false;
+        double build_seconds = 0;
+    };
+    // Loads the cached table, or builds and caches it.
+    Entry get(const TablePlan& plan, bool progress) const;
+
+private:
+    std::string dir_;
+};
+
+}  // namespace lat

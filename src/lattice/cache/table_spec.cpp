@@ -1,0 +1,62 @@
+#include "lattice/cache/table_spec.h"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "util/error.h"
+#include "util/hash.h"
+
+namespace lat {
+
+std::string sigma_inv_error(long long k) {
+    if (k >= 1 && k <= kMaxSigmaInv) return {};
+    return "sigma^-1 = " + std::to_string(k) + " is out of range (1 to " +
+           std::to_string(kMaxSigmaInv) + ")";
+}
+
+void check_sigma_inv(long long k, const std::string& where) {
+    if (const std::string e = sigma_inv_error(k); !e.empty()) throw InputError(where + ": " + e);
+}
+
+TablePlan plan_table(const Primitive& p, const TableSpec& spec, const std::string& scene_file) {
+    TablePlan plan;
+    plan.primitive = &p;
+    plan.place = located_message(scene_file, p.where, "");
+    if (!p.lattice)
+        throw InputError(plan.place + "primitive '" + p.name +
+                         "' has no lattice (add \"lattice\": {\"sigma\": ..., \"cells\": [...]})");
+    check_sigma_inv(spec.sigma_inv, "--sigma-inv");
+    plan.encoding = &find_encoding(spec.encoding);
+    plan.options = spec.options;
+
+    TableHeader& h = plan.header;
+    h.encoding = plan.encoding->name;
+    h.sigma = p.lattice->sigma;
+    h.sigma_inv = spec.sigma_inv;
+    h.cell = p.lattice->sigma / spec.sigma_inv;
+    for (std::size_t a = 0; a < 3; ++a) {
+        const long long n = static_cast<long long>(p.lattice->cells[a]) * spec.sigma_inv;
+        h.cells[a] = static_cast<int>(std::min<long long>(n, 0x7FFFFFFF));
+    }
+    h.fingerprint = Fingerprint()
+                        .add(p.fingerprint)
+                        .add(h.sigma)
+                        .add(h.cells[0])
+                        .add(h.cells[1])
+                        .add(h.cells[2])
+                        .add(spec.sigma_inv)
+                        .add(h.encoding)
+                        .add(spec.options.max_point_error)
+                        .add(spec.options.max_normal_error_deg)
+                        .add(spec.options.normals)
+                        .add(kRasterizerVersion)
+                        .value();
+    h.metadata = nlohmann::json{{"primitive", p.name},
+                                {"definition", nlohmann::json::parse(p.definition)},
+                                {"scene", scene_file}}
+                     .dump();
+    plan.context = h.context(p.shape.get());
+    return plan;
+}
+
+}  // namespace lat

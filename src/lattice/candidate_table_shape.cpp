@@ -1,0 +1,50 @@
+#include "lattice/candidate_table_shape.h"
+
+#include <cassert>
+
+namespace lat {
+
+CandidateTableShape::CandidateTableShape(std::shared_ptr<const LatticeTable> table,
+                                         const TableContext& ctx)
+    : table_(std::move(table)), primitive_(ctx.primitive), frame_(ctx, 0.0) {
+    assert(primitive_ && table_->kind() == LatticeTable::Kind::kCandidates);
+}
+
+void CandidateTableShape::cull_boxes(std::vector<Bounds3>& out) const {
+    out.insert(out.end(), frame_.cull_boxes().begin(), frame_.cull_boxes().end());
+}
+
+bool CandidateTableShape::candidates(const Ray& r, CandidateList& list) const {
+    LatticeFrame::Snap s;
+    return frame_.snap(r, s) && table_->candidates(s.a, s.b, list);
+}
+
+bool CandidateTableShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    CandidateList list;
+    if (!candidates(r, list)) return false;
+    bool found = false;
+    for (int k = 0; k < list.count; ++k)
+        if (primitive_->intersect_primitive(list.parts[k], r, tmin, tmax, hit)) {
+            tmax = hit.t;
+            found = true;
+        }
+    return found;
+}
+
+bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const {
+    CandidateList list;
+    if (!candidates(r, list)) return false;
+    for (int k = 0; k < list.count; ++k)
+        if (primitive_->occluded_primitive(list.parts[k], r, tmin, tmax)) return true;
+    return false;
+}
+
+void CandidateTableShape::spans(const Ray& r, SpanList& out) const {
+    CandidateList list;
+    if (!candidates(r, list)) return;
+    const std::size_t first = out.size();
+    for (int k = 0; k < list.count; ++k) primitive_->primitive_spans(list.parts[k], r, out);
+    merge_span_union(out, first);  // the union of the candidate parts' spans
+}
+
+}  // namespace lat

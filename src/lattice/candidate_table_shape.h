@@ -1,0 +1,36 @@
+#pragma once
+// An exact lattice: the table (encoding `candidates`) names, per snapped pair, the parts of the
+// primitive that a ray snapping to it can meet, and those are intersected exactly with the
+// real ray. Images equal exact mode; the cost of a ray depends on how many parts lie near it,
+// not on how many the primitive has.
+#include <memory>
+
+#include "lattice/lattice_shape.h"
+
+namespace lat {
+
+class CandidateTableShape final : public Shape {
+public:
+    // ctx.primitive must be set and outlive the shape.
+    CandidateTableShape(std::shared_ptr<const LatticeTable> table, const TableContext& ctx);
+
+    Bounds3 bounds() const override { return frame_.box(); }
+    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
+    bool occluded(const Ray& r, double tmin, double tmax) const override;
+    void spans(const Ray& r, SpanList& out) const override;
+    Vec3 normal(const Ray& r, const Crossing& c) const override {
+        return primitive_->normal(r, c);
+    }
+    bool inside(Vec3 p) const override { return primitive_->inside(p); }
+    void cull_boxes(std::vector<Bounds3>& out) const override;
+
+private:
+    std::shared_ptr<const LatticeTable> table_;
+    const Shape* primitive_;
+    LatticeFrame frame_;
+
+    // The parts the ray can meet; false when none.
+    bool candidates(const Ray& r, CandidateList& list) const;
+};
+
+}  // namespace lat

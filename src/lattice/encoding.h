@@ -1,0 +1,53 @@
+#pragma once
+// A table encoding is one descriptor: its name, its limits, and how it is built, opened and
+// bounded. Each lives in its own folder (lattice/encodings/<name>/) and is listed once, in
+// lattice/encodings/registry.cpp; everything else finds it by name through find_encoding and
+// then only goes through the descriptor and the LatticeTable interface.
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "lattice/table.h"
+#include "util/big_buffer.h"
+
+namespace lat {
+
+// Error targets for the encodings that quantise (in units of the primitive's sigma, degrees).
+struct EncodeOptions {
+    double max_point_error = 0.01;
+    double max_normal_error_deg = 1.0;
+    std::string normals = "auto";  // dense: "oct", "part" or "auto" (the smaller)
+};
+
+struct Encoding {
+    std::string_view name;
+    std::string_view summary;
+    LatticeTable::Kind kind = LatticeTable::Kind::kHits;
+    std::uint64_t max_points = 0;  // boundary points it can key
+    double bytes_per_hit = 0;      // at the build's peak, for planning memory before a build
+    bool needs_hits = true;        // built from rasterized hits (else from the primitive itself)
+
+    // The payload. `hits` are the rasterized hits when needs_hits (else empty); ctx.primitive
+    // is set. Must not depend on the thread count.
+    ByteBuffer (*build)(const RawHits& hits, const TableContext& ctx, const EncodeOptions& opt);
+    // The table over a payload (which must outlive it); throws std::runtime_error when the
+    // payload is inconsistent.
+    std::unique_ptr<LatticeTable> (*open)(const std::uint8_t* payload, std::size_t size,
+                                          std::uint64_t entries, const TableContext& ctx);
+    // How far (primitive units) a stored hit can lie from the primitive's surface at most;
+    // infinity when it can answer pairs whose segment misses (perfect hashing). The renderer
+    // culls rays far from the primitive by it without changing any answer.
+    double (*error_bound)(const TableContext& ctx, const EncodeOptions& opt);
+    // Limits on the primitive beyond the point count: empty when it can be built, else why not
+    // (the caller adds the file and place). Null: no such limits.
+    std::string (*refuses)(const Shape& primitive) = nullptr;
+};
+
+// Every registered encoding, in the order they are listed to users.
+std::span<const Encoding* const> encodings();
+// Throws InputError listing the known encodings when `name` is not one.
+const Encoding& find_encoding(std::string_view name);
+
+}  // namespace lat

@@ -1,0 +1,33 @@
+#include "lattice/encoding.h"
+#include "lattice/encodings/candidates/candidates_table.h"
+
+namespace lat {
+
+extern const Encoding kCandidatesEncoding;
+const Encoding kCandidatesEncoding{
+    .name = "candidates",
+    .summary = "exact: per pair the parts a ray can meet, intersected exactly at render",
+    .kind = LatticeTable::Kind::kCandidates,
+    .max_points = 0xFFFFFFFFull,
+    .bytes_per_hit = 2.0,
+    .needs_hits = false,
+    .build = [](const RawHits&, const TableContext& ctx, const EncodeOptions&) {
+        return CandidatesTable::build(ctx, false);
+    },
+    .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
+               const TableContext& ctx) -> std::unique_ptr<LatticeTable> {
+        return std::make_unique<CandidatesTable>(payload, size, entries, ctx);
+    },
+    .error_bound = [](const TableContext&, const EncodeOptions&) {
+        return 0.0;  // exact hits on the real ray
+    },
+    .refuses = [](const Shape& primitive) -> std::string {
+        if (primitive.primitive_count() <= CandidatesTable::kMaxParts) return {};
+        return "the candidates encoding handles primitives of at most " +
+               std::to_string(CandidatesTable::kMaxParts) + " parts; this one has " +
+               std::to_string(primitive.primitive_count()) +
+               " (choose another encoding, e.g. dense)";
+    },
+};
+
+}  // namespace lat

@@ -1,0 +1,291 @@
+#include "lattice/encodings/candidates/candidates_table.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "geometry/chain.h"
+#include "lattice/face_cones.h"
+#include "util/progress.h"
+
+namespace lat {
+namespace {
+
+constexpr std::uint64_t kMagic = 0x31444E4143'5441ull;  // tag for "CAND1"
+
+struct Header {
+    std::uint64_t magic;
+    std::uint32_t points, set_bits;
+    std::uint64_t domain, occupied;
+    std::uint32_t sets, pad;
+    std::uint64_t reserved[3];
+};
+static_assert(sizeof(Header) == 64);
+
+
+struct Sections {
+    std::uint64_t occ, counts, ids, masks, total;
+};
+
+Sections sections(std::uint64_t domain, std::uint64_t occupied, std::uint32_t set_bits, std::uint32_t sets) {
+    Sections s{};
+    const std::uint64_t nwords = words_for_bits(domain);
+    s.occ = sizeof(Header);
+    s.counts = s.occ + nwords * 8;
+    s.ids = s.counts + (RankIndex::count_entries(nwords) * 4 + 7) / 8 * 8;
+    s.masks = s.ids + (words_for_bits(occupied * set_bits) + 1) * 8;
+    s.total = s.masks + static_cast<std::uint64_t>(sets) * 8;
+    return s;
+}
+
+double point_segment_distance(Vec3 c, Vec3 p, Vec3 q) {
+    const Vec3 d = q - p;
+    const double dd = dot(d, d);
+    const double t = dd > 0 ? std::clamp(dot(c - p, d) / dd, 0.0, 1.0) : 0.0;
+    return length(p + d * t - c);
+}
+
+double segment_segment_distance(Vec3 p0, Vec3 p1, Vec3 q0, Vec3 q1) {
+    const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+    const double a = dot(d1, d1), e = dot(d2, d2), f = dot(d2, r);
+    double s = 0, t = 0;
+    if (a <= 1e-300 && e <= 1e-300) return length(r);
+    if (a <= 1e-300) {
+        t = std::clamp(f / e, 0.0, 1.0);
+    } else {
+        const double c = dot(d1, r);
+        if (e <= 1e-300) {
+            s = std::clamp(-c / a, 0.0, 1.0);
+        } else {
+            const double b = dot(d1, d2), den = a * e - b * b;
+            s = den > 0 ? std::clamp((b * f - c * e) / den, 0.0, 1.0) : 0.0;
+            t = (b * s + f) / e;
+            if (t < 0) t = 0, s = std::clamp(-c / a, 0.0, 1.0);
+            else if (t > 1) t = 1, s = std::clamp((b - c) / a, 0.0, 1.0);
+        }
+    }
+    return length(p0 + d1 * s - (q0 + d2 * t));
+}
+
+// One part of the primitive, in lattice units: what "within reach of a segment" means for it.
+struct Part {
+    enum Kind { kSphere, kCapsule, kSpheres } kind;
+    Vec3 a, b;                            // centre, or capsule axis
+    double r;                             // radius
+    std::vector<BoundingSphere> spheres;  // for other shapes
+    bool near(Vec3 p, Vec3 q, double reach) const {
+        if (kind == kSphere) return point_segment_distance(a, p, q) <= r + reach;
+        if (kind == kCapsule) return segment_segment_distance(p, q, a, b) <= r + reach;
+        for (const BoundingSphere& s : spheres)
+            if (point_segment_distance(s.center, p, q) <= s.radius + reach) return true;
+        return false;
+    }
+};
+
+std::vector<Part> parts_of(const Shape& shape, double cell) {
+    std::vector<Part> parts;
+    const auto* chain = dynamic_cast<const ChainShape*>(&shape);
+    for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
+        Part p{Part::kSpheres, {}, {}, 0, {}};
+        if (chain && i < chain->spheres().size()) {
+            p = {Part::kSphere, chain->spheres()[i].center / cell, {}, chain->spheres()[i].radius / cell, {}};
+        } else if (chain) {
+            const ChainCylinder& c = chain->cylinders()[i - chain->spheres().size()];
+            p = {Part::kCapsule, chain->spheres()[static_cast<std::size_t>(c.from)].center / cell,
+                 chain->spheres()[static_cast<std::size_t>(c.to)].center / cell, c.radius / cell, {}};
+        } else {
+            shape.primitive_spheres(i, p.spheres);
+            for (BoundingSphere& s : p.spheres) s = {s.center / cell, s.radius / cell};
+        }
+        parts.push_back(std::move(p));
+    }
+    return parts;
+}
+
+struct Scratch {
+    std::vector<std::uint64_t> mask;  // per face point
+    std::vector<std::size_t> touched;
+};
+
+struct Found {
+    std::uint64_t pair, mask;
+};
+
+}  // namespace
+
+ByteBuffer CandidatesTable::build(const TableContext& ctx, bool progress) {
+    if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
+    const Shape& shape = *ctx.primitive;
+    if (shape.primitive_count() > kMaxParts)
+        throw std::runtime_error("candidates: the primitive has more than 64 parts");
+    const BoundaryGrid grid(ctx.cells);
+    const std::vector<Part> parts = parts_of(shape, ctx.cell);
+    // Culling spheres, grown by the reach, grouped by part.
+    std::vector<PartSphere> cull;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        std::vector<BoundingSphere> bs;
+        shape.primitive_spheres(i, bs);
+        for (const BoundingSphere& b : bs)
+            cull.push_back({b.center / ctx.cell, (b.radius / ctx.cell + kSnapReach) * (1 + 1e-9) + 1e-9,
+                            static_cast<std::uint32_t>(i)});
+    }
+    std::array<FaceLayout, 6> faces;
+    for (int f = 0; f < 6; ++f) faces[static_cast<std::size_t>(f)] = layout_face(grid, f);
+
+    const std::uint32_t npoints = grid.count();
+    constexpr std::uint32_t kBlock = 32;
+    const std::uint32_t nblocks = (npoints + kBlock - 1) / kBlock;
+    std::vector<std::vector<Found>> found(nblocks);
+    tbb::enumerable_thread_specific<Scratch> scratch;
+    ProgressBar bar("candidates", npoints, progress);
+    tbb::parallel_for(std::uint32_t{0}, nblocks, [&](std::uint32_t blk) {
+        Scratch& s = scratch.local();
+        std::vector<Found>& out = found[blk];
+        for (std::uint32_t a = blk * kBlock; a < std::min(npoints, (blk + 1) * kBlock); ++a) {
+            const GridPoint ga = grid.point(a);
+            const std::uint8_t fa = grid.faces(ga);
+            const Vec3 p = to_vec(ga);
+            // The pair of a point with itself: parts within reach of the point.
+            std::uint64_t self = 0;
+            for (std::size_t i = 0; i < parts.size(); ++i)
+                if (parts[i].near(p, p, kSnapReach)) self |= std::uint64_t{1} << i;
+            if (self) out.push_back({pair_index(a, a), self});
+            for (const FaceLayout& fl : faces) {
+                if (s.mask.size() < fl.mask.size()) s.mask.assign(fl.mask.size(), 0);
+                for (const PartSphere& ps : cull) {
+                    const std::uint64_t bit = std::uint64_t{1} << ps.part;
+                    for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
+                        if (fl.ids[k] <= a || (s.mask[k] & bit)) return;
+                        if (!BoundaryGrid::valid_pair(fa, fl.mask[k])) return;
+                        if (!parts[ps.part].near(p, q, kSnapReach)) return;
+                        if (!s.mask[k]) s.touched.push_back(k);
+                        s.mask[k] |= bit;
+                    });
+                }
+                for (const std::size_t k : s.touched) {
+                    out.push_back({pair_index(a, fl.ids[k]), s.mask[k]});
+                    s.mask[k] = 0;
+                }
+                s.touched.clear();
+            }
+        }
+        std::sort(out.begin(), out.end(), [](const Found& x, const Found& y) { return x.pair < y.pair; });
+        bar.add(std::min(npoints, (blk + 1) * kBlock) - blk * kBlock);
+    });
+    bar.finish();
+
+    // Distinct part sets, numbered in first-seen order (deterministic).
+    std::unordered_map<std::uint64_t, std::uint32_t> set_id;
+    std::vector<std::uint64_t> sets;
+    std::uint64_t occupied = 0;
+    for (const auto& block : found)
+        for (const Found& f : block) {
+            ++occupied;
+            if (set_id.emplace(f.mask, std::uint32_t(sets.size())).second) sets.push_back(f.mask);
+        }
+    std::uint32_t set_bits = 0;
+    while ((1ull << set_bits) < sets.size()) ++set_bits;
+    const std::uint64_t domain = static_cast<std::uint64_t>(npoints) * (npoints + 1) / 2;
+    const std::uint64_t nwords = words_for_bits(domain);
+    const Sections sec = sections(domain, occupied, set_bits, std::uint32_t(sets.size()));
+    ByteBuffer payload(sec.total);
+    std::memset(payload.data(), 0, sec.total);
+    auto* occ = reinterpret_cast<std::uint64_t*>(payload.data() + sec.occ);
+    for (const auto& block : found)
+        for (const Found& f : block) occ[f.pair >> 6] |= std::uint64_t{1} << (f.pair & 63);
+    auto* counts = reinterpret_cast<std::uint32_t*>(payload.data() + sec.counts);
+    RankIndex::build(occ, nwords, counts);
+    const RankIndex rank(occ, counts);
+    auto* ids = reinterpret_cast<std::uint64_t*>(payload.data() + sec.ids);
+    if (set_bits)
+        for (const auto& block : found)
+            for (const Found& f : block) write_bits(ids, rank.rank(f.pair) * set_bits, set_bits, set_id[f.mask]);
+    std::memcpy(payload.data() + sec.masks, sets.data(), sets.size() * 8);
+    const Header h{kMagic, npoints, set_bits, domain, occupied, std::uint32_t(sets.size()), 0, {0, 0, 0}};
+    std::memcpy(payload.data(), &h, sizeof h);
+    return payload;
+}
+
+CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
+                                 const TableContext& ctx)
+    : entries_(entries), size_(size), ctx_(ctx), grid_(ctx.cells) {
+    if (size < sizeof(Header)) throw std::runtime_error("candidates: payload too small");
+    if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
+    Header h;
+    std::memcpy(&h, payload, sizeof h);
+    if (h.magic != kMagic) throw std::runtime_error("candidates: bad payload tag");
+    points_ = h.points, set_bits_ = h.set_bits, sets_ = h.sets, occupied_ = h.occupied;
+    if (points_ != grid_.count() || h.domain != std::uint64_t(points_) * (points_ + 1) / 2 ||
+        set_bits_ > 32 || (sets_ > 1 && (1ull << set_bits_) < sets_))
+        throw std::runtime_error("candidates: inconsistent layout");
+    const Sections sec = sections(h.domain, h.occupied, h.set_bits, h.sets);
+    if (sec.total != size) throw std::runtime_error("candidates: payload size does not match its layout");
+    const std::uint64_t nwords = words_for_bits(h.domain);
+    const auto* counts = reinterpret_cast<const std::uint32_t*>(payload + sec.counts);
+    if (counts[RankIndex::count_entries(nwords) - 1] != occupied_)
+        throw std::runtime_error("candidates: rank directory does not match its count");
+    rank_ = RankIndex(reinterpret_cast<const std::uint64_t*>(payload + sec.occ), counts);
+    ids_ = reinterpret_cast<const std::uint64_t*>(payload + sec.ids);
+    masks_ = reinterpret_cast<const std::uint64_t*>(payload + sec.masks);
+    const std::uint64_t nparts = ctx.primitive->primitive_count();
+    for (std::uint32_t i = 0; i < sets_; ++i)
+        if (nparts < 64 && (masks_[i] >> nparts) != 0)
+            throw std::runtime_error("candidates: a part set names parts the primitive does not have");
+}
+
+std::string CandidatesTable::details() const {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "%llu pairs with candidates, %u distinct part sets (%u bits a pair)",
+                  static_cast<unsigned long long>(occupied_), sets_, set_bits_);
+    return buf;
+}
+
+bool CandidatesTable::candidates(std::uint32_t a, std::uint32_t b, CandidateList& out) const {
+    if (a >= points_ || b >= points_) return false;
+    const std::uint64_t i = pair_index(std::min(a, b), std::max(a, b));
+    if (!rank_.test(i)) return false;
+    const std::uint64_t id = set_bits_ ? read_bits(ids_, rank_.rank(i) * set_bits_, set_bits_) : 0;
+    if (id >= sets_) return false;  // corrupt
+    std::uint64_t m = masks_[id];
+    out.count = 0;
+    while (m) {
+        out.parts[out.count++] = static_cast<std::uint32_t>(std::countr_zero(m));
+        m &= m - 1;
+    }
+    return true;
+}
+
+bool CandidatesTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
+    // As rasterization answers: the candidates intersected exactly with the segment.
+    CandidateList list;
+    if (a == b || !candidates(a, b, list)) return false;
+    const Vec3 pa = to_vec(grid_.point(a)), pb = to_vec(grid_.point(b));
+    const Ray seg{pa * ctx_.cell, (pb - pa) * ctx_.cell};
+    const Shape& shape = *ctx_.primitive;
+    if (shape.inside(seg.o)) {  // a point of the closed solid on the box: the hit is the point
+        SpanList spans;
+        shape.spans(seg, spans);
+        Crossing best{kInfinity, 0, 0};
+        for (const Span& sp : spans)
+            for (const Crossing& c : {sp.in, sp.out})
+                if (std::abs(c.t) < std::abs(best.t)) best = c;
+        hit = {0.0, normalize(shape.normal(seg, {0.0, best.part, best.leaf}))};
+        return true;
+    }
+    Crossing best{kInfinity, 0, 0};
+    for (int k = 0; k < list.count; ++k) {
+        Crossing c;
+        if (shape.intersect_primitive(list.parts[k], seg, 0.0, std::min(best.t, 1.0 + 1e-12), c)) best = c;
+    }
+    if (best.t > 1.0) return false;
+    hit = {std::min(best.t, 1.0), normalize(shape.normal(seg, best))};
+    return true;
+}
+
+}  // namespace lat

@@ -1,0 +1,265 @@
+#include "lattice/encodings/dense/dense_table.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <stdexcept>
+
+#include "geometry/shape.h"
+#include "lattice/octahedral.h"
+
+namespace lat {
+namespace {
+
+constexpr std::uint64_t kMagic = 0x31454E4553'4E4544ull;  // "DENSE1" little-endian-ish tag
+constexpr double kRawNormalSlack = 0.01;  // degrees: the raw 16-bit normals' own error, bounded
+
+struct Header {
+    std::uint64_t magic;
+    std::uint32_t points, t_bits;
+    std::uint64_t domain, occupied;
+    std::uint32_t normal_mode, normal_bits, parts, pad;
+    std::uint64_t reserved[2];
+};
+static_assert(sizeof(Header) == 64);
+
+
+struct Sections {
+    std::uint64_t occ, counts, records, codes, total;  // byte offsets
+};
+
+Sections sections(const DenseTable::Layout& l) {
+    Sections s{};
+    const std::uint64_t nwords = words_for_bits(l.domain);
+    const std::uint64_t record_bits = 2ull * (l.t_bits + l.normal_bits);
+    s.occ = sizeof(Header);
+    s.counts = s.occ + nwords * 8;
+    s.records = s.counts + (RankIndex::count_entries(nwords) * 4 + 7) / 8 * 8;
+    s.codes = s.records + (words_for_bits(l.occupied * record_bits) + 1) * 8;
+    s.total = s.codes + static_cast<std::uint64_t>(l.parts) * 8;
+    return s;
+}
+
+double angle_deg(Vec3 a, Vec3 b) {
+    return std::acos(std::clamp(dot(a, b), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+// The largest of f(hit) over all hits (in parallel over chunks), optionally over every n-th.
+template <class F>
+double max_over(const RawHits& hits, F f, std::size_t stride = 1) {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, hits.chunks.size()), 0.0,
+        [&](const tbb::blocked_range<std::size_t>& r, double m) {
+            for (std::size_t c = r.begin(); c != r.end(); ++c)
+                for (std::size_t i = 0; i < hits.chunks[c].size(); i += stride) m = std::max(m, f(hits.chunks[c][i]));
+            return m;
+        },
+        [](double x, double y) { return std::max(x, y); });
+}
+
+std::uint32_t quantise(double t, std::uint32_t bits) {
+    const double top = double((1ull << bits) - 1);
+    return static_cast<std::uint32_t>(std::lround(std::clamp(t, 0.0, 1.0) * top));
+}
+
+}  // namespace
+
+ByteBuffer DenseTable::build(const RawHits& raw, const TableContext& ctx, const EncodeOptions& opt) {
+    const BoundaryGrid grid(ctx.cells);
+    Layout l;
+    l.points = grid.count();
+    l.domain = static_cast<std::uint64_t>(l.points) * (l.points - 1) / 2;
+    std::vector<Vec3> point(l.points);
+    for (std::uint32_t i = 0; i < l.points; ++i) point[i] = to_vec(grid.point(i));
+    auto normal_of = [](const RawHit& h) { return oct_decode({h.nu, h.nv}, kRawNormalBits); };
+    auto segment = [&](const RawHit& h) {
+        return Ray{point[h.a] * ctx.cell, (point[h.b] - point[h.a]) * ctx.cell};
+    };
+
+    // t: the fewest bits whose rounding keeps every point within the target.
+    const double lmax = max_over(raw, [&](const RawHit& h) {
+        return length(point[h.b] - point[h.a]) * ctx.cell / ctx.sigma;
+    });
+    std::uint32_t t_bits = 1;
+    while (t_bits < 30 && 0.5 / double((1ull << t_bits) - 1) * lmax > opt.max_point_error) ++t_bits;
+
+    // Part codes: the normal re-evaluated at the decoded point; t may need more bits for it.
+    std::map<std::pair<std::uint16_t, std::uint16_t>, std::uint32_t> code_of;
+    std::vector<std::uint32_t> codes;
+    bool part_possible = ctx.primitive != nullptr && opt.normals != "oct";
+    std::uint32_t part_t_bits = t_bits, part_bits = 0;
+    if (part_possible) {
+        for (const auto& chunk : raw.chunks)
+            for (const RawHit& h : chunk)
+                if (code_of.emplace(std::make_pair(h.part, h.leaf), std::uint32_t(code_of.size())).second) {
+                    const Crossing c = h.crossing(0);
+                    codes.push_back(c.part);
+                    codes.push_back(c.leaf);
+                }
+        while ((1ull << part_bits) < code_of.size()) ++part_bits;
+        auto normal_at = [&](const RawHit& h, double t) {
+            return normalize(ctx.primitive->normal(segment(h), h.crossing(t)));
+        };
+        for (;; ++part_t_bits) {
+            if (part_t_bits > 30) {
+                part_possible = false;
+                break;
+            }
+            const double top = double((1ull << part_t_bits) - 1);
+            const double worst = max_over(raw, [&](const RawHit& h) {
+                return angle_deg(normal_at(h, h.t), normal_at(h, quantise(h.t, part_t_bits) / top));
+            });
+            if (worst + kRawNormalSlack <= opt.max_normal_error_deg) break;
+        }
+    }
+    // Octahedral normals: the fewest bits per component within the target (found on a sample,
+    // then checked on every hit), unless part codes are sure to be smaller.
+    std::uint32_t oct_bits = 16;
+    const bool need_oct = !part_possible || opt.normals == "oct" ||
+                          (opt.normals == "auto" && t_bits + 2 * 4 < part_t_bits + part_bits);
+    if (need_oct) {
+        auto worst_at = [&](std::uint32_t b, std::size_t stride) {
+            return max_over(raw, [&](const RawHit& h) {
+                const Vec3 n = normal_of(h);
+                return angle_deg(n, oct_decode(oct_encode_precise(n, int(b)), int(b)));
+            }, stride);
+        };
+        oct_bits = 4;
+        while (oct_bits < 16 && worst_at(oct_bits, 61) + kRawNormalSlack > opt.max_normal_error_deg) ++oct_bits;
+        while (oct_bits < 16 && worst_at(oct_bits, 1) + kRawNormalSlack > opt.max_normal_error_deg) ++oct_bits;
+    }
+    const std::uint32_t oct_record = t_bits + 2 * oct_bits, part_record = part_t_bits + part_bits;
+    if (opt.normals == "part" && !part_possible)
+        throw std::runtime_error("dense: part normals need the primitive");
+    const bool use_part = part_possible && (opt.normals == "part" || part_record < oct_record || !need_oct);
+    l.normal_mode = use_part ? 1 : 0;
+    l.t_bits = use_part ? part_t_bits : t_bits;
+    l.normal_bits = use_part ? part_bits : 2 * oct_bits;
+    l.parts = use_part ? static_cast<std::uint32_t>(code_of.size()) : 0;
+
+    // Occupancy: a pair is stored when either direction hits.
+    const std::uint64_t nwords = words_for_bits(l.domain);
+    std::vector<std::uint64_t> occ(nwords, 0);
+    tbb::parallel_for(std::size_t{0}, raw.chunks.size(), [&](std::size_t c) {
+        for (const RawHit& h : raw.chunks[c]) {
+            const std::uint64_t i = pair_index(std::min(h.a, h.b), std::max(h.a, h.b));
+            std::atomic_ref<std::uint64_t>(occ[i >> 6]).fetch_or(std::uint64_t{1} << (i & 63),
+                                                                  std::memory_order_relaxed);
+        }
+    });
+    std::vector<std::uint32_t> counts(RankIndex::count_entries(nwords));
+    RankIndex::build(occ.data(), nwords, counts.data());
+    l.occupied = counts.back();
+
+    const Sections sec = sections(l);
+    ByteBuffer payload(sec.total);
+    std::memset(payload.data(), 0, sec.total);
+    const Header hdr{kMagic, l.points, l.t_bits, l.domain, l.occupied, l.normal_mode, l.normal_bits, l.parts, 0, {0, 0}};
+    std::memcpy(payload.data(), &hdr, sizeof hdr);
+    std::memcpy(payload.data() + sec.occ, occ.data(), nwords * 8);
+    std::memcpy(payload.data() + sec.counts, counts.data(), counts.size() * 4);
+    if (l.parts) std::memcpy(payload.data() + sec.codes, codes.data(), codes.size() * 4);
+
+    // Records: both directions of each pair; a direction that missed only by rounding at a
+    // tangency takes the other's point, reversed.
+    const RankIndex rank(occ.data(), counts.data());
+    auto* rec = reinterpret_cast<std::uint64_t*>(payload.data() + sec.records);
+    const std::uint32_t field = l.t_bits + l.normal_bits;
+    std::vector<std::uint8_t> present(l.occupied, 0);
+    auto write_field = [&](std::uint64_t k, int dir, std::uint32_t tq, std::uint64_t n) {
+        const std::uint64_t off = k * 2 * field + static_cast<std::uint64_t>(dir) * field;
+        write_bits(rec, off, l.t_bits, tq);
+        if (l.normal_bits) write_bits(rec, off + l.t_bits, l.normal_bits, n);
+    };
+    auto normal_field = [&](const RawHit& h) -> std::uint64_t {
+        if (use_part) return code_of.find({h.part, h.leaf})->second;
+        const Oct o = oct_encode_precise(normal_of(h), int(l.normal_bits / 2));
+        return o.u | (std::uint64_t{o.v} << (l.normal_bits / 2));
+    };
+    for (const auto& chunk : raw.chunks)
+        for (const RawHit& h : chunk) {
+            const std::uint64_t k = rank.rank(pair_index(std::min(h.a, h.b), std::max(h.a, h.b)));
+            const int dir = h.a < h.b ? 0 : 1;
+            write_field(k, dir, quantise(h.t, l.t_bits), normal_field(h));
+            present[k] |= static_cast<std::uint8_t>(1 << dir);
+        }
+    // The rare lone direction (a tangency decided differently each way): copy it over.
+    for (const auto& chunk : raw.chunks)
+        for (const RawHit& h : chunk) {
+            const std::uint64_t k = rank.rank(pair_index(std::min(h.a, h.b), std::max(h.a, h.b)));
+            if (present[k] == 3) continue;
+            write_field(k, h.a < h.b ? 1 : 0, quantise(1.0 - double(h.t), l.t_bits), normal_field(h));
+        }
+    return payload;
+}
+
+DenseTable::DenseTable(const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
+                       const TableContext& ctx)
+    : entries_(entries), size_(size), ctx_(ctx), grid_(ctx.cells) {
+    if (size < sizeof(Header)) throw std::runtime_error("dense: payload too small");
+    Header h;
+    std::memcpy(&h, payload, sizeof h);
+    if (h.magic != kMagic) throw std::runtime_error("dense: bad payload tag");
+    l_ = {h.points, h.domain, h.occupied, h.t_bits, h.normal_mode, h.normal_bits, h.parts};
+    if (l_.points != grid_.count() || l_.domain != std::uint64_t(l_.points) * (l_.points - 1) / 2 ||
+        l_.t_bits < 1 || l_.t_bits > 30 || l_.normal_mode > 1 || l_.normal_bits > 32 ||
+        (l_.normal_mode == 0 && (l_.normal_bits % 2 || l_.normal_bits < 2)))
+        throw std::runtime_error("dense: inconsistent layout");
+    if (l_.normal_mode == 1 && !ctx.primitive)
+        throw std::runtime_error("dense: part normals need the primitive");
+    const Sections sec = sections(l_);
+    if (sec.total != size) throw std::runtime_error("dense: payload size does not match its layout");
+    const auto* counts = reinterpret_cast<const std::uint32_t*>(payload + sec.counts);
+    const std::uint64_t nwords = words_for_bits(l_.domain);
+    if (counts[RankIndex::count_entries(nwords) - 1] != l_.occupied)
+        throw std::runtime_error("dense: rank directory does not match its count");
+    rank_ = RankIndex(reinterpret_cast<const std::uint64_t*>(payload + sec.occ), counts);
+    records_ = reinterpret_cast<const std::uint64_t*>(payload + sec.records);
+    part_codes_ = reinterpret_cast<const std::uint32_t*>(payload + sec.codes);
+    t_scale_ = 1.0 / double((1ull << l_.t_bits) - 1);
+}
+
+std::string DenseTable::details() const {
+    const std::uint64_t nwords = words_for_bits(l_.domain);
+    char buf[400];
+    std::snprintf(buf, sizeof buf,
+                  "%llu of %llu pairs stored; t %u bits, normals %s %u bits%s; occupancy %llu bytes, "
+                  "rank directory %llu bytes, records %llu bytes",
+                  static_cast<unsigned long long>(l_.occupied), static_cast<unsigned long long>(l_.domain),
+                  l_.t_bits, l_.normal_mode ? "as part codes" : "octahedral", l_.normal_bits,
+                  l_.normal_mode ? (" (" + std::to_string(l_.parts) + " codes)").c_str() : "",
+                  static_cast<unsigned long long>(nwords * 8),
+                  static_cast<unsigned long long>(RankIndex::count_entries(nwords) * 4),
+                  static_cast<unsigned long long>((l_.occupied * 2 * (l_.t_bits + l_.normal_bits) + 7) / 8));
+    return buf;
+}
+
+bool DenseTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
+    if (a == b || a >= l_.points || b >= l_.points) return false;
+    const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
+    const std::uint64_t i = pair_index(lo, hi);
+    if (!rank_.test(i)) return false;
+    const std::uint64_t k = rank_.rank(i);
+    const std::uint32_t field = l_.t_bits + l_.normal_bits;
+    const std::uint64_t off = k * 2 * field + (a < b ? 0 : field);
+    hit.t = double(read_bits(records_, off, l_.t_bits)) * t_scale_;
+    const std::uint64_t n = l_.normal_bits ? read_bits(records_, off + l_.t_bits, l_.normal_bits) : 0;
+    if (l_.normal_mode == 0) {
+        const int bits = int(l_.normal_bits / 2);
+        hit.normal = oct_decode({std::uint32_t(n & ((1u << bits) - 1)), std::uint32_t(n >> bits)}, bits);
+        return true;
+    }
+    if (n >= l_.parts) return false;  // corrupt record
+    const Vec3 pa = to_vec(grid_.point(a)), pb = to_vec(grid_.point(b));
+    const Crossing c{hit.t, part_codes_[2 * n], part_codes_[2 * n + 1]};
+    hit.normal = normalize(ctx_.primitive->normal({pa * ctx_.cell, (pb - pa) * ctx_.cell}, c));
+    return true;
+}
+
+}  // namespace lat

@@ -1,0 +1,136 @@
+#include "lattice/encodings/hash14/hash14_table.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "lattice/octahedral.h"
+#include "util/hash.h"
+
+namespace lat {
+namespace {
+
+// Payload: u64 bucket count, then the entries (buckets first, then overflow).
+constexpr std::size_t kHeader = 8;
+
+// Multiply-shift range reduction (Lemire) of a mixed key; buckets < 2^32.
+std::uint64_t bucket_of(std::uint32_t a, std::uint32_t b, std::uint64_t buckets) {
+    const std::uint64_t h = mix64((static_cast<std::uint64_t>(a) << 16) | b);
+    return ((h >> 32) * buckets) >> 32;
+}
+
+}  // namespace
+
+ByteBuffer Hash14Table::build(const RawHits& hits) {
+    const std::uint64_t n = hits.size();
+    const std::uint64_t buckets = std::max<std::uint64_t>(1, n / 2);
+    if (buckets + n >= kEnd) throw std::length_error("hash14: too many entries for 32-bit links");
+    // Buckets are split into partitions small enough (4k buckets, 57 kB) to stay in cache
+    // while their hits are placed; hits are first sorted stably into their partitions.
+    constexpr int kPartBits = 12;
+    const std::uint64_t parts = (buckets + (1u << kPartBits) - 1) >> kPartBits;
+    auto part_of = [](std::uint64_t bucket) { return bucket >> kPartBits; };
+    const std::size_t nchunks = hits.chunks.size();
+    std::vector<std::uint64_t> count(nchunks * parts, 0);
+    tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
+        for (const RawHit& h : hits.chunks[c]) {
+            if (h.a >= kMaxPoints || h.b >= kMaxPoints)
+                throw std::length_error("hash14: point id over 16 bits");
+            ++count[c * parts + part_of(bucket_of(h.a, h.b, buckets))];
+        }
+    });
+    // Stable positions: partition by partition, chunk by chunk.
+    std::vector<std::uint64_t> offset(nchunks * parts), part_start(parts + 1, 0);
+    std::uint64_t pos = 0;
+    for (std::uint64_t p = 0; p < parts; ++p) {
+        part_start[p] = pos;
+        for (std::size_t c = 0; c < nchunks; ++c) {
+            offset[c * parts + p] = pos;
+            pos += count[c * parts + p];
+        }
+    }
+    part_start[parts] = pos;
+    ByteBuffer sorted_buf(n * sizeof(RawHit));
+    auto* sorted = reinterpret_cast<RawHit*>(sorted_buf.data());
+    tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
+        std::uint64_t* off = &offset[c * parts];
+        for (const RawHit& h : hits.chunks[c]) sorted[off[part_of(bucket_of(h.a, h.b, buckets))]++] = h;
+    });
+
+    // Which buckets are used, per partition (partition p owns buckets [b0(p), b0(p + 1))), fixes
+    // every partition's overflow area before anything is placed.
+    auto b0 = [&](std::uint64_t p) { return std::min(buckets, p << kPartBits); };
+    std::vector<std::uint64_t> over_count(parts, 0);
+    tbb::parallel_for(std::uint64_t{0}, parts, [&](std::uint64_t p) {
+        std::vector<bool> used(b0(p + 1) - b0(p), false);
+        std::uint64_t distinct = 0;
+        for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
+            auto&& u = used[bucket_of(sorted[i].a, sorted[i].b, buckets) - b0(p)];
+            distinct += !u;
+            u = true;
+        }
+        over_count[p] = (part_start[p + 1] - part_start[p]) - distinct;
+    });
+    std::vector<std::uint64_t> over_start(parts + 1, buckets);
+    for (std::uint64_t p = 0; p < parts; ++p) over_start[p + 1] = over_start[p] + over_count[p];
+
+    ByteBuffer payload(kHeader + over_start[parts] * sizeof(Hash14Entry));
+    std::memcpy(payload.data(), &buckets, 8);
+    auto* out = reinterpret_cast<Hash14Entry*>(payload.data() + kHeader);
+    tbb::parallel_for(std::uint64_t{0}, parts, [&](std::uint64_t p) {
+        for (std::uint64_t k = b0(p); k < b0(p + 1); ++k) out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, kEnd};
+        std::uint64_t next_over = over_start[p];
+        for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
+            const RawHit& h = sorted[i];
+            const auto t = static_cast<std::uint16_t>(std::lround(std::clamp(double(h.t), 0.0, 1.0) * 65535.0));
+            const Hash14Entry e{static_cast<std::uint16_t>(h.a), static_cast<std::uint16_t>(h.b), t,
+                                h.nu, h.nv, kEnd};
+            Hash14Entry& head = out[bucket_of(h.a, h.b, buckets)];
+            if (head.a == 0xFFFF) {
+                head = e;
+                continue;
+            }
+            // Collisions go right after the bucket's head in its chain.
+            Hash14Entry& slot = out[next_over];
+            slot = e;
+            slot.next = head.next;
+            head.next = static_cast<std::uint32_t>(next_over++);
+        }
+    });
+    return payload;
+}
+
+Hash14Table::Hash14Table(const std::uint8_t* payload, std::size_t size, std::uint64_t entries)
+    : entries_(entries), size_(size) {
+    if (size < kHeader) throw std::runtime_error("hash14: payload too small");
+    std::memcpy(&buckets_, payload, 8);
+    const std::size_t need = kHeader + buckets_ * sizeof(Hash14Entry);
+    if (buckets_ == 0 || need > size || (size - kHeader) % sizeof(Hash14Entry) != 0)
+        throw std::runtime_error("hash14: inconsistent payload size");
+    e_ = reinterpret_cast<const Hash14Entry*>(payload + kHeader);
+    const std::uint64_t total = (size - kHeader) / sizeof(Hash14Entry);
+    // Every chain link must stay inside the table (a corrupt file must not crash lookups).
+    for (std::uint64_t k = 0; k < total; ++k)
+        if (e_[k].next != kEnd && (e_[k].next >= total || e_[k].next < buckets_))
+            throw std::runtime_error("hash14: overflow chain out of range");
+}
+
+bool Hash14Table::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
+    if (a >= kMaxPoints || b >= kMaxPoints) return false;
+    const Hash14Entry* e = e_ + bucket_of(a, b, buckets_);
+    for (int guard = 0; guard < 1 << 20; ++guard) {
+        if (e->a == a && e->b == b) {
+            hit.t = e->t * (1.0 / 65535.0);
+            hit.normal = oct_decode({e->nu, e->nv}, kRawNormalBits);
+            return true;
+        }
+        if (e->next == kEnd) return false;
+        e = e_ + e->next;
+    }
+    return false;  // a cycle in a corrupt table
+}
+
+}  // namespace lat

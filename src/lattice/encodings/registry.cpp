@@ -1,0 +1,29 @@
+// The one list of table encodings. Adding one: a folder encodings/<name>/ with its table and
+// its descriptor (see docs/encodings.md, "Adding an encoding"), and its name in both lists here.
+#include "lattice/encoding.h"
+
+#include "util/error.h"
+
+namespace lat {
+
+extern const Encoding kHash14Encoding, kDenseEncoding, kCandidatesEncoding, kPerfect5Encoding,
+    kPerfect6Encoding, kPerfect7Encoding, kLearnedEncoding;
+
+std::span<const Encoding* const> encodings() {
+    static const Encoding* const all[] = {
+        &kHash14Encoding,   &kDenseEncoding,    &kCandidatesEncoding, &kPerfect5Encoding,
+        &kPerfect6Encoding, &kPerfect7Encoding, &kLearnedEncoding,
+    };
+    return all;
+}
+
+const Encoding& find_encoding(std::string_view name) {
+    std::string known;
+    for (const Encoding* e : encodings()) {
+        if (e->name == name) return *e;
+        known += (known.empty() ? "" : ", ") + std::string(e->name);
+    }
+    throw InputError("unknown table encoding '" + std::string(name) + "' (known: " + known + ")");
+}
+
+}  // namespace lat
