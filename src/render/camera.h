@@ -1,5 +1,5 @@
 #pragma once
-// The pinhole camera of the reference format (shared/reference/README.md): pixel (i, j), row 0
+// The pinhole camera of the reference format (docs/scene-format.md): pixel (i, j), row 0
 // at the top, sample offset (sx, sy) in [0, 1) with (0.5, 0.5) the pixel centre.
 #include "math/ray.h"
 #include "scene/scene.h"

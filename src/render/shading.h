@@ -1,5 +1,5 @@
 #pragma once
-// Phong shading with shadows, exactly as shared/reference/README.md states it.
+// Phong shading with shadows, exactly as the reference format states it (docs/scene-format.md).
 #include <cstdint>
 
 #include "render/render_scene.h"

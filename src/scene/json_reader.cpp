@@ -127,11 +127,6 @@ Vec3 JsonValue::direction() const {
     return v;
 }
 
-double JsonValue::number_or(const std::string& key, double def) const {
-    auto v = find(key);
-    return v ? v->number() : def;
-}
-
 Vec3 JsonValue::vec3_or(const std::string& key, Vec3 def) const {
     auto v = find(key);
     return v ? v->vec3() : def;

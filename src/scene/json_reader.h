@@ -55,7 +55,6 @@ public:
     Vec3 direction() const;  // non-zero vec3
 
     // Typed lookup with default.
-    double number_or(const std::string& key, double def) const;
     Vec3 vec3_or(const std::string& key, Vec3 def) const;
 
 private:

@@ -28,7 +28,7 @@ struct Table1Row {
     std::vector<Table1Cell> cells;
 };
 
-// Reads a Table 1 file (the format of shared/reference/table1.json, see
+// Reads a Table 1 file (the format of examples/table1.json, see
 // docs/table1.md) and counts every row; throws InputError for a malformed file.
 std::vector<Table1Row> compute_table1(const std::string& path, bool progress);
 

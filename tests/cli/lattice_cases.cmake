@@ -14,6 +14,7 @@ file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 set(P2 ${EXAMPLES}/plate2-thistle.json)
 set(P3 ${EXAMPLES}/plate3-hair-closeup.json)
+set(LIMITS ${DATA}/limits)
 
 if(CASE STREQUAL "corrupt")
   run(0 "" ${LATTICE} rasterize -q ${P3} --primitive hair --lattice-dir ${WORK})
@@ -56,6 +57,30 @@ elseif(CASE STREQUAL "too_big")
 elseif(CASE STREQUAL "unknown_primitive")
   run(2 "no primitive named 'fur' \\(it has: hair\\)"
       ${LATTICE} rasterize -q ${P3} --primitive fur -o ${WORK}/t.lht)
+elseif(CASE STREQUAL "candidates_part_limit")
+  # A user limit is an input error naming the place, in rasterize and in render.
+  set(why "primitives\\.chain: primitive 'chain': the candidates encoding handles primitives of at most 64 parts; this one has 79")
+  run(2 "long-chain\\.json: ${why}"
+      ${LATTICE} rasterize -q ${LIMITS}/long-chain.json --primitive chain --encoding candidates -o ${WORK}/t.lht)
+  run(2 "long-chain\\.json: ${why}"
+      ${LATTICE} render -q ${LIMITS}/long-chain.json --mode lattice --encoding candidates --lattice-dir ${WORK} -o ${WORK}/x.png)
+  run(0 "" ${LATTICE} render -q ${LIMITS}/long-chain.json --mode lattice --encoding dense --lattice-dir ${WORK} -o ${WORK}/x.png)
+elseif(CASE STREQUAL "sigma_inv_range")
+  foreach(k 0 -3 1025)
+    run(2 "^lattice: error: --sigma-inv: sigma\\^-1 = ${k} is out of range \\(1 to 1024\\)\n$"
+        ${LATTICE} rasterize -q ${P3} --primitive hair --sigma-inv ${k} -o ${WORK}/t.lht)
+  endforeach()
+  run(2 "--sigma-inv: sigma\\^-1 = 0 is out of range"
+      ${LATTICE} render -q ${P3} --mode lattice --sigma-inv 0 --lattice-dir ${WORK} -o ${WORK}/x.png)
+elseif(CASE STREQUAL "unknown_encoding")
+  run(2 "--encoding: unknown table encoding 'nope' \\(known: hash14, dense, candidates, perfect5, perfect6, perfect7, learned\\)"
+      ${LATTICE} rasterize -q ${P3} --primitive hair --encoding nope -o ${WORK}/t.lht)
+elseif(CASE STREQUAL "point_limit")
+  run(2 "primitives\\.hair: the hash14 encoding keys at most 65535 boundary points; a lattice of 84 x 84 x 240 cells \\(sigma\\^-1 = 12\\) has 94754"
+      ${LATTICE} rasterize -q ${P3} --primitive hair --sigma-inv 12 -o ${WORK}/t.lht)
+elseif(CASE STREQUAL "outside_box")
+  run(2 "outside-box\\.json: primitives\\.blob: primitive 'blob' reaches outside its lattice box \\[0, 1\\] x \\[0, 1\\] x \\[0, 1\\]"
+      ${LATTICE} rasterize -q ${LIMITS}/outside-box.json --primitive blob -o ${WORK}/t.lht)
 elseif(CASE STREQUAL "render_then_reuse")
   # A lattice render builds its table once, then finds it in the cache.
   run(0 "1 table .*1 built" ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/a.png)

@@ -26,7 +26,11 @@ TablePlan plan_table(const Primitive& p, const TableSpec& spec, const std::strin
         throw InputError(plan.place + "primitive '" + p.name +
                          "' has no lattice (add \"lattice\": {\"sigma\": ..., \"cells\": [...]})");
     check_sigma_inv(spec.sigma_inv, "--sigma-inv");
-    plan.encoding = &find_encoding(spec.encoding);
+    try {
+        plan.encoding = &find_encoding(spec.encoding);
+    } catch (const InputError& e) {
+        throw InputError(std::string("--encoding: ") + e.what());
+    }
     plan.options = spec.options;
 
     TableHeader& h = plan.header;

@@ -1,0 +1,165 @@
+// Every registered encoding, through its descriptor only: a new encoding gets these tests by
+// being listed in lattice/encodings/registry.cpp.
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cstring>
+#include <fstream>
+#include <set>
+
+#include "geometry/chain.h"
+#include "lattice/boundary_grid.h"
+#include "lattice/certify.h"
+#include "lattice/encoding.h"
+#include "lattice/rasterizer.h"
+#include "lattice/table_file.h"
+#include "temp_dir.h"
+#include "util/error.h"
+
+namespace lat {
+namespace {
+
+// The hook of the paper's Figure 1 at sigma^-1 = 2, with sigma = 1.
+const ChainShape& hook() {
+    static const ChainShape s({{{1, 1, 1}, 0.5}, {{1, 1, 3}, 0.5}, {{3, 1, 3}, 0.5}, {{3, 1, 2}, 0.5}},
+                              {{0, 1, 0.5}, {1, 2, 0.5}, {2, 3, 0.5}});
+    return s;
+}
+const TableContext kContext{{8, 4, 8}, 0.5, 1.0, &hook()};
+
+struct Built {
+    RasterizeResult raster;
+    ByteBuffer payload;
+    std::unique_ptr<LatticeTable> table;
+};
+
+Built build(const Encoding& e) {
+    Built b;
+    RasterizeOptions opt;
+    opt.keep_hits = e.needs_hits;
+    b.raster = rasterize(kContext, opt);
+    b.payload = e.build(b.raster.raw, kContext, {});
+    b.table = e.open(b.payload.data(), b.payload.size(), b.raster.hits, kContext);
+    return b;
+}
+
+TableHeader header_for(const Encoding& e, const Built& b) {
+    TableHeader h;
+    h.encoding = e.name;
+    h.cells = kContext.cells;
+    h.sigma_inv = 2;
+    h.sigma = kContext.sigma;
+    h.cell = kContext.cell;
+    h.fingerprint = 42;
+    h.pairs = b.raster.pairs_eq2;
+    h.entries = b.raster.hits;
+    h.metadata = "{}";
+    return h;
+}
+
+std::string load_error(const std::string& path) {
+    try {
+        load_table_file(path, nullptr, &hook());
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+class EveryEncoding : public ::testing::TestWithParam<const Encoding*> {};
+
+TEST_P(EveryEncoding, IsFoundByItsNameOnly) {
+    const Encoding& e = *GetParam();
+    EXPECT_EQ(&find_encoding(e.name), &e);
+    std::set<std::string_view> names;
+    for (const Encoding* x : encodings()) names.insert(x->name);
+    EXPECT_EQ(names.size(), encodings().size()) << "two encodings share a name";
+    EXPECT_TRUE(e.build && e.open && e.error_bound);
+}
+
+TEST_P(EveryEncoding, CertifiedWithinItsDeclaredBound) {
+    const Encoding& e = *GetParam();
+    const Built b = build(e);
+    EXPECT_EQ(b.table->kind(), e.kind);
+    const CertifyReport r = certify_table(*b.table, kContext, false);
+    EXPECT_GT(r.exact_hits, 1000u);
+    EXPECT_EQ(r.false_misses, 0u);
+    const double bound = e.error_bound(kContext, {});
+    // certify reports in units of sigma, the bound is in primitive units; certify's exact hits
+    // keep t as a float (relative 6e-8 of a segment no longer than the box's diagonal, 6).
+    EXPECT_LE(r.max_point_error * kContext.sigma, bound * (1 + 1e-9) + 1e-6);
+    if (std::isfinite(bound)) {
+        EXPECT_EQ(r.false_hits, 0u);  // every answer lies near the surface
+    }
+    EXPECT_LE(r.max_normal_error_deg, EncodeOptions{}.max_normal_error_deg);
+}
+
+TEST_P(EveryEncoding, SameBytesForAnyThreadCount) {
+    const Encoding& e = *GetParam();
+    const Built two = build(e);
+    Built one;
+    tbb::task_arena(1).execute([&] { one = build(e); });
+    ASSERT_EQ(one.payload.size(), two.payload.size());
+    EXPECT_EQ(std::memcmp(one.payload.data(), two.payload.data(), one.payload.size()), 0);
+}
+
+TEST_P(EveryEncoding, RoundTripsThroughATableFile) {
+    const Encoding& e = *GetParam();
+    const Built b = build(e);
+    test::TempDir dir;
+    const std::string path = (dir.path() / "t.lht").string();
+    write_table_file(path, header_for(e, b), b.payload);
+    const LoadedTable t = load_table_file(path, nullptr, &hook());
+    EXPECT_EQ(t.header.encoding, e.name);
+    EXPECT_EQ(t.table->entries(), b.table->entries());
+    const BoundaryGrid grid(kContext.cells);
+    int answered = 0;
+    for (std::uint32_t a = 0; a < grid.count(); a += 3)
+        for (std::uint32_t c = 0; c < grid.count(); c += 5) {
+            TableHit x, y;
+            CandidateList cx, cy;
+            const bool hx = e.kind == LatticeTable::Kind::kCandidates ? b.table->candidates(a, c, cx)
+                                                                      : b.table->lookup(a, c, x);
+            const bool hy = e.kind == LatticeTable::Kind::kCandidates ? t.table->candidates(a, c, cy)
+                                                                      : t.table->lookup(a, c, y);
+            ASSERT_EQ(hx, hy) << a << " " << c;
+            EXPECT_EQ(x.t, y.t);
+            EXPECT_EQ(x.normal, y.normal);
+            EXPECT_EQ(cx.count, cy.count);
+            answered += hx ? 1 : 0;
+        }
+    EXPECT_GT(answered, 10);
+}
+
+TEST_P(EveryEncoding, CorruptAndTruncatedFilesAreInputErrors) {
+    const Encoding& e = *GetParam();
+    const Built b = build(e);
+    test::TempDir dir;
+    const std::string path = (dir.path() / "t.lht").string();
+    // A byte changed on disk: the checksum catches it.
+    write_table_file(path, header_for(e, b), b.payload);
+    {
+        std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(static_cast<std::streamoff>(kTableHeaderBytes + b.payload.size() / 2));
+        f.put('\x5a');
+    }
+    EXPECT_NE(load_error(path).find("checksum mismatch"), std::string::npos) << load_error(path);
+    // Payloads cut short, with consistent checksums (as a forged file would have): the
+    // encoding itself must refuse them.
+    for (const std::size_t keep : {std::size_t{0}, std::size_t{7}, b.payload.size() / 2,
+                                   b.payload.size() - 8}) {
+        ByteBuffer cut(keep);
+        if (keep) std::memcpy(cut.data(), b.payload.data(), keep);
+        write_table_file(path, header_for(e, b), cut);
+        EXPECT_NE(load_error(path).find("not a valid lattice table"), std::string::npos)
+            << "kept " << keep << " of " << b.payload.size() << ": " << load_error(path);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Registry, EveryEncoding, ::testing::ValuesIn(encodings().begin(), encodings().end()),
+                         [](const ::testing::TestParamInfo<const Encoding*>& p) {
+                             return std::string(p.param->name);
+                         });
+
+}  // namespace
+}  // namespace lat

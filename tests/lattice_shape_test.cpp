@@ -1,0 +1,88 @@
+// Lattice shapes in CSG: a hit carries the point and normal its table stored, and a CSG tree
+// hands them on, moved into its own coordinates (not the ray's point, which lies off them).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "csg/csg_shape.h"
+#include "geometry/chain.h"
+#include "geometry/sphere.h"
+#include "lattice/encoding.h"
+#include "lattice/lattice_shape.h"
+#include "lattice/rasterizer.h"
+
+namespace lat {
+namespace {
+
+struct HookLattice {
+    ChainShape hook{{{{1, 1, 1}, 0.5}, {{1, 1, 3}, 0.5}, {{3, 1, 3}, 0.5}, {{3, 1, 2}, 0.5}},
+                    {{0, 1, 0.5}, {1, 2, 0.5}, {2, 3, 0.5}}};
+    TableContext ctx{{4, 2, 4}, 1.0, 1.0, &hook};  // coarse: stored points lie well off rays
+    std::shared_ptr<const Shape> shape;
+
+    HookLattice() {
+        const Encoding& e = find_encoding("hash14");
+        const RasterizeResult r = rasterize(ctx);
+        auto payload = std::make_shared<ByteBuffer>(e.build(r.raw, ctx, {}));
+        std::shared_ptr<LatticeTable> table = e.open(payload->data(), payload->size(), r.hits, ctx);
+        table->hold(payload);
+        shape = make_lattice_shape(table, ctx, e.error_bound(ctx, {}));
+    }
+};
+
+TEST(LatticeInCsg, ALeafInADifferenceIsShadedAtItsStoredPoint) {
+    const HookLattice lattice;
+    const Transform xf = Transform::translate({10, -3, 2}) * Transform::rotate({0, 0, 1}, 0.7);
+    // The hook, moved, minus a ball that takes a bite out of its top left corner.
+    CsgShape csg;
+    const int a = csg.add_leaf({lattice.shape, xf, 0, -1});
+    const int b = csg.add_leaf({std::make_shared<SphereShape>(xf.point({1, 1, 3.4}), 0.4),
+                                Transform{}, 1, -1});
+    csg.set_root(csg.add_node(CsgOp::kDifference, {a, b}));
+
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int compared = 0, off_ray = 0, bitten = 0;
+    for (int n = 0; n < 20000; ++n) {
+        const Vec3 target = xf.point({2 + 2 * u(rng), 1 + u(rng), 2 + 2 * u(rng)});
+        const Vec3 d = normalize(Vec3{u(rng), u(rng), u(rng)});
+        const Ray ray{target - d * 20, d};
+        Crossing c;
+        if (!csg.intersect(ray, 0, kInfinity, c)) continue;
+        const SurfacePoint s = csg.surface(ray, c);
+        if (c.leaf_index() != 0) {  // the ball's inside surface, exact
+            ++bitten;
+            EXPECT_LT(length(s.p - ray.at(c.t)), 1e-9);
+            continue;
+        }
+        // What the lattice alone says about the same crossing, in its own coordinates.
+        const Ray local = xf.inverse_ray(ray);
+        SpanList spans;
+        lattice.shape->spans(local, spans);
+        ASSERT_EQ(spans.size(), 1u);
+        const Crossing& own = c.part == 0 ? spans[0].in : spans[0].out;
+        ASSERT_TRUE(own.has_stored);
+        EXPECT_LT(length(s.p - xf.point(own.stored.p)), 1e-9) << n;
+        EXPECT_LT(length(s.n - normalize(xf.normal(own.stored.n))), 1e-9) << n;
+        off_ray += length(s.p - ray.at(c.t)) > 1e-3 ? 1 : 0;
+        ++compared;
+    }
+    EXPECT_GT(compared, 1000);
+    EXPECT_GT(bitten, 10);
+    EXPECT_GT(off_ray, compared / 4);  // the old bug (the ray's point) would fail above
+}
+
+TEST(LatticeInCsg, ShapesAnswerWithTheStoredSurface) {
+    const HookLattice lattice;
+    const Ray ray{{2, -5, 2.9}, {0, 1, 0}};
+    Crossing c;
+    ASSERT_TRUE(lattice.shape->intersect(ray, 0, kInfinity, c));
+    ASSERT_TRUE(c.has_stored);
+    const SurfacePoint s = lattice.shape->surface(ray, c);
+    EXPECT_EQ(s.p, c.stored.p);
+    EXPECT_EQ(s.n, c.stored.n);
+    EXPECT_NEAR(length(s.n), 1.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace lat
