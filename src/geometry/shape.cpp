@@ -34,4 +34,15 @@ void merge_span_union(SpanList& spans, std::size_t first) {
     spans.resize(w);
 }
 
+Crossing nearest_crossing(const Shape& shape, const Ray& r) {
+    SpanList spans;
+    shape.spans(r, spans);
+    Crossing best{kInfinity, 0, 0};
+    for (const Span& sp : spans)
+        for (const Crossing& c : {sp.in, sp.out})
+            if (std::abs(c.t) < std::abs(best.t)) best = c;
+    best.t = 0;
+    return best;
+}
+
 }  // namespace lat

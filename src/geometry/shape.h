@@ -128,4 +128,8 @@ void merge_span_union(SpanList& spans, std::size_t first);
 // The first crossing of a span list with tmin < t < tmax, if any.
 bool first_crossing(const SpanList& spans, double tmin, double tmax, Crossing& hit);
 
+// For a ray starting on (or within rounding of) the shape's boundary: the crossing of its line
+// nearest the start, moved to t = 0, so that normal() gives the surface there.
+Crossing nearest_crossing(const Shape& shape, const Ray& r);
+
 }  // namespace lat

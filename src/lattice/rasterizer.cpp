@@ -88,7 +88,7 @@ public:
     void trace_entry(const S& shape, std::uint32_t a, bool keep, Scratch& s, Counts& cnt) const {
         const GridPoint gp = grid_.point(a);
         const std::uint8_t fa = grid_.faces(gp);
-        const Vec3 p{double(gp.x), double(gp.y), double(gp.z)};
+        const Vec3 p = to_vec(gp);
         // Eq. (2) also counts a point paired with itself on two of its faces.
         const int nf = __builtin_popcount(fa);
         cnt.enumerated += static_cast<std::uint64_t>(nf * nf - nf);
@@ -179,8 +179,7 @@ private:
     template <class S>
     RawHit make_hit(const S& shape, std::uint32_t a, const Vec3& p, std::uint32_t b, bool start_inside,
                     const Scratch& s, std::size_t k) const {
-        const GridPoint q = grid_.point(b);
-        const Vec3 qv{double(q.x), double(q.y), double(q.z)};
+        const Vec3 qv = to_vec(grid_.point(b));
         const Ray r{p * h_, (qv - p) * h_};
         Crossing c = s.best_c[k];
         float t = static_cast<float>(std::min(1.0, s.best_t[k]));
@@ -194,17 +193,6 @@ private:
         assert(c.part <= RawHit::kMaxPart && c.leaf_index() <= RawHit::kMaxLeaf);
         return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v),
                 static_cast<std::uint16_t>(c.part), RawHit::pack_leaf(c.leaf)};
-    }
-
-    static Crossing nearest_crossing(const Shape& shape, const Ray& r) {
-        SpanList spans;
-        shape.spans(r, spans);
-        Crossing best{kInfinity, 0, 0};
-        for (const Span& sp : spans)
-            for (const Crossing& c : {sp.in, sp.out})
-                if (std::abs(c.t) < std::abs(best.t)) best = c;
-        best.t = 0;
-        return best;
     }
 };
 

@@ -269,13 +269,7 @@ bool CandidatesTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) co
     const Ray seg{pa * ctx_.cell, (pb - pa) * ctx_.cell};
     const Shape& shape = *ctx_.primitive;
     if (shape.inside(seg.o)) {  // a point of the closed solid on the box: the hit is the point
-        SpanList spans;
-        shape.spans(seg, spans);
-        Crossing best{kInfinity, 0, 0};
-        for (const Span& sp : spans)
-            for (const Crossing& c : {sp.in, sp.out})
-                if (std::abs(c.t) < std::abs(best.t)) best = c;
-        hit = {0.0, normalize(shape.normal(seg, {0.0, best.part, best.leaf}))};
+        hit = {0.0, normalize(shape.normal(seg, nearest_crossing(shape, seg)))};
         return true;
     }
     Crossing best{kInfinity, 0, 0};
