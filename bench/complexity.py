@@ -6,8 +6,9 @@ from the 19-part hair to a 10,000-part tuft and CSG of 1 to 12 tori), through th
 command itself:
   1. builds each encoding's table into WORK/cache with `lattice rasterize` (build time, bytes;
      an encoding that refuses the primitive is skipped and its message recorded);
-  2. renders exact mode and lattice mode per encoding, RUNS times each, interleaved so that
-     load from other processes hits all modes alike; the median render_ms is kept;
+  2. renders the scene without its instances, exact mode and lattice mode per encoding, RUNS
+     times each, interleaved so that load from other processes hits all alike; the median
+     render_ms is kept (and the minimum, in the JSON);
   3. compares each lattice image with the exact one (`lattice compare --json`: PSNR);
   4. counts lattice visits with bench/lattice_visits (render --stats does not report them)
      and estimates the CPU time per visit as (lattice ms - ms of the scene without its
@@ -58,9 +59,18 @@ def fmt_db(v):
     return f"{v:.2f}" if isinstance(v, (int, float)) else str(v)  # identical images: "inf"
 
 
-def bench_primitive(a, name, cost, base_ms):
+def without_instances(a, name):
+    """The scene without its instances: what the sphere, floor and shading cost alone."""
+    s = json.load(open(os.path.join(a.work, "scenes", name + ".json")))
+    s["objects"] = [o for o in s["objects"] if o["type"] != "instance"]
+    path = os.path.join(a.work, "scenes", "base.json")
+    json.dump(s, open(path, "w"))
+    return path
+
+
+def bench_primitive(a, name, cost):
     scene = os.path.join(a.work, "scenes", name + ".json")
-    r = {"primitive": name, "cost": cost,
+    r = {"primitive": name, "cost": cost, "loadavg": os.getloadavg()[0],
          "family": "csg" if name.startswith("csg") else "spheres+cylinders", "lattice": {}}
     encs = []
     for enc in a.encodings:  # build tables first, timed apart from rendering
@@ -79,8 +89,10 @@ def bench_primitive(a, name, cost, base_ms):
                              "N_lp": s["N_lp"], "runs_ms": []}
         encs.append(enc)
     exact_png = os.path.join(a.work, name + "-exact.png")
-    r["exact_runs_ms"] = []
-    for _ in range(a.runs):  # interleaved: exact, then every encoding, RUNS times
+    base, base_png = without_instances(a, name), os.path.join(a.work, "base.png")
+    r["exact_runs_ms"], r["base_runs_ms"] = [], []
+    for _ in range(a.runs):  # interleaved: base, exact, then every encoding, RUNS times
+        r["base_runs_ms"].append(render(a, base, base_png)["render_ms"])
         e = render(a, scene, exact_png)
         r["exact_runs_ms"].append(e["render_ms"])
         r["rays"] = e["primary_rays"] + e["shadow_rays"]
@@ -91,9 +103,12 @@ def bench_primitive(a, name, cost, base_ms):
             r["lattice"][enc]["runs_ms"].append(s["render_ms"])
             r["lattice"][enc]["rays"] = s["primary_rays"] + s["shadow_rays"]
     r["exact_ms"] = statistics.median(r["exact_runs_ms"])
+    r["exact_min_ms"] = min(r["exact_runs_ms"])
+    r["base_ms"] = base_ms = statistics.median(r["base_runs_ms"])
     for enc in encs:
         L = r["lattice"][enc]
         L["ms"] = statistics.median(L["runs_ms"])
+        L["min_ms"] = min(L["runs_ms"])
         cmp = json.loads(check([a.lattice, "compare", exact_png,
                                 os.path.join(a.work, f"{name}-{enc}.png"), "--json"]))
         L["psnr_db"] = cmp["psnr_db"]
@@ -119,11 +134,11 @@ def markdown(res):
     print("## Complexity: exact against lattice mode as the primitive grows\n")
     print(f"Plate 4 placement (1000 instances), {c['size']} x {c['size']}, {c['threads']} threads, "
           f"sigma^-1 = {c['sigma_inv']}, median of {c['runs']} renders (render_ms); "
-          f"load average {c['loadavg_start']} at start. Scene without instances: "
-          f"{fmt_ms(res['base_ms'])} ms.\n")
-    print("| primitive | parts / leaves | exact ms | " + " | ".join(f"{e} ms" for e in encs)
+          f"load average {c['loadavg_start']:.1f} at start (timings are noisy when it exceeds "
+          f"{c['cpus']}: compare within a row). Runs {c['seconds']:.0f} s.\n")
+    print("| primitive | parts / leaves | load | no instances ms | exact ms | " + " | ".join(f"{e} ms" for e in encs)
           + " | exact / best lattice |")
-    print("| --- | ---: | ---: | " + " | ".join("---:" for _ in encs) + " | ---: |")
+    print("| --- | ---: | ---: | ---: | ---: | " + " | ".join("---:" for _ in encs) + " | ---: |")
     for r in res["primitives"]:
         cells, best = [], None
         for e in encs:
@@ -134,7 +149,8 @@ def markdown(res):
                 cells.append(fmt_ms(L["ms"]))
                 best = L["ms"] if best is None else min(best, L["ms"])
         ratio = f"{r['exact_ms'] / best:.2f}" if best else "-"
-        print(f"| {r['primitive']} | {r['cost']} | {fmt_ms(r['exact_ms'])} | "
+        print(f"| {r['primitive']} | {r['cost']} | {r['loadavg']:.1f} | {fmt_ms(r['base_ms'])} | "
+              f"{fmt_ms(r['exact_ms'])} | "
               + " | ".join(cells) + f" | {ratio} |")
     print("\n| primitive | encoding | ms | visits/ray | ns/visit (est.) | table bytes | build s "
           "| PSNR vs exact (dB) |")
@@ -161,7 +177,7 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--work", help="scenes, table cache and images (default: BUILD/complexity)")
     ap.add_argument("--size", type=int, default=512)
-    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--sigma-inv", type=int, default=1)
     ap.add_argument("--encodings", default="hash14,dense,candidates")
@@ -178,25 +194,15 @@ def main():
     check([sys.executable, os.path.join(HERE, "complexity_scenes.py"),
            os.path.join(a.work, "scenes"), "--size", str(a.size), "--only", ",".join(names)])
 
-    # The same scene without its instances: what the sphere, floor and shading cost alone.
-    base = json.load(open(os.path.join(a.work, "scenes", names[0] + ".json")))
-    base["objects"] = [o for o in base["objects"] if o["type"] != "instance"]
-    base_scene = os.path.join(a.work, "scenes", "base.json")
-    json.dump(base, open(base_scene, "w"))
-    base_png = os.path.join(a.work, "base.png")
-    base_ms = statistics.median(render(a, base_scene, base_png)["render_ms"]
-                                for _ in range(a.runs))
-
     res = {"config": {"size": a.size, "runs": a.runs, "threads": a.threads,
                       "sigma_inv": a.sigma_inv, "encodings": a.encodings,
                       "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
                       "cpus": os.cpu_count(), "loadavg_start": os.getloadavg()[0]},
-           "base_ms": base_ms, "primitives": []}
+           "primitives": []}
     t0 = time.time()
     for name in names:
         print(f"complexity: {name}", file=sys.stderr)
-        res["primitives"].append(bench_primitive(a, name, complexity_scenes.PRIMITIVES[name][1],
-                                                 base_ms))
+        res["primitives"].append(bench_primitive(a, name, complexity_scenes.PRIMITIVES[name][1]))
     res["config"]["seconds"] = time.time() - t0
     os.makedirs(a.out, exist_ok=True)
     json.dump(res, open(os.path.join(a.out, "complexity.json"), "w"), indent=2)

@@ -9,8 +9,8 @@ covers about as many pixels as the hair and the lattice's cost per visit stays c
 
   hair19         the Plate 3/4 hair: 10 spheres + 9 cylinders
   tuft200 ...    strands of chained spheres and cylinders (parts = strands x (2n - 1))
-  csg1, 4, 12    CSG of tori: one torus, a 4-leaf unit (a torus minus a torus, union the
-                 intersection of two tori), three such units stacked
+  csg1, 4, 12    CSG of tori stretched along the column: one torus, a 4-leaf unit (a torus
+                 minus a torus, union the intersection of two tori), three such units
 
 Usage: complexity_scenes.py OUT_DIR [--size N] [--only NAME,...]; prints the written paths.
 Python 3 standard library only; the output is deterministic (fixed seeds)."""
@@ -86,10 +86,12 @@ def csg(leaves):
         obj = placed(torus((1, 0, 0), 2.6, 0.6), 2.9, 10.0)
     elif leaves == 4:
         obj = placed(unit4(), 2.9, 10.0)
-    else:  # three units stacked, the middle one turned by 90 degrees
-        obj = {"type": "csg", "op": "union",
-               "children": [placed(unit4(), 0.95, z, rot)
-                            for z, rot in ((3.5, 0), (10.0, 90), (16.5, 0))]}
+    else:  # three such units in the same column (one turned by 90 degrees, one narrower):
+        # about the silhouette of csg4, so that the leaves, not the size, make the difference
+        units = [placed(unit4(), 2.9, 10.0), placed(unit4(), 2.9, 10.0, 90),
+                 dict(placed(unit4(), 2.9, 10.0), transform=[
+                     {"scale": [0.7, 0.7, 2.9]}, {"translate": [BOX[0] / 2, BOX[1] / 2, 10.0]}])]
+        obj = {"type": "csg", "op": "union", "children": units}
     return {"object": obj, "lattice": LATTICE}
 
 
