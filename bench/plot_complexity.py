@@ -11,6 +11,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # no display on a build machine
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FuncFormatter, NullFormatter  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -38,12 +39,19 @@ def main():
                         xytext=(4, 6), fontsize=7)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.set_xticks(x)  # the measured costs, as plain numbers
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.tick_params(axis="y", which="minor", labelsize=7)
         ax.set_xlabel(xlabel)
         ax.set_ylabel("render time (ms)")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle(f"Plate 4 placement, 1000 instances, {c['size']}x{c['size']}, {c['threads']} threads, "
-                 f"sigma^-1 = {c['sigma_inv']} (median of {c['runs']})", fontsize=10)
+                 f"sigma^-1 = {c['sigma_inv']} (median of {c['runs']}; load average {c['loadavg_start']:.1f} "
+                 f"on {c['cpus']} CPUs)", fontsize=10)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     print(out)
