@@ -1,11 +1,13 @@
-// lattice_visits SCENE.json --lattice-dir DIR [--encoding E] [--sigma-inv K] [--threads N]
+// lattice_visits SCENE.json --lattice-dir DIR [--encoding E] [--sigma-inv K] [--threads N] [-o
+// OUT.png]
 //
 // Counts lattice visits: how often the renderer asks a lattice instance about a ray, which
 // `lattice render --stats` does not report. Renders the scene in lattice mode with every
 // primitive's lattice shape wrapped in a shape that counts the calls and forwards them
 // unchanged, and prints JSON: rays, visits by kind, and the (slower, counted) render time.
 // The table must already be in the cache (bench/complexity.py rasterizes it first). Timings
-// for the benchmark come from `lattice render` itself, never from this wrapped render.
+// for the benchmark come from `lattice render` itself, never from this wrapped render. With
+// -o it writes the image, which must equal `lattice render`'s (the wrapper changes nothing).
 #include <tbb/global_control.h>
 
 #include <atomic>
@@ -14,6 +16,7 @@
 #include <memory>
 #include <string>
 
+#include "io/image.h"
 #include "render/renderer.h"
 #include "scene/lattice_tables.h"
 #include "scene/scene_loader.h"
@@ -58,13 +61,16 @@ public:
     lat::Bounds3 primitive_bounds(std::size_t i, const lat::Transform& xf) const override {
         return s_->primitive_bounds(i, xf);
     }
-    lat::Bounds3 placed_bounds(const lat::Transform& xf) const override { return s_->placed_bounds(xf); }
+    lat::Bounds3 placed_bounds(const lat::Transform& xf) const override {
+        return s_->placed_bounds(xf);
+    }
     bool intersect_primitive(std::size_t i, const lat::Ray& r, double tmin, double tmax,
                              lat::Crossing& hit) const override {
         c_.intersect.fetch_add(1, std::memory_order_relaxed);
         return s_->intersect_primitive(i, r, tmin, tmax, hit);
     }
-    bool occluded_primitive(std::size_t i, const lat::Ray& r, double tmin, double tmax) const override {
+    bool occluded_primitive(std::size_t i, const lat::Ray& r, double tmin,
+                            double tmax) const override {
         c_.occluded.fetch_add(1, std::memory_order_relaxed);
         return s_->occluded_primitive(i, r, tmin, tmax);
     }
@@ -86,34 +92,43 @@ private:
 };
 
 int usage() {
-    std::fprintf(stderr,
-                 "usage: lattice_visits SCENE.json --lattice-dir DIR [--encoding E] [--sigma-inv K] "
-                 "[--threads N]\n");
+    std::fprintf(
+        stderr,
+        "usage: lattice_visits SCENE.json --lattice-dir DIR [--encoding E] [--sigma-inv K] "
+        "[--threads N] [-o OUT.png]\n");
     return 2;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::string scene_file, dir;
+    std::string scene_file, dir, output;
     lat::TableSpec spec;
     int threads = 0;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         const bool has_value = i + 1 < argc;
-        if (a == "--lattice-dir" && has_value) dir = argv[++i];
-        else if (a == "--encoding" && has_value) spec.encoding = argv[++i];
-        else if (a == "--sigma-inv" && has_value) spec.sigma_inv = std::atoi(argv[++i]);
-        else if (a == "--threads" && has_value) threads = std::atoi(argv[++i]);
-        else if (scene_file.empty() && a[0] != '-') scene_file = a;
-        else return usage();
+        if (a == "--lattice-dir" && has_value)
+            dir = argv[++i];
+        else if (a == "--encoding" && has_value)
+            spec.encoding = argv[++i];
+        else if (a == "--sigma-inv" && has_value)
+            spec.sigma_inv = std::atoi(argv[++i]);
+        else if (a == "--threads" && has_value)
+            threads = std::atoi(argv[++i]);
+        else if (a == "-o" && has_value)
+            output = argv[++i];
+        else if (scene_file.empty() && a[0] != '-')
+            scene_file = a;
+        else
+            return usage();
     }
     if (scene_file.empty() || dir.empty()) return usage();
     try {
         std::unique_ptr<tbb::global_control> limit;
         if (threads > 0)
-            limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                          static_cast<std::size_t>(threads));
+            limit = std::make_unique<tbb::global_control>(
+                tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
         const lat::Scene scene = lat::load_scene(scene_file);
         const lat::TableCache cache(dir, true);
         const lat::SceneLattices lattices = lat::scene_lattices(scene, cache, spec, false);
@@ -121,18 +136,21 @@ int main(int argc, char** argv) {
         std::vector<std::shared_ptr<const lat::Shape>> wrapped;
         for (const auto& s : lattices.shapes)
             wrapped.push_back(s ? std::make_shared<CountingShape>(s, counts) : nullptr);
-        const lat::RenderScene rs(scene, [&wrapped](int p) { return wrapped[static_cast<std::size_t>(p)]; });
+        const lat::RenderScene rs(
+            scene, [&wrapped](int p) { return wrapped[static_cast<std::size_t>(p)]; });
         const lat::RenderOutput out = lat::render_image(rs, {});
-        std::printf("{\"encoding\": \"%s\", \"tables_built\": %d, \"primary_rays\": %llu, "
-                    "\"shadow_rays\": %llu, \"intersect\": %llu, \"occluded\": %llu, \"spans\": %llu, "
-                    "\"shading_calls\": %llu, \"counted_render_ms\": %.3f}\n",
-                    spec.encoding.c_str(), lattices.built,
-                    static_cast<unsigned long long>(out.stats.primary_rays),
-                    static_cast<unsigned long long>(out.stats.shadow_rays),
-                    static_cast<unsigned long long>(counts.intersect.load()),
-                    static_cast<unsigned long long>(counts.occluded.load()),
-                    static_cast<unsigned long long>(counts.spans.load()),
-                    static_cast<unsigned long long>(counts.shading.load()), out.stats.render_ms);
+        if (!output.empty()) lat::write_png(output, out.display);
+        std::printf(
+            "{\"encoding\": \"%s\", \"tables_built\": %d, \"primary_rays\": %llu, "
+            "\"shadow_rays\": %llu, \"intersect\": %llu, \"occluded\": %llu, \"spans\": %llu, "
+            "\"shading_calls\": %llu, \"counted_render_ms\": %.3f}\n",
+            spec.encoding.c_str(), lattices.built,
+            static_cast<unsigned long long>(out.stats.primary_rays),
+            static_cast<unsigned long long>(out.stats.shadow_rays),
+            static_cast<unsigned long long>(counts.intersect.load()),
+            static_cast<unsigned long long>(counts.occluded.load()),
+            static_cast<unsigned long long>(counts.spans.load()),
+            static_cast<unsigned long long>(counts.shading.load()), out.stats.render_ms);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "lattice_visits: error: %s\n", e.what());
         return 2;
