@@ -8,6 +8,9 @@ DEMO_OUT ?= out/demo.png
 
 PACKAGES := cmake make g++ pkg-config libembree-dev libtbb-dev libpng-dev nlohmann-json3-dev \
             libcli11-dev libopenexr-dev libgtest-dev libgmock-dev libbenchmark-dev python3
+# Only `make bench` plots (bench/plot_complexity.py): a target-specific value, inherited by its
+# prerequisites (build -> configure -> deps), so `make test` and `make demo` do not install it.
+bench: PACKAGES += python3-matplotlib
 
 .PHONY: all deps configure build demo test bench clean format
 

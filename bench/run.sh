@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # make bench: runs every bench/*_bench program, writes bench/results/<name>.json (Google
-# Benchmark's JSON) and bench/results/summary.md (a readable table of all of them).
+# Benchmark's JSON) and bench/results/summary.md (a readable table of all of them), then the
+# encodings and complexity benchmarks through the lattice command (and docs/images/complexity.png).
 set -euo pipefail
 build=${1:-build}
 here=$(cd "$(dirname "$0")" && pwd)
@@ -14,7 +15,13 @@ for exe in "$build"/bin/*_bench; do
 done
 echo "== encodings (through the lattice command)"
 python3 "$here/encodings.py" "$build/bin/lattice" "$out" > "$out/encodings.md"
-{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md"; } > "$out/summary.md"
+echo "== complexity (exact against lattice mode as the primitive grows; docs/complexity.md)"
+python3 "$here/complexity.py" "$build/bin/lattice" "$out" --work "$build/complexity" > "$out/complexity.md"
+# matplotlib is Debian's python3-matplotlib: plot with Debian's python3 even when another one
+# (pyenv, a virtualenv) comes first in PATH.
+py=/usr/bin/python3; [ -x "$py" ] || py=python3
+"$py" "$here/plot_complexity.py" "$out/complexity.json" "$here/../docs/images/complexity.png"
+{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md"; } > "$out/summary.md"
 echo
 cat "$out/summary.md"
 echo "results: $out"

@@ -61,3 +61,12 @@ foreach(case corrupt truncated other_primitive missing_dir not_a_dir too_big unk
             -DWORK=${CLI_OUT}/lattice-${case} -DCASE=${case}
             -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/lattice_cases.cmake)
 endforeach()
+
+# The complexity benchmark's generated scenes load and render (tiny; no ../shared needed).
+find_package(Python3 COMPONENTS Interpreter QUIET)
+if(Python3_Interpreter_FOUND)
+  add_test(NAME cli.complexity_scenes
+    COMMAND ${CMAKE_COMMAND} -DLATTICE=$<TARGET_FILE:lattice> -DPYTHON=${Python3_EXECUTABLE}
+            -DGEN=${PROJECT_SOURCE_DIR}/bench/complexity_scenes.py -DWORK=${CLI_OUT}/complexity
+            -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/complexity_scenes.cmake)
+endif()

@@ -1,0 +1,214 @@
+#!/usr/bin/env python3
+"""Complexity benchmark: exact mode against lattice mode as the primitive grows.
+
+For every scene of bench/complexity_scenes.py (Plate 4's placement and camera, primitives
+from the 19-part hair to a 10,000-part tuft and CSG of 1 to 12 tori), through the `lattice`
+command itself:
+  1. builds each encoding's table into WORK/cache with `lattice rasterize` (build time, bytes;
+     an encoding that refuses the primitive is skipped and its message recorded);
+  2. renders the scene without its instances, exact mode and lattice mode per encoding, RUNS
+     times each, interleaved so that load from other processes hits all alike; the median
+     render_ms is kept (and the minimum, in the JSON);
+  3. compares each lattice image with the exact one (`lattice compare --json`: PSNR);
+  4. counts lattice visits with bench/lattice_visits (render --stats does not report them)
+     and estimates the CPU time per visit as (lattice ms - ms of the scene without its
+     instances) x threads / visits: everything the instances add, Embree traversal included.
+Writes OUT/complexity.json and prints a Markdown summary.
+
+Usage: complexity.py LATTICE_BIN OUT_DIR [--work DIR] [--size N] [--runs N] [--threads N]
+                     [--encodings a,b] [--only name,...]"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+sys.dont_write_bytecode = True  # no bench/__pycache__ in the source tree
+import complexity_scenes  # noqa: E402
+
+
+def run(cmd):
+    """Runs a command; returns (exit code, stdout, stderr) without raising."""
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    return p.returncode, p.stdout, p.stderr
+
+
+def check(cmd):
+    code, out, err = run(cmd)
+    if code:
+        sys.exit(f"complexity.py: {' '.join(cmd)} failed ({code}): {err.strip()}")
+    return out
+
+
+def render(a, scene, image, *extra):
+    stats = os.path.join(a.work, "stats.json")
+    check([a.lattice, "render", "-q", scene, "-o", image, "--threads", str(a.threads),
+           "--stats", stats, *extra])
+    return json.load(open(stats))
+
+
+def lattice_args(a, enc):
+    return ["--mode", "lattice", "--encoding", enc, "--sigma-inv", str(a.sigma_inv),
+            "--lattice-dir", a.cache]
+
+
+def fmt_db(v):
+    return f"{v:.2f}" if isinstance(v, (int, float)) else str(v)  # identical images: "inf"
+
+
+def without_instances(a, name):
+    """The scene without its instances: what the sphere, floor and shading cost alone."""
+    s = json.load(open(os.path.join(a.work, "scenes", name + ".json")))
+    s["objects"] = [o for o in s["objects"] if o["type"] != "instance"]
+    path = os.path.join(a.work, "scenes", "base.json")
+    json.dump(s, open(path, "w"))
+    return path
+
+
+def bench_primitive(a, name, cost):
+    scene = os.path.join(a.work, "scenes", name + ".json")
+    r = {"primitive": name, "cost": cost, "loadavg": os.getloadavg()[0],
+         "family": "csg" if name.startswith("csg") else "spheres+cylinders", "lattice": {}}
+    encs = []
+    for enc in a.encodings:  # build tables first, timed apart from rendering
+        stats = os.path.join(a.work, "rasterize.json")
+        t0 = time.time()
+        code, _, err = run([a.lattice, "rasterize", "-q", scene, "--primitive", name,
+                            "--encoding", enc, "--sigma-inv", str(a.sigma_inv), "--lattice-dir",
+                            a.cache, "--threads", str(a.threads), "--stats", stats])
+        if code:  # how long the refusal took matters too: it may come after the rasterization
+            r["lattice"][enc] = {"refused": err.strip().removeprefix("lattice: "),
+                                 "exit_code": code, "refused_after_s": time.time() - t0}
+            continue
+        s = json.load(open(stats))
+        r["lattice"][enc] = {"build_s": s["rasterize_seconds"] + s["encode_seconds"],
+                             "table_bytes": s["table_bytes"], "stored_hits": s["stored_hits"],
+                             "N_lp": s["N_lp"], "runs_ms": []}
+        encs.append(enc)
+    exact_png = os.path.join(a.work, name + "-exact.png")
+    base, base_png = without_instances(a, name), os.path.join(a.work, "base.png")
+    r["exact_runs_ms"], r["base_runs_ms"] = [], []
+    for _ in range(a.runs):  # interleaved: base, exact, then every encoding, RUNS times
+        r["base_runs_ms"].append(render(a, base, base_png)["render_ms"])
+        e = render(a, scene, exact_png)
+        r["exact_runs_ms"].append(e["render_ms"])
+        r["rays"] = e["primary_rays"] + e["shadow_rays"]
+        for enc in encs:
+            png = os.path.join(a.work, f"{name}-{enc}.png")
+            s = render(a, scene, png, *lattice_args(a, enc))
+            assert s["tables_built"] == 0, "the table should have come from the cache"
+            r["lattice"][enc]["runs_ms"].append(s["render_ms"])
+            r["lattice"][enc]["rays"] = s["primary_rays"] + s["shadow_rays"]
+    r["exact_ms"] = statistics.median(r["exact_runs_ms"])
+    r["exact_min_ms"] = min(r["exact_runs_ms"])
+    r["base_ms"] = base_ms = statistics.median(r["base_runs_ms"])
+    for enc in encs:
+        L = r["lattice"][enc]
+        L["ms"] = statistics.median(L["runs_ms"])
+        L["min_ms"] = min(L["runs_ms"])
+        cmp = json.loads(check([a.lattice, "compare", exact_png,
+                                os.path.join(a.work, f"{name}-{enc}.png"), "--json"]))
+        L["psnr_db"] = cmp["psnr_db"]
+        if os.path.exists(a.visits):
+            v = json.loads(check([a.visits, scene, "--threads", str(a.threads),
+                                  "--lattice-dir", a.cache, "--encoding", enc,
+                                  "--sigma-inv", str(a.sigma_inv)]))
+            visits = v["intersect"] + v["occluded"] + v["spans"]
+            L["visits"] = {k: v[k] for k in ("intersect", "occluded", "spans", "shading_calls")}
+            L["visits_per_ray"] = visits / L["rays"]
+            L["ns_per_visit_est"] = ((L["ms"] - base_ms) * 1e6 * a.threads / visits
+                                     if visits else None)
+    return r
+
+
+def fmt_ms(v):
+    return f"{v:.1f}" if v < 100 else f"{v:.0f}"
+
+
+def markdown(res):
+    c = res["config"]
+    encs = c["encodings"]
+    print("## Complexity: exact against lattice mode as the primitive grows\n")
+    print(f"Plate 4 placement (1000 instances), {c['size']} x {c['size']}, {c['threads']} threads, "
+          f"sigma^-1 = {c['sigma_inv']}, median of {c['runs']} renders (render_ms); "
+          f"load average {c['loadavg_start']:.1f} at start (timings are noisy when it exceeds "
+          f"{c['cpus']}: compare within a row). Runs {c['seconds']:.0f} s.\n")
+    print("| primitive | parts / leaves | load | no instances ms | exact ms | " + " | ".join(f"{e} ms" for e in encs)
+          + " | exact / best lattice |")
+    print("| --- | ---: | ---: | ---: | ---: | " + " | ".join("---:" for _ in encs) + " | ---: |")
+    for r in res["primitives"]:
+        cells, best = [], None
+        for e in encs:
+            L = r["lattice"][e]
+            if "refused" in L:
+                cells.append("refused")
+            else:
+                cells.append(fmt_ms(L["ms"]))
+                best = L["ms"] if best is None else min(best, L["ms"])
+        ratio = f"{r['exact_ms'] / best:.2f}" if best else "-"
+        print(f"| {r['primitive']} | {r['cost']} | {r['loadavg']:.1f} | {fmt_ms(r['base_ms'])} | "
+              f"{fmt_ms(r['exact_ms'])} | "
+              + " | ".join(cells) + f" | {ratio} |")
+    print("\n| primitive | encoding | ms | visits/ray | ns/visit (est.) | table bytes | build s "
+          "| PSNR vs exact (dB) |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for r in res["primitives"]:
+        for e in encs:
+            L = r["lattice"][e]
+            if "refused" in L:
+                print(f"| {r['primitive']} | {e} | refused after {L['refused_after_s']:.1f} s "
+                      f"(exit {L['exit_code']}): {L['refused']} | | | | | |")
+                continue
+            vpr = f"{L['visits_per_ray']:.2f}" if "visits_per_ray" in L else "n/a"
+            nsv = L.get("ns_per_visit_est")
+            nsv = f"{nsv:.0f}" if nsv is not None else "n/a"
+            print(f"| {r['primitive']} | {e} | {fmt_ms(L['ms'])} | {vpr} | {nsv} | "
+                  f"{L['table_bytes']} | {L['build_s']:.2f} | {fmt_db(L['psnr_db'])} |")
+    print("\nvisits: calls of a lattice's intersect/occluded/spans (bench/lattice_visits); "
+          "ns/visit: (lattice ms - ms without instances) x threads / visits.\n")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("lattice")
+    ap.add_argument("out")
+    ap.add_argument("--work", help="scenes, table cache and images (default: BUILD/complexity)")
+    ap.add_argument("--size", type=int, default=512)
+    ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--sigma-inv", type=int, default=1)
+    ap.add_argument("--encodings", default="hash14,dense,candidates")
+    ap.add_argument("--only", default="")
+    a = ap.parse_args()
+    a.lattice = os.path.abspath(a.lattice)
+    a.visits = os.path.join(os.path.dirname(a.lattice), "lattice_visits")
+    a.work = os.path.abspath(a.work or os.path.join(os.path.dirname(os.path.dirname(a.lattice)),
+                                                     "complexity"))
+    a.cache = os.path.join(a.work, "cache")
+    a.encodings = a.encodings.split(",")
+    os.makedirs(a.cache, exist_ok=True)
+    names = a.only.split(",") if a.only else list(complexity_scenes.PRIMITIVES)
+    check([sys.executable, os.path.join(HERE, "complexity_scenes.py"),
+           os.path.join(a.work, "scenes"), "--size", str(a.size), "--only", ",".join(names)])
+
+    res = {"config": {"size": a.size, "runs": a.runs, "threads": a.threads,
+                      "sigma_inv": a.sigma_inv, "encodings": a.encodings,
+                      "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+                      "cpus": os.cpu_count(), "loadavg_start": os.getloadavg()[0]},
+           "primitives": []}
+    t0 = time.time()
+    for name in names:
+        print(f"complexity: {name}", file=sys.stderr)
+        res["primitives"].append(bench_primitive(a, name, complexity_scenes.PRIMITIVES[name][1]))
+    res["config"]["seconds"] = time.time() - t0
+    os.makedirs(a.out, exist_ok=True)
+    json.dump(res, open(os.path.join(a.out, "complexity.json"), "w"), indent=2)
+    markdown(res)
+
+
+if __name__ == "__main__":
+    main()
