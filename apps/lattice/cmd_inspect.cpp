@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "common.h"
 #include "lattice/certify.h"
+#include "lattice/encoding.h"
 #include "lattice/table_file.h"
 #include "scene/table_metadata.h"
 #include "util/memory.h"
@@ -26,8 +27,10 @@ int run_inspect(const InspectArgs& a) {
     const Primitive prim = primitive_from_metadata(h, a.file);
     const LoadedTable t = load_table_file(a.file, nullptr, prim.shape.get());
     const double per_hit = h.entries ? double(t.bytes) / double(h.entries) : 0.0;
+    const Encoding& encoding = find_encoding(h.encoding);  // known: the file loaded
     nlohmann::json j = {{"file", a.file},
                         {"encoding", h.encoding},
+                        {"encoding_summary", encoding.summary},
                         {"primitive", prim.name},
                         {"cells", h.cells},
                         {"sigma", h.sigma},
@@ -44,6 +47,7 @@ int run_inspect(const InspectArgs& a) {
                     static_cast<unsigned long long>(h.pairs), static_cast<unsigned long long>(h.entries),
                     human_bytes(double(t.bytes)).c_str(),
                     static_cast<unsigned long long>(t.bytes), per_hit);
+        std::printf("  %.*s\n", static_cast<int>(encoding.summary.size()), encoding.summary.data());
         if (!t.table->details().empty()) std::printf("  %s\n", t.table->details().c_str());
     }
     j["details"] = t.table->details();

@@ -1,6 +1,7 @@
 // lattice render SCENE.json -o OUT.png [--threads N] [--spp N] [--stats FILE.json] [--mode M]
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <map>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -17,6 +18,14 @@
 namespace lat::cli {
 namespace {
 
+enum class RenderMode { kExact, kLattice };
+
+// The option values, each said once: they both check the option and convert it.
+const std::map<std::string, RenderMode> kModes{{"exact", RenderMode::kExact},
+                                               {"lattice", RenderMode::kLattice}};
+const std::map<std::string, Instancing> kInstancing{
+    {"auto", Instancing::kAuto}, {"always", Instancing::kAlways}, {"never", Instancing::kNever}};
+
 struct RenderArgs {
     std::string scene;
     std::string output;
@@ -28,99 +37,117 @@ struct RenderArgs {
     TableSpec spec;
     std::string instancing = "auto";
     bool quiet = false;
+
+    bool lattice_mode() const { return kModes.at(mode) == RenderMode::kLattice; }
 };
 
-int run_render(const RenderArgs& a) {
-    using clock = std::chrono::steady_clock;
-    const auto t0 = clock::now();
-    // Everything the user can get wrong is checked before the (possibly long) render.
-    const ImageFormat format = image_format_for(a.output);
-    check_writable(a.output);
-    if (!a.stats.empty()) check_writable(a.stats);
+// Wall-clock milestones of a render command, in milliseconds from its start.
+struct Timings {
+    double loaded = 0, tables = 0, built = 0, written = 0;
+};
 
-    const Scene scene = load_scene(a.scene);
-    const ThreadLimit limit(a.threads);
-    const bool progress = !a.quiet && ProgressBar::stderr_is_terminal();
-    const auto t1 = clock::now();
-    SceneLattices lattices;
-    RenderScene::InstanceShapeFn instance_shape;
-    if (a.mode == "lattice") {
-        const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
-                               !a.lattice_dir.empty());
-        lattices = scene_lattices(scene, cache, a.spec, progress);
-        instance_shape = [&lattices](int prim) { return lattices.shapes[static_cast<std::size_t>(prim)]; };
-    }
-    const auto t1b = clock::now();
-    AccelOptions accel;
-    accel.instancing = a.instancing == "always"  ? Instancing::kAlways
-                       : a.instancing == "never" ? Instancing::kNever
-                                                 : Instancing::kAuto;
-    const RenderScene rs(scene, instance_shape, accel);
-    const auto t2 = clock::now();
-
-    RenderOptions opt;
-    opt.spp = a.spp;
-    opt.progress = progress;
-    const RenderOutput out = render_image(rs, opt);
-
+void write_image(const std::string& path, ImageFormat format, const RenderOutput& out) {
     switch (format) {
-        case ImageFormat::png: write_png(a.output, out.display); break;
-        case ImageFormat::pfm: write_pfm(a.output, out.radiance); break;
-        case ImageFormat::exr: write_exr(a.output, out.radiance); break;
+        case ImageFormat::png: write_png(path, out.display); break;
+        case ImageFormat::pfm: write_pfm(path, out.radiance); break;
+        case ImageFormat::exr: write_exr(path, out.radiance); break;
     }
-    const auto t3 = clock::now();
+}
 
-    const RenderStats& st = out.stats;
-    const double load_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
-    const double tables_ms = std::chrono::duration<double, std::milli>(t1b - t1).count();
-    const double build_ms = std::chrono::duration<double, std::milli>(t2 - t1b).count();
-    const double total_ms = std::chrono::duration<double, std::milli>(t3 - t0).count();
+double mrays_per_s(const RenderStats& st) {
     const std::uint64_t rays = st.primary_rays + st.shadow_rays;
-    const double mrays = st.render_ms > 0 ? rays / (st.render_ms * 1e3) : 0.0;
-    const std::size_t peak = peak_rss_bytes();
-    if (!a.quiet && a.mode == "lattice")
+    return st.render_ms > 0 ? static_cast<double>(rays) / (st.render_ms * 1e3) : 0.0;
+}
+
+void print_summary(const RenderArgs& a, const Scene& scene, const SceneLattices& lattices,
+                   const RenderStats& st, const Timings& t) {
+    if (a.lattice_mode())
         std::fprintf(stderr, "lattice: %zu table%s (%s, %s hits), %d built in %.1f s\n",
                      lattices.paths.size(), lattices.paths.size() == 1 ? "" : "s",
                      human_bytes(static_cast<double>(lattices.table_bytes)).c_str(),
                      std::to_string(lattices.table_entries).c_str(), lattices.built,
                      lattices.build_seconds);
-    if (!a.quiet)
-        std::fprintf(stderr,
-                     "lattice: %s %dx%d, %d spp, %s mode: render %.1f ms on %d threads, "
-                     "%llu primary + %llu shadow rays, %.2f M rays/s (total %.1f ms, peak %.1f MB)\n",
-                     a.output.c_str(), scene.camera.width, scene.camera.height, std::max(1, a.spp),
-                     a.mode.c_str(), st.render_ms, st.threads,
-                     static_cast<unsigned long long>(st.primary_rays),
-                     static_cast<unsigned long long>(st.shadow_rays), mrays, total_ms,
-                     static_cast<double>(peak) / (1 << 20));
-    if (!a.stats.empty()) {
-        nlohmann::json j;
-        j["scene"] = a.scene;
-        j["output"] = a.output;
-        j["mode"] = a.mode;
-        j["width"] = scene.camera.width;
-        j["height"] = scene.camera.height;
-        j["spp"] = std::max(1, a.spp);
-        j["threads"] = st.threads;
-        j["load_ms"] = load_ms;
-        j["build_ms"] = build_ms;
-        if (a.mode == "lattice") {
-            j["sigma_inv"] = a.spec.sigma_inv;
-            j["encoding"] = a.spec.encoding;
-            j["tables_ms"] = tables_ms;
-            j["tables_built"] = lattices.built;
-            j["table_bytes"] = lattices.table_bytes;
-            j["table_entries"] = lattices.table_entries;
-            j["table_files"] = lattices.paths;
-        }
-        j["render_ms"] = st.render_ms;
-        j["total_ms"] = total_ms;
-        j["primary_rays"] = st.primary_rays;
-        j["shadow_rays"] = st.shadow_rays;
-        j["rays_per_second"] = mrays * 1e6;
-        j["peak_memory_bytes"] = peak;
-        write_json_file(a.stats, j);
+    std::fprintf(stderr,
+                 "lattice: %s %dx%d, %d spp, %s mode: render %.1f ms on %d threads, "
+                 "%llu primary + %llu shadow rays, %.2f M rays/s (total %.1f ms, peak %.1f MB)\n",
+                 a.output.c_str(), scene.camera.width, scene.camera.height, std::max(1, a.spp),
+                 a.mode.c_str(), st.render_ms, st.threads,
+                 static_cast<unsigned long long>(st.primary_rays),
+                 static_cast<unsigned long long>(st.shadow_rays), mrays_per_s(st), t.written,
+                 static_cast<double>(peak_rss_bytes()) / (1 << 20));
+}
+
+nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const SceneLattices& lattices,
+                          const RenderStats& st, const Timings& t) {
+    nlohmann::json j;
+    j["scene"] = a.scene;
+    j["output"] = a.output;
+    j["mode"] = a.mode;
+    j["width"] = scene.camera.width;
+    j["height"] = scene.camera.height;
+    j["spp"] = std::max(1, a.spp);
+    j["threads"] = st.threads;
+    j["load_ms"] = t.loaded;
+    j["build_ms"] = t.built - t.tables;
+    if (a.lattice_mode()) {
+        j["sigma_inv"] = a.spec.sigma_inv;
+        j["encoding"] = a.spec.encoding;
+        j["tables_ms"] = t.tables - t.loaded;
+        j["tables_built"] = lattices.built;
+        j["table_bytes"] = lattices.table_bytes;
+        j["table_entries"] = lattices.table_entries;
+        j["table_files"] = lattices.paths;
     }
+    j["render_ms"] = st.render_ms;
+    j["total_ms"] = t.written;
+    j["primary_rays"] = st.primary_rays;
+    j["shadow_rays"] = st.shadow_rays;
+    j["rays_per_second"] = mrays_per_s(st) * 1e6;
+    j["peak_memory_bytes"] = peak_rss_bytes();
+    return j;
+}
+
+int run_render(const RenderArgs& a) {
+    using clock = std::chrono::steady_clock;
+    const auto start = clock::now();
+    auto since_start = [&] {
+        return std::chrono::duration<double, std::milli>(clock::now() - start).count();
+    };
+    // Everything the user can get wrong is checked before the (possibly long) render.
+    const ImageFormat format = image_format_for(a.output);
+    check_writable(a.output);
+    if (!a.stats.empty()) check_writable(a.stats);
+
+    Timings t;
+    const Scene scene = load_scene(a.scene);
+    const ThreadLimit limit(a.threads);
+    const bool progress = !a.quiet && ProgressBar::stderr_is_terminal();
+    t.loaded = since_start();
+    SceneLattices lattices;
+    RenderScene::InstanceShapeFn instance_shape;
+    if (a.lattice_mode()) {
+        const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
+                               !a.lattice_dir.empty());
+        lattices = scene_lattices(scene, cache, a.spec, progress);
+        instance_shape = [&lattices](int prim) {
+            return lattices.shapes[static_cast<std::size_t>(prim)];
+        };
+    }
+    t.tables = since_start();
+    AccelOptions accel;
+    accel.instancing = kInstancing.at(a.instancing);
+    const RenderScene rs(scene, instance_shape, accel);
+    t.built = since_start();
+
+    RenderOptions opt;
+    opt.spp = a.spp;
+    opt.progress = progress;
+    const RenderOutput out = render_image(rs, opt);
+    write_image(a.output, format, out);
+    t.written = since_start();
+
+    if (!a.quiet) print_summary(a, scene, lattices, out.stats, t);
+    if (!a.stats.empty()) write_json_file(a.stats, stats_json(a, scene, lattices, out.stats, t));
     return 0;
 }
 
@@ -140,7 +167,7 @@ Command add_render_command(CLI::App& parent) {
     c.app->add_option("--mode", args->mode,
                       "exact: full ray trace of every primitive; lattice: instances through their "
                       "lattice tables (built on first use and cached)")
-        ->check(CLI::IsMember({"exact", "lattice"}));
+        ->check(CLI::IsMember(kModes));
     c.app->add_option("--lattice-dir", args->lattice_dir,
                       "Directory of cached lattice tables (default: $LATTICE_CACHE_DIR, "
                       "$XDG_CACHE_HOME/lattice or ~/.cache/lattice)");
@@ -148,7 +175,7 @@ Command add_render_command(CLI::App& parent) {
     c.app->add_option("--instancing", args->instancing,
                       "Multi-part objects as Embree instances (always), flattened into one "
                       "hierarchy (never), or flattened unless that would be huge (auto)")
-        ->check(CLI::IsMember({"auto", "always", "never"}));
+        ->check(CLI::IsMember(kInstancing));
     c.app->add_flag("-q,--quiet", args->quiet, "No progress bar or summary line");
     c.run = [args] { return run_render(*args); };
     return c;
