@@ -68,135 +68,193 @@ std::uint32_t quantise(double t, std::uint32_t bits) {
     return static_cast<std::uint32_t>(std::lround(std::clamp(t, 0.0, 1.0) * top));
 }
 
-}  // namespace
+// The build's state, one step a method: the widths that meet the error targets, then the
+// occupancy bits and their rank directory, then the payload.
+class DenseBuilder {
+public:
+    DenseBuilder(const RawHits& raw, const TableContext& ctx, const EncodeOptions& opt)
+        : raw_(raw), ctx_(ctx), opt_(opt) {
+        const BoundaryGrid grid(ctx.cells);
+        l_.points = grid.count();
+        l_.domain = static_cast<std::uint64_t>(l_.points) * (l_.points - 1) / 2;
+        point_.resize(l_.points);
+        for (std::uint32_t i = 0; i < l_.points; ++i) point_[i] = to_vec(grid.point(i));
+    }
 
-ByteBuffer DenseTable::build(const RawHits& raw, const TableContext& ctx, const EncodeOptions& opt) {
-    const BoundaryGrid grid(ctx.cells);
-    Layout l;
-    l.points = grid.count();
-    l.domain = static_cast<std::uint64_t>(l.points) * (l.points - 1) / 2;
-    std::vector<Vec3> point(l.points);
-    for (std::uint32_t i = 0; i < l.points; ++i) point[i] = to_vec(grid.point(i));
-    auto normal_of = [](const RawHit& h) { return oct_decode({h.nu, h.nv}, kRawNormalBits); };
-    auto segment = [&](const RawHit& h) {
-        return Ray{point[h.a] * ctx.cell, (point[h.b] - point[h.a]) * ctx.cell};
-    };
+    ByteBuffer build() {
+        choose_widths();
+        build_occupancy();
+        ByteBuffer payload(sections(l_).total);
+        write_sections(payload);
+        write_records(payload);
+        return payload;
+    }
+
+private:
+    const RawHits& raw_;
+    const TableContext& ctx_;
+    const EncodeOptions& opt_;
+    DenseTable::Layout l_;
+    std::vector<Vec3> point_;
+    std::map<std::pair<std::uint16_t, std::uint16_t>, std::uint32_t> code_of_;
+    std::vector<std::uint32_t> codes_;  // (part, leaf) per code
+    bool use_part_ = false;
+    std::vector<std::uint64_t> occ_;
+    std::vector<std::uint32_t> counts_;
+
+    static Vec3 normal_of(const RawHit& h) { return oct_decode({h.nu, h.nv}, kRawNormalBits); }
+    Ray segment(const RawHit& h) const {
+        return {point_[h.a] * ctx_.cell, (point_[h.b] - point_[h.a]) * ctx_.cell};
+    }
+    static std::uint64_t pair_of(const RawHit& h) {
+        return DenseTable::pair_index(std::min(h.a, h.b), std::max(h.a, h.b));
+    }
 
     // t: the fewest bits whose rounding keeps every point within the target.
-    const double lmax = max_over(raw, [&](const RawHit& h) {
-        return length(point[h.b] - point[h.a]) * ctx.cell / ctx.sigma;
-    });
-    std::uint32_t t_bits = 1;
-    while (t_bits < 30 && 0.5 / double((1ull << t_bits) - 1) * lmax > opt.max_point_error) ++t_bits;
+    std::uint32_t choose_t_bits() const {
+        const double lmax = max_over(raw_, [&](const RawHit& h) {
+            return length(point_[h.b] - point_[h.a]) * ctx_.cell / ctx_.sigma;
+        });
+        std::uint32_t t_bits = 1;
+        while (t_bits < 30 && 0.5 / double((1ull << t_bits) - 1) * lmax > opt_.max_point_error)
+            ++t_bits;
+        return t_bits;
+    }
 
     // Part codes: the normal re-evaluated at the decoded point; t may need more bits for it.
-    std::map<std::pair<std::uint16_t, std::uint16_t>, std::uint32_t> code_of;
-    std::vector<std::uint32_t> codes;
-    bool part_possible = ctx.primitive != nullptr && opt.normals != "oct";
-    std::uint32_t part_t_bits = t_bits, part_bits = 0;
-    if (part_possible) {
-        for (const auto& chunk : raw.chunks)
+    // Returns false when the part normals cannot meet the target (or there is no primitive).
+    bool choose_part_codes(std::uint32_t& part_t_bits, std::uint32_t& part_bits) {
+        if (ctx_.primitive == nullptr || opt_.normals == "oct") return false;
+        for (const auto& chunk : raw_.chunks)
             for (const RawHit& h : chunk)
-                if (code_of.emplace(std::make_pair(h.part, h.leaf), std::uint32_t(code_of.size())).second) {
+                if (code_of_.emplace(std::make_pair(h.part, h.leaf), std::uint32_t(code_of_.size()))
+                        .second) {
                     const Crossing c = h.crossing(0);
-                    codes.push_back(c.part);
-                    codes.push_back(c.leaf);
+                    codes_.push_back(c.part);
+                    codes_.push_back(c.leaf);
                 }
-        while ((1ull << part_bits) < code_of.size()) ++part_bits;
+        part_bits = 0;
+        while ((1ull << part_bits) < code_of_.size()) ++part_bits;
         auto normal_at = [&](const RawHit& h, double t) {
-            return normalize(ctx.primitive->normal(segment(h), h.crossing(t)));
+            return normalize(ctx_.primitive->normal(segment(h), h.crossing(t)));
         };
         for (;; ++part_t_bits) {
-            if (part_t_bits > 30) {
-                part_possible = false;
-                break;
-            }
+            if (part_t_bits > 30) return false;
             const double top = double((1ull << part_t_bits) - 1);
-            const double worst = max_over(raw, [&](const RawHit& h) {
+            const double worst = max_over(raw_, [&](const RawHit& h) {
                 return angle_deg(normal_at(h, h.t), normal_at(h, quantise(h.t, part_t_bits) / top));
             });
-            if (worst + kRawNormalSlack <= opt.max_normal_error_deg) break;
+            if (worst + kRawNormalSlack <= opt_.max_normal_error_deg) return true;
         }
     }
+
     // Octahedral normals: the fewest bits per component within the target (found on a sample,
-    // then checked on every hit), unless part codes are sure to be smaller.
-    std::uint32_t oct_bits = 16;
-    const bool need_oct = !part_possible || opt.normals == "oct" ||
-                          (opt.normals == "auto" && t_bits + 2 * 4 < part_t_bits + part_bits);
-    if (need_oct) {
+    // then checked on every hit).
+    std::uint32_t choose_oct_bits() const {
         auto worst_at = [&](std::uint32_t b, std::size_t stride) {
-            return max_over(raw, [&](const RawHit& h) {
-                const Vec3 n = normal_of(h);
-                return angle_deg(n, oct_decode(oct_encode_precise(n, int(b)), int(b)));
-            }, stride);
+            return max_over(
+                raw_,
+                [&](const RawHit& h) {
+                    const Vec3 n = normal_of(h);
+                    return angle_deg(n, oct_decode(oct_encode_precise(n, int(b)), int(b)));
+                },
+                stride);
         };
-        oct_bits = 4;
-        while (oct_bits < 16 && worst_at(oct_bits, 61) + kRawNormalSlack > opt.max_normal_error_deg) ++oct_bits;
-        while (oct_bits < 16 && worst_at(oct_bits, 1) + kRawNormalSlack > opt.max_normal_error_deg) ++oct_bits;
+        std::uint32_t oct_bits = 4;
+        while (oct_bits < 16 && worst_at(oct_bits, 61) + kRawNormalSlack > opt_.max_normal_error_deg)
+            ++oct_bits;
+        while (oct_bits < 16 && worst_at(oct_bits, 1) + kRawNormalSlack > opt_.max_normal_error_deg)
+            ++oct_bits;
+        return oct_bits;
     }
-    const std::uint32_t oct_record = t_bits + 2 * oct_bits, part_record = part_t_bits + part_bits;
-    if (opt.normals == "part" && !part_possible)
-        throw std::runtime_error("dense: part normals need the primitive");
-    const bool use_part = part_possible && (opt.normals == "part" || part_record < oct_record || !need_oct);
-    l.normal_mode = use_part ? 1 : 0;
-    l.t_bits = use_part ? part_t_bits : t_bits;
-    l.normal_bits = use_part ? part_bits : 2 * oct_bits;
-    l.parts = use_part ? static_cast<std::uint32_t>(code_of.size()) : 0;
+
+    // Part codes or octahedral normals, whichever the options ask for or is smaller.
+    void choose_widths() {
+        const std::uint32_t t_bits = choose_t_bits();
+        std::uint32_t part_t_bits = t_bits, part_bits = 0;
+        const bool part_possible = choose_part_codes(part_t_bits, part_bits);
+        // Octahedral codes are only worked out when part codes are not sure to be smaller.
+        std::uint32_t oct_bits = 16;
+        const bool need_oct = !part_possible || opt_.normals == "oct" ||
+                              (opt_.normals == "auto" && t_bits + 2 * 4 < part_t_bits + part_bits);
+        if (need_oct) oct_bits = choose_oct_bits();
+        const std::uint32_t oct_record = t_bits + 2 * oct_bits, part_record = part_t_bits + part_bits;
+        if (opt_.normals == "part" && !part_possible)
+            throw std::runtime_error("dense: part normals need the primitive");
+        use_part_ = part_possible &&
+                    (opt_.normals == "part" || part_record < oct_record || !need_oct);
+        l_.normal_mode = use_part_ ? 1 : 0;
+        l_.t_bits = use_part_ ? part_t_bits : t_bits;
+        l_.normal_bits = use_part_ ? part_bits : 2 * oct_bits;
+        l_.parts = use_part_ ? static_cast<std::uint32_t>(code_of_.size()) : 0;
+    }
 
     // Occupancy: a pair is stored when either direction hits.
-    const std::uint64_t nwords = words_for_bits(l.domain);
-    std::vector<std::uint64_t> occ(nwords, 0);
-    tbb::parallel_for(std::size_t{0}, raw.chunks.size(), [&](std::size_t c) {
-        for (const RawHit& h : raw.chunks[c]) {
-            const std::uint64_t i = pair_index(std::min(h.a, h.b), std::max(h.a, h.b));
-            std::atomic_ref<std::uint64_t>(occ[i >> 6]).fetch_or(std::uint64_t{1} << (i & 63),
-                                                                  std::memory_order_relaxed);
-        }
-    });
-    std::vector<std::uint32_t> counts(RankIndex::count_entries(nwords));
-    RankIndex::build(occ.data(), nwords, counts.data());
-    l.occupied = counts.back();
+    void build_occupancy() {
+        const std::uint64_t nwords = words_for_bits(l_.domain);
+        occ_.assign(nwords, 0);
+        tbb::parallel_for(std::size_t{0}, raw_.chunks.size(), [&](std::size_t c) {
+            for (const RawHit& h : raw_.chunks[c]) {
+                const std::uint64_t i = pair_of(h);
+                std::atomic_ref<std::uint64_t>(occ_[i >> 6])
+                    .fetch_or(std::uint64_t{1} << (i & 63), std::memory_order_relaxed);
+            }
+        });
+        counts_.resize(RankIndex::count_entries(nwords));
+        RankIndex::build(occ_.data(), nwords, counts_.data());
+        l_.occupied = counts_.back();
+    }
 
-    const Sections sec = sections(l);
-    ByteBuffer payload(sec.total);
-    std::memset(payload.data(), 0, sec.total);
-    const Header hdr{kMagic, l.points, l.t_bits, l.domain, l.occupied, l.normal_mode, l.normal_bits, l.parts, 0, {0, 0}};
-    std::memcpy(payload.data(), &hdr, sizeof hdr);
-    std::memcpy(payload.data() + sec.occ, occ.data(), nwords * 8);
-    std::memcpy(payload.data() + sec.counts, counts.data(), counts.size() * 4);
-    if (l.parts) std::memcpy(payload.data() + sec.codes, codes.data(), codes.size() * 4);
+    void write_sections(ByteBuffer& payload) const {
+        const Sections sec = sections(l_);
+        std::memset(payload.data(), 0, sec.total);
+        const Header hdr{kMagic,        l_.points,      l_.t_bits,      l_.domain, l_.occupied,
+                         l_.normal_mode, l_.normal_bits, l_.parts,       0,         {0, 0}};
+        std::memcpy(payload.data(), &hdr, sizeof hdr);
+        std::memcpy(payload.data() + sec.occ, occ_.data(), occ_.size() * 8);
+        std::memcpy(payload.data() + sec.counts, counts_.data(), counts_.size() * 4);
+        if (l_.parts) std::memcpy(payload.data() + sec.codes, codes_.data(), codes_.size() * 4);
+    }
 
     // Records: both directions of each pair; a direction that missed only by rounding at a
     // tangency takes the other's point, reversed.
-    const RankIndex rank(occ.data(), counts.data());
-    auto* rec = reinterpret_cast<std::uint64_t*>(payload.data() + sec.records);
-    const std::uint32_t field = l.t_bits + l.normal_bits;
-    std::vector<std::uint8_t> present(l.occupied, 0);
-    auto write_field = [&](std::uint64_t k, int dir, std::uint32_t tq, std::uint64_t n) {
-        const std::uint64_t off = k * 2 * field + static_cast<std::uint64_t>(dir) * field;
-        write_bits(rec, off, l.t_bits, tq);
-        if (l.normal_bits) write_bits(rec, off + l.t_bits, l.normal_bits, n);
-    };
-    auto normal_field = [&](const RawHit& h) -> std::uint64_t {
-        if (use_part) return code_of.find({h.part, h.leaf})->second;
-        const Oct o = oct_encode_precise(normal_of(h), int(l.normal_bits / 2));
-        return o.u | (std::uint64_t{o.v} << (l.normal_bits / 2));
-    };
-    for (const auto& chunk : raw.chunks)
-        for (const RawHit& h : chunk) {
-            const std::uint64_t k = rank.rank(pair_index(std::min(h.a, h.b), std::max(h.a, h.b)));
-            const int dir = h.a < h.b ? 0 : 1;
-            write_field(k, dir, quantise(h.t, l.t_bits), normal_field(h));
-            present[k] |= static_cast<std::uint8_t>(1 << dir);
-        }
-    // The rare lone direction (a tangency decided differently each way): copy it over.
-    for (const auto& chunk : raw.chunks)
-        for (const RawHit& h : chunk) {
-            const std::uint64_t k = rank.rank(pair_index(std::min(h.a, h.b), std::max(h.a, h.b)));
-            if (present[k] == 3) continue;
-            write_field(k, h.a < h.b ? 1 : 0, quantise(1.0 - double(h.t), l.t_bits), normal_field(h));
-        }
-    return payload;
+    void write_records(ByteBuffer& payload) const {
+        const RankIndex rank(occ_.data(), counts_.data());
+        auto* rec = reinterpret_cast<std::uint64_t*>(payload.data() + sections(l_).records);
+        const std::uint32_t field = l_.t_bits + l_.normal_bits;
+        std::vector<std::uint8_t> present(l_.occupied, 0);
+        auto write_field = [&](std::uint64_t k, int dir, std::uint32_t tq, std::uint64_t n) {
+            const std::uint64_t off = k * 2 * field + static_cast<std::uint64_t>(dir) * field;
+            write_bits(rec, off, l_.t_bits, tq);
+            if (l_.normal_bits) write_bits(rec, off + l_.t_bits, l_.normal_bits, n);
+        };
+        auto normal_field = [&](const RawHit& h) -> std::uint64_t {
+            if (use_part_) return code_of_.find({h.part, h.leaf})->second;
+            const Oct o = oct_encode_precise(normal_of(h), int(l_.normal_bits / 2));
+            return o.u | (std::uint64_t{o.v} << (l_.normal_bits / 2));
+        };
+        for (const auto& chunk : raw_.chunks)
+            for (const RawHit& h : chunk) {
+                const std::uint64_t k = rank.rank(pair_of(h));
+                const int dir = h.a < h.b ? 0 : 1;
+                write_field(k, dir, quantise(h.t, l_.t_bits), normal_field(h));
+                present[k] |= static_cast<std::uint8_t>(1 << dir);
+            }
+        // The rare lone direction (a tangency decided differently each way): copy it over.
+        for (const auto& chunk : raw_.chunks)
+            for (const RawHit& h : chunk) {
+                const std::uint64_t k = rank.rank(pair_of(h));
+                if (present[k] == 3) continue;
+                write_field(k, h.a < h.b ? 1 : 0, quantise(1.0 - double(h.t), l_.t_bits),
+                            normal_field(h));
+            }
+    }
+};
+
+}  // namespace
+
+ByteBuffer DenseTable::build(const RawHits& raw, const TableContext& ctx, const EncodeOptions& opt) {
+    return DenseBuilder(raw, ctx, opt).build();
 }
 
 DenseTable::DenseTable(const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
