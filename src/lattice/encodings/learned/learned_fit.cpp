@@ -140,126 +140,172 @@ std::vector<std::uint64_t> FieldFit::quantise(const FieldShape& s) const {
     return out;
 }
 
+namespace {
+
+// One fit, one step a method: the bricks near the points, the nodes fitted there, the signs
+// spread to every node, and the bricks classified as dense (both signs) or of one sign.
+class FieldFitter {
+public:
+    FieldFitter(const PointGrid& grid, FieldShape& s, const I3& nn)
+        : grid_(grid), s_(s), nn_(nn), nv_{nn[0] - 1, nn[1] - 1, nn[2] - 1} {
+        const auto nb3 = s.bricks();
+        nb_ = {nb3[0], nb3[1], nb3[2]};
+        nbricks_ = s.brick_count();
+    }
+
+    void fit(FieldFit& out) {
+        find_candidates();
+        fit_nodes();
+        spread_signs();
+        classify_bricks(out);
+    }
+
+private:
+    const PointGrid& grid_;
+    const FieldShape& s_;
+    I3 nn_, nv_, nb_;  // nodes, voxels and bricks per axis
+    std::uint64_t nbricks_ = 0;
+    std::vector<std::uint8_t> candidate_;  // per brick
+    std::vector<std::uint64_t> cand_;      // the candidate bricks' ids
+    std::vector<double> dist_;             // per node of each candidate brick
+    std::vector<Vec3> normal_;
+    std::vector<std::uint8_t> known_;
+    std::vector<std::int8_t> sign_;  // per node of the grid
+
+    std::uint64_t brick_id(const I3& b) const {
+        return std::uint64_t((b[2] * nb_[1] + b[1]) * nb_[0] + b[0]);
+    }
+    I3 brick_of(std::uint64_t id) const {
+        return I3{std::int64_t(id % std::uint64_t(nb_[0])),
+                  std::int64_t(id / std::uint64_t(nb_[0]) % std::uint64_t(nb_[1])),
+                  std::int64_t(id / std::uint64_t(nb_[0] * nb_[1]))};
+    }
+    // The node of a brick's local node index, clamped to the grid (padding repeats the edge).
+    I3 node_at(const I3& b, int node) const {
+        const I3 l{node % (kBrick + 1), node / (kBrick + 1) % (kBrick + 1),
+                   node / ((kBrick + 1) * (kBrick + 1))};
+        I3 n;
+        for (std::size_t ax = 0; ax < 3; ++ax) n[ax] = std::min(b[ax] * kBrick + l[ax], nn_[ax] - 1);
+        return n;
+    }
+    std::uint64_t node_id(const I3& n) const {
+        return std::uint64_t((n[2] * nn_[1] + n[1]) * nn_[0] + n[0]);
+    }
+    int sign_of(const I3& n) const { return sign_[node_id(n)] < 0 ? -1 : 1; }
+
+    // Candidate bricks: those within a voxel of some point.
+    void find_candidates() {
+        candidate_.assign(nbricks_, 0);
+        for (std::int64_t z = 0; z < nv_[2]; ++z)
+            for (std::int64_t y = 0; y < nv_[1]; ++y)
+                for (std::int64_t x = 0; x < nv_[0]; ++x) {
+                    if (!grid_.occupied({x, y, z})) continue;
+                    for (int c = 0; c < 27; ++c) {
+                        const I3 v{x + c % 3 - 1, y + c / 3 % 3 - 1, z + c / 9 - 1};
+                        if (v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] >= nv_[0] || v[1] >= nv_[1] ||
+                            v[2] >= nv_[2])
+                            continue;
+                        candidate_[brick_id({v[0] / kBrick, v[1] / kBrick, v[2] / kBrick})] = 1;
+                    }
+                }
+        for (std::uint64_t b = 0; b < nbricks_; ++b)
+            if (candidate_[b]) cand_.push_back(b);
+    }
+
+    void fit_nodes() {
+        dist_.assign(cand_.size() * kBrickNodes, 0.0);
+        normal_.assign(cand_.size() * kBrickNodes, Vec3{0, 0, 1});
+        known_.assign(cand_.size() * kBrickNodes, 0);
+        tbb::parallel_for(std::size_t{0}, cand_.size(), [&](std::size_t k) {
+            const I3 b = brick_of(cand_[k]);
+            for (int node = 0; node < kBrickNodes; ++node) {
+                const I3 n = node_at(b, node);
+                const std::size_t i = k * kBrickNodes + std::size_t(node);
+                double d;
+                if (grid_.fit_node({double(n[0]), double(n[1]), double(n[2])}, d, normal_[i]))
+                    dist_[i] = std::clamp(d, -s_.dmax, s_.dmax), known_[i] = 1;
+            }
+        });
+    }
+
+    // Signs of the nodes the fit reached, spread breadth-first (in index order: deterministic)
+    // to all others; what no surface reaches is outside.
+    void spread_signs() {
+        sign_.assign(std::uint64_t(nn_[0] * nn_[1] * nn_[2]), 0);
+        std::vector<std::uint64_t> queue;
+        for (std::size_t k = 0; k < cand_.size(); ++k)
+            for (int node = 0; node < kBrickNodes; ++node) {
+                const std::size_t i = k * kBrickNodes + std::size_t(node);
+                if (!known_[i]) continue;
+                const std::uint64_t id = node_id(node_at(brick_of(cand_[k]), node));
+                if (sign_[id] == 0) queue.push_back(id);
+                sign_[id] = dist_[i] <= 0 ? -1 : 1;
+            }
+        std::sort(queue.begin(), queue.end());
+        const std::uint64_t step[3] = {1, std::uint64_t(nn_[0]), std::uint64_t(nn_[0] * nn_[1])};
+        for (std::size_t q = 0; q < queue.size(); ++q) {
+            const std::uint64_t id = queue[q];
+            const std::int64_t at[3] = {std::int64_t(id % step[1]),
+                                        std::int64_t(id / step[1] % std::uint64_t(nn_[1])),
+                                        std::int64_t(id / step[2])};
+            for (std::size_t ax = 0; ax < 3; ++ax) {
+                if (at[ax] > 0 && sign_[id - step[ax]] == 0)
+                    sign_[id - step[ax]] = sign_[id], queue.push_back(id - step[ax]);
+                if (at[ax] + 1 < nn_[ax] && sign_[id + step[ax]] == 0)
+                    sign_[id + step[ax]] = sign_[id], queue.push_back(id + step[ax]);
+            }
+        }
+    }
+
+    // Dense bricks are the candidates with nodes of both signs: elsewhere the trilinear field
+    // has no zero, and one sign bit says as much.
+    void classify_bricks(FieldFit& out) {
+        out.dense_bits.assign(words_for_bits(nbricks_), 0);
+        out.sign_bits.assign(words_for_bits(nbricks_), 0);
+        out.dist.clear();
+        out.normal.clear();
+        std::size_t k = 0;
+        for (std::uint64_t b = 0; b < nbricks_; ++b) {
+            const I3 bb = brick_of(b);
+            bool neg = false, pos = false;
+            if (candidate_[b]) {
+                for (int node = 0; node < kBrickNodes; ++node) {
+                    const std::size_t i = k * kBrickNodes + std::size_t(node);
+                    if (!known_[i]) dist_[i] = sign_of(node_at(bb, node)) * s_.dmax;
+                    (dist_[i] <= 0 ? neg : pos) = true;
+                }
+            }
+            if (neg && pos) {
+                out.dense_bits[b >> 6] |= std::uint64_t{1} << (b & 63);
+                out.dist.insert(out.dist.end(), dist_.begin() + std::ptrdiff_t(k * kBrickNodes),
+                                dist_.begin() + std::ptrdiff_t((k + 1) * kBrickNodes));
+                out.normal.insert(out.normal.end(),
+                                  normal_.begin() + std::ptrdiff_t(k * kBrickNodes),
+                                  normal_.begin() + std::ptrdiff_t((k + 1) * kBrickNodes));
+            } else if (candidate_[b] ? neg : sign_of(node_at(bb, kBrickNodes / 2)) < 0) {
+                out.sign_bits[b >> 6] |= std::uint64_t{1} << (b & 63);
+            }
+            k += candidate_[b];
+        }
+        out.dense = out.dist.size() / kBrickNodes;
+    }
+};
+
+}  // namespace
+
 bool fit_field(std::span<const SurfacePoint> points, std::array<int, 3> cells, double g,
                FieldFit& out) {
     FieldShape& s = out.shape;
     s.g = g;
     s.dmax = kSearch * g;
-    I3 nv{}, nn{};  // voxels and nodes per axis
+    I3 nn{};  // nodes per axis
     for (std::size_t ax = 0; ax < 3; ++ax) {
         s.nodes[ax] = static_cast<int>(std::ceil(cells[ax] / g - 1e-9)) + 1;
         nn[ax] = s.nodes[ax];
-        nv[ax] = nn[ax] - 1;
     }
     if (nn[0] * nn[1] * nn[2] > std::int64_t(kMaxVoxels)) return false;
-    const PointGrid grid(points, g, nv);
-    const auto nb3 = s.bricks();
-    const I3 nb{nb3[0], nb3[1], nb3[2]};
-    const std::uint64_t nbricks = s.brick_count();
-    auto brick_id = [&](const I3& b) {
-        return std::uint64_t((b[2] * nb[1] + b[1]) * nb[0] + b[0]);
-    };
-    auto brick_of = [&](std::uint64_t id) {
-        return I3{std::int64_t(id % std::uint64_t(nb[0])),
-                  std::int64_t(id / std::uint64_t(nb[0]) % std::uint64_t(nb[1])),
-                  std::int64_t(id / std::uint64_t(nb[0] * nb[1]))};
-    };
-    // The node of a brick's local node index, clamped to the grid (padding repeats the edge).
-    auto node_at = [&](const I3& b, int node) {
-        const I3 l{node % (kBrick + 1), node / (kBrick + 1) % (kBrick + 1),
-                   node / ((kBrick + 1) * (kBrick + 1))};
-        I3 n;
-        for (std::size_t ax = 0; ax < 3; ++ax) n[ax] = std::min(b[ax] * kBrick + l[ax], nn[ax] - 1);
-        return n;
-    };
-    auto node_id = [&](const I3& n) { return std::uint64_t((n[2] * nn[1] + n[1]) * nn[0] + n[0]); };
-
-    // Candidate bricks: those within a voxel of some point.
-    std::vector<std::uint8_t> candidate(nbricks, 0);
-    for (std::int64_t z = 0; z < nv[2]; ++z)
-        for (std::int64_t y = 0; y < nv[1]; ++y)
-            for (std::int64_t x = 0; x < nv[0]; ++x) {
-                if (!grid.occupied({x, y, z})) continue;
-                for (int c = 0; c < 27; ++c) {
-                    const I3 v{x + c % 3 - 1, y + c / 3 % 3 - 1, z + c / 9 - 1};
-                    if (v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] >= nv[0] || v[1] >= nv[1] ||
-                        v[2] >= nv[2])
-                        continue;
-                    candidate[brick_id({v[0] / kBrick, v[1] / kBrick, v[2] / kBrick})] = 1;
-                }
-            }
-    std::vector<std::uint64_t> cand;
-    for (std::uint64_t b = 0; b < nbricks; ++b)
-        if (candidate[b]) cand.push_back(b);
-    std::vector<double> dist(cand.size() * kBrickNodes);
-    std::vector<Vec3> normal(cand.size() * kBrickNodes, Vec3{0, 0, 1});
-    std::vector<std::uint8_t> known(cand.size() * kBrickNodes, 0);
-    tbb::parallel_for(std::size_t{0}, cand.size(), [&](std::size_t k) {
-        const I3 b = brick_of(cand[k]);
-        for (int node = 0; node < kBrickNodes; ++node) {
-            const I3 n = node_at(b, node);
-            const std::size_t i = k * kBrickNodes + std::size_t(node);
-            double d;
-            if (grid.fit_node({double(n[0]), double(n[1]), double(n[2])}, d, normal[i]))
-                dist[i] = std::clamp(d, -s.dmax, s.dmax), known[i] = 1;
-        }
-    });
-    // Signs of the nodes the fit reached, spread breadth-first (in index order: deterministic)
-    // to all others; what no surface reaches is outside.
-    std::vector<std::int8_t> sign(std::uint64_t(nn[0] * nn[1] * nn[2]), 0);
-    std::vector<std::uint64_t> queue;
-    for (std::size_t k = 0; k < cand.size(); ++k)
-        for (int node = 0; node < kBrickNodes; ++node) {
-            const std::size_t i = k * kBrickNodes + std::size_t(node);
-            if (!known[i]) continue;
-            const std::uint64_t id = node_id(node_at(brick_of(cand[k]), node));
-            if (sign[id] == 0) queue.push_back(id);
-            sign[id] = dist[i] <= 0 ? -1 : 1;
-        }
-    std::sort(queue.begin(), queue.end());
-    const std::uint64_t step[3] = {1, std::uint64_t(nn[0]), std::uint64_t(nn[0] * nn[1])};
-    for (std::size_t q = 0; q < queue.size(); ++q) {
-        const std::uint64_t id = queue[q];
-        const std::int64_t at[3] = {std::int64_t(id % step[1]),
-                                    std::int64_t(id / step[1] % std::uint64_t(nn[1])),
-                                    std::int64_t(id / step[2])};
-        for (std::size_t ax = 0; ax < 3; ++ax) {
-            if (at[ax] > 0 && sign[id - step[ax]] == 0)
-                sign[id - step[ax]] = sign[id], queue.push_back(id - step[ax]);
-            if (at[ax] + 1 < nn[ax] && sign[id + step[ax]] == 0)
-                sign[id + step[ax]] = sign[id], queue.push_back(id + step[ax]);
-        }
-    }
-    auto sign_of = [&](const I3& n) { return sign[node_id(n)] < 0 ? -1 : 1; };
-    // Dense bricks are the candidates with nodes of both signs: elsewhere the trilinear field
-    // has no zero, and one sign bit says as much.
-    out.dense_bits.assign(words_for_bits(nbricks), 0);
-    out.sign_bits.assign(words_for_bits(nbricks), 0);
-    out.dist.clear();
-    out.normal.clear();
-    std::size_t k = 0;
-    for (std::uint64_t b = 0; b < nbricks; ++b) {
-        const I3 bb = brick_of(b);
-        bool neg = false, pos = false;
-        if (candidate[b]) {
-            for (int node = 0; node < kBrickNodes; ++node) {
-                const std::size_t i = k * kBrickNodes + std::size_t(node);
-                if (!known[i]) dist[i] = sign_of(node_at(bb, node)) * s.dmax;
-                (dist[i] <= 0 ? neg : pos) = true;
-            }
-        }
-        if (neg && pos) {
-            out.dense_bits[b >> 6] |= std::uint64_t{1} << (b & 63);
-            out.dist.insert(out.dist.end(), dist.begin() + std::ptrdiff_t(k * kBrickNodes),
-                            dist.begin() + std::ptrdiff_t((k + 1) * kBrickNodes));
-            out.normal.insert(out.normal.end(), normal.begin() + std::ptrdiff_t(k * kBrickNodes),
-                              normal.begin() + std::ptrdiff_t((k + 1) * kBrickNodes));
-        } else if (candidate[b] ? neg : sign_of(node_at(bb, kBrickNodes / 2)) < 0) {
-            out.sign_bits[b >> 6] |= std::uint64_t{1} << (b & 63);
-        }
-        k += candidate[b];
-    }
-    out.dense = out.dist.size() / kBrickNodes;
+    const PointGrid grid(points, g, I3{nn[0] - 1, nn[1] - 1, nn[2] - 1});
+    FieldFitter(grid, s, nn).fit(out);
     return true;
 }
 
