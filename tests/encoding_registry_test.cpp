@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <set>
@@ -154,6 +156,50 @@ TEST_P(EveryEncoding, CorruptAndTruncatedFilesAreInputErrors) {
         EXPECT_NE(load_error(path).find("not a valid lattice table"), std::string::npos)
             << "kept " << keep << " of " << b.payload.size() << ": " << load_error(path);
     }
+}
+
+// A forged file (checksums recomputed) with one payload byte changed, at many places: it must
+// be refused as an input error, or open into a table whose every answer stays in bounds (a
+// crash or a sanitizer report here is a table trusting its file).
+TEST_P(EveryEncoding, ForgedPayloadsAreRefusedOrSafe) {
+    const Encoding& e = *GetParam();
+    const Built b = build(e);
+    test::TempDir dir;
+    const std::string path = (dir.path() / "t.lht").string();
+    const BoundaryGrid grid(kContext.cells);
+    const std::size_t stride = std::max<std::size_t>(1, b.payload.size() / 400);
+    int refused = 0, opened = 0;
+    for (std::size_t at = 0; at < b.payload.size(); at += at < 128 ? 1 : stride) {
+        for (const std::uint8_t flip : {std::uint8_t{0x01}, std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
+            ByteBuffer forged(b.payload.size());
+            std::memcpy(forged.data(), b.payload.data(), b.payload.size());
+            forged.data()[at] ^= flip;
+            write_table_file(path, header_for(e, b), forged);
+            LoadedTable t;
+            try {
+                t = load_table_file(path, nullptr, &hook());
+            } catch (const InputError&) {
+                ++refused;
+                continue;
+            }
+            ++opened;
+            for (std::uint32_t x = 0; x < grid.count(); x += 7)
+                for (std::uint32_t y = 0; y < grid.count(); y += 11) {
+                    TableHit hit;
+                    CandidateList list;
+                    if (e.kind == LatticeTable::Kind::kCandidates) {
+                        if (t.table->candidates(x, y, list)) {
+                            ASSERT_LE(list.count, kMaxCandidates);
+                            for (int k = 0; k < list.count; ++k)
+                                ASSERT_LT(list.parts[k], hook().primitive_count());
+                        }
+                    } else if (t.table->lookup(x, y, hit)) {
+                        ASSERT_TRUE(std::isfinite(hit.t) && std::isfinite(hit.normal.x)) << at;
+                    }
+                }
+        }
+    }
+    EXPECT_GT(refused + opened, 100);
 }
 
 INSTANTIATE_TEST_SUITE_P(Registry, EveryEncoding, ::testing::ValuesIn(encodings().begin(), encodings().end()),

@@ -5,10 +5,12 @@
 
 #include "commands.h"
 #include "common.h"
+#include "lattice/boundary_grid.h"
 #include "lattice/certify.h"
 #include "lattice/encoding.h"
 #include "lattice/table_file.h"
 #include "scene/table_metadata.h"
+#include "util/error.h"
 #include "util/memory.h"
 #include "util/progress.h"
 
@@ -51,6 +53,15 @@ int run_inspect(const InspectArgs& a) {
         if (!t.table->details().empty()) std::printf("  %s\n", t.table->details().c_str());
     }
     j["details"] = t.table->details();
+    if (const double pairs = static_cast<double>(BoundaryGrid::pair_count(h.cells));
+        a.certify && pairs > kMaxCertifyPairs) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf,
+                      ": certifying would re-intersect %.3g point pairs, more than the limit of "
+                      "%.3g (use --no-certify)",
+                      pairs, kMaxCertifyPairs);
+        throw InputError(a.file + buf);
+    }
     if (a.certify) {
         const CertifyReport r = certify_table(*t.table, h.context(prim.shape.get()), !a.json && ProgressBar::stderr_is_terminal());
         j["certified"] = {{"pairs", r.pairs},

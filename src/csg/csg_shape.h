@@ -43,6 +43,10 @@ public:
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
+    bool names_surface(const Crossing& c) const override {
+        return c.leaf_index() < leaves_.size() &&
+               leaves_[c.leaf_index()].leaf.shape->names_surface({c.t, c.part, 0});
+    }
     // A leaf's stored surface point (lattices) is carried to CSG coordinates.
     SurfacePoint surface(const Ray& r, const Crossing& c) const override;
     bool inside(Vec3 p) const override { return inside(root_, p); }

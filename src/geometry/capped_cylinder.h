@@ -14,6 +14,8 @@ public:
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
+    // The side (0) and the two caps (1, 2).
+    bool names_surface(const Crossing& c) const override { return c.part <= 2; }
     bool inside(Vec3 p) const override;
 
     // The span of the ray's line inside the cylinder, if any (t0 < t1, parts as above).

@@ -32,6 +32,10 @@ public:
     bool occluded(const Ray& r, double tmin, double tmax) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
+    // A part's index in the high bits, its own part number in the low two.
+    bool names_surface(const Crossing& c) const override {
+        return (c.part >> 2) < primitive_count() && part(c.part >> 2).names_surface({c.t, c.part & 3u, 0});
+    }
     bool inside(Vec3 p) const override;
 
     std::size_t primitive_count() const override { return sphere_parts_.size() + cyl_parts_.size(); }

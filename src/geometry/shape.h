@@ -84,6 +84,9 @@ public:
     virtual double surface_tolerance() const { return 0.0; }
     // Whether p is inside the solid (boundary counts as either).
     virtual bool inside(Vec3 p) const = 0;
+    // Whether c's part (and CSG leaf) name a surface of this shape, so that normal() may be
+    // asked for it: crossings read from files (lattice tables) are checked with it first.
+    virtual bool names_surface(const Crossing& c) const { return c.part == 0; }
 
     // Shapes made of many parts (sphere/cylinder chains) expose them so the accelerator can
     // build a hierarchy over them; by default the shape is one primitive.

@@ -19,6 +19,10 @@ struct CertifyReport {
     double seconds = 0;
 };
 
+// Certification is exhaustive: lattices with more point pairs than this (hours of work) are
+// refused by `lattice inspect` unless certification is skipped.
+inline constexpr double kMaxCertifyPairs = 2e10;
+
 // ctx.primitive must be set. Parallel over entry points.
 CertifyReport certify_table(const LatticeTable& table, const TableContext& ctx, bool progress);
 

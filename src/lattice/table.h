@@ -70,6 +70,15 @@ struct TableContext {
     const Shape* primitive = nullptr;
 };
 
+// The one range of sigma^-1, the refinement of a lattice, for requests and for table files.
+inline constexpr int kMaxSigmaInv = 1024;
+// Empty when 1 <= k <= kMaxSigmaInv, else "sigma^-1 = K is out of range (1 to 1024)".
+inline std::string sigma_inv_error(long long k) {
+    if (k >= 1 && k <= kMaxSigmaInv) return {};
+    return "sigma^-1 = " + std::to_string(k) + " is out of range (1 to " +
+           std::to_string(kMaxSigmaInv) + ")";
+}
+
 // Up to this many parts per candidate list (a table with longer lists cannot be built).
 inline constexpr int kMaxCandidates = 64;
 struct CandidateList {

@@ -6,11 +6,13 @@
 #include <unistd.h>
 
 #include <bit>
+#include <cmath>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
 
+#include "lattice/boundary_grid.h"
 #include "lattice/encoding.h"
 #include "util/error.h"
 #include "util/hash.h"
@@ -70,6 +72,26 @@ std::array<std::uint8_t, kTableHeaderBytes> encode_header(const TableHeader& h,
     return b;
 }
 
+// The lattice a header describes must be one this program could have written: numbers finite
+// and in range, consistent with each other, and small enough to index. Empty when it is.
+std::string lattice_error(const TableHeader& h) {
+    if (std::string e = sigma_inv_error(h.sigma_inv); !e.empty()) return e;
+    if (!(std::isnormal(h.sigma) && h.sigma > 0 && h.sigma < 1e300))
+        return "sigma must be a positive finite number";
+    if (!(std::isnormal(h.cell) && h.cell == h.sigma / h.sigma_inv))
+        return "the cell size is not sigma / sigma^-1";
+    for (const int c : h.cells)
+        if (c < 1 || c % h.sigma_inv != 0)
+            return "the cells must be positive multiples of sigma^-1";
+    const long double nx = h.cells[0], ny = h.cells[1], nz = h.cells[2];
+    if (2 * ((nx + 1) * (ny + 1) + (ny + 1) * (nz + 1) + (nz + 1) * (nx + 1)) >= 0xFFFFFFFFu)
+        return "the lattice has too many boundary points to index";
+    if (BoundaryGrid::pair_count(h.cells) != static_cast<long double>(h.pairs))
+        return "N_lp does not match the cells";
+    if (h.entries > h.pairs) return "more stored hits than point pairs";
+    return {};
+}
+
 TableHeader decode_header(const std::uint8_t* b, std::size_t file_size, const std::string& path,
                           std::uint64_t& payload_checksum, std::uint64_t& meta_bytes) {
     auto bad = [&](const std::string& what) -> InputError {
@@ -105,6 +127,7 @@ TableHeader decode_header(const std::uint8_t* b, std::size_t file_size, const st
     if (h.payload_bytes > body || meta_bytes != body - h.payload_bytes)
         throw bad("file holds " + std::to_string(body) + " bytes after the header, header says " +
                   std::to_string(h.payload_bytes + meta_bytes) + " (truncated?)");
+    if (const std::string e = lattice_error(h); !e.empty()) throw bad(e);
     return h;
 }
 
@@ -209,8 +232,13 @@ LoadedTable load_table_file(const std::string& path, const TableHeader* expected
         throw InputError(path + ": not a valid lattice table: payload checksum mismatch (corrupt)");
     h.metadata.assign(reinterpret_cast<const char*>(meta), meta_bytes);
     try {
-        std::unique_ptr<LatticeTable> table = find_encoding(h.encoding).open(
-            payload, h.payload_bytes, h.entries, h.context(primitive));
+        const Encoding& encoding = find_encoding(h.encoding);
+        if (const std::uint32_t n = BoundaryGrid(h.cells).count(); n > encoding.max_points)
+            throw std::runtime_error("the " + h.encoding + " encoding keys at most " +
+                                     std::to_string(encoding.max_points) +
+                                     " boundary points; the lattice has " + std::to_string(n));
+        std::unique_ptr<LatticeTable> table =
+            encoding.open(payload, h.payload_bytes, h.entries, h.context(primitive));
         table->hold(m);
         out.table = std::move(table);
         out.bytes = out.table->bytes() + kTableHeaderBytes + meta_bytes;

@@ -75,6 +75,16 @@ public:
     static std::uint64_t count_entries(std::uint64_t nwords) {
         return (nwords + kBlockWords - 1) / kBlockWords + 1;
     }
+    // Whether counts is exactly the directory build() makes for these words: what a table read
+    // from a file checks before any rank() can index with a count.
+    static bool valid(const std::uint64_t* words, std::uint64_t nwords, const std::uint32_t* counts) {
+        std::uint64_t total = 0;
+        for (std::uint64_t i = 0; i < nwords; ++i) {
+            if (i % kBlockWords == 0 && counts[i / kBlockWords] != total) return false;
+            total += static_cast<std::uint64_t>(std::popcount(words[i]));
+        }
+        return counts[(nwords + kBlockWords - 1) / kBlockWords] == total;
+    }
 
     RankIndex() = default;
     RankIndex(const std::uint64_t* words, const std::uint32_t* counts) : w_(words), c_(counts) {}

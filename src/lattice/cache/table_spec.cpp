@@ -8,12 +8,6 @@
 
 namespace lat {
 
-std::string sigma_inv_error(long long k) {
-    if (k >= 1 && k <= kMaxSigmaInv) return {};
-    return "sigma^-1 = " + std::to_string(k) + " is out of range (1 to " +
-           std::to_string(kMaxSigmaInv) + ")";
-}
-
 void check_sigma_inv(long long k, const std::string& where) {
     if (const std::string e = sigma_inv_error(k); !e.empty()) throw InputError(where + ": " + e);
 }

@@ -13,10 +13,6 @@ namespace lat {
 // Bump when rasterization semantics change, so cached tables are rebuilt.
 inline constexpr int kRasterizerVersion = 3;
 
-// The one range of sigma^-1, the refinement of a lattice.
-inline constexpr int kMaxSigmaInv = 1024;
-// Empty when 1 <= k <= kMaxSigmaInv, else "sigma^-1 = K is out of range (1 to 1024)".
-std::string sigma_inv_error(long long k);
 // Throws InputError "WHERE: " + sigma_inv_error(k) when k is out of range.
 void check_sigma_inv(long long k, const std::string& where);
 

@@ -222,15 +222,17 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
     if (h.magic != kMagic) throw std::runtime_error("candidates: bad payload tag");
     points_ = h.points, set_bits_ = h.set_bits, sets_ = h.sets, occupied_ = h.occupied;
     if (points_ != grid_.count() || h.domain != std::uint64_t(points_) * (points_ + 1) / 2 ||
-        set_bits_ > 32 || (sets_ > 1 && (1ull << set_bits_) < sets_))
+        set_bits_ > 32 || (sets_ > 1 && (1ull << set_bits_) < sets_) || occupied_ > h.domain ||
+        sets_ > occupied_ + 1)
         throw std::runtime_error("candidates: inconsistent layout");
     const Sections sec = sections(h.domain, h.occupied, h.set_bits, h.sets);
     if (sec.total != size) throw std::runtime_error("candidates: payload size does not match its layout");
     const std::uint64_t nwords = words_for_bits(h.domain);
     const auto* counts = reinterpret_cast<const std::uint32_t*>(payload + sec.counts);
-    if (counts[RankIndex::count_entries(nwords) - 1] != occupied_)
-        throw std::runtime_error("candidates: rank directory does not match its count");
-    rank_ = RankIndex(reinterpret_cast<const std::uint64_t*>(payload + sec.occ), counts);
+    const auto* occ = reinterpret_cast<const std::uint64_t*>(payload + sec.occ);
+    if (!RankIndex::valid(occ, nwords, counts) || counts[RankIndex::count_entries(nwords) - 1] != occupied_)
+        throw std::runtime_error("candidates: rank directory does not match its occupancy bits");
+    rank_ = RankIndex(occ, counts);
     ids_ = reinterpret_cast<const std::uint64_t*>(payload + sec.ids);
     masks_ = reinterpret_cast<const std::uint64_t*>(payload + sec.masks);
     const std::uint64_t nparts = ctx.primitive->primitive_count();

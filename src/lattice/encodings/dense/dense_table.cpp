@@ -267,7 +267,9 @@ DenseTable::DenseTable(const std::uint8_t* payload, std::size_t size, std::uint6
     l_ = {h.points, h.domain, h.occupied, h.t_bits, h.normal_mode, h.normal_bits, h.parts};
     if (l_.points != grid_.count() || l_.domain != std::uint64_t(l_.points) * (l_.points - 1) / 2 ||
         l_.t_bits < 1 || l_.t_bits > 30 || l_.normal_mode > 1 || l_.normal_bits > 32 ||
-        (l_.normal_mode == 0 && (l_.normal_bits % 2 || l_.normal_bits < 2)))
+        (l_.normal_mode == 0 && (l_.normal_bits % 2 || l_.normal_bits < 2)) ||
+        l_.occupied > l_.domain || l_.parts > (std::uint64_t{1} << l_.normal_bits) ||
+        (l_.normal_mode == 1 && l_.parts == 0))
         throw std::runtime_error("dense: inconsistent layout");
     if (l_.normal_mode == 1 && !ctx.primitive)
         throw std::runtime_error("dense: part normals need the primitive");
@@ -275,11 +277,16 @@ DenseTable::DenseTable(const std::uint8_t* payload, std::size_t size, std::uint6
     if (sec.total != size) throw std::runtime_error("dense: payload size does not match its layout");
     const auto* counts = reinterpret_cast<const std::uint32_t*>(payload + sec.counts);
     const std::uint64_t nwords = words_for_bits(l_.domain);
-    if (counts[RankIndex::count_entries(nwords) - 1] != l_.occupied)
-        throw std::runtime_error("dense: rank directory does not match its count");
-    rank_ = RankIndex(reinterpret_cast<const std::uint64_t*>(payload + sec.occ), counts);
+    const auto* occ = reinterpret_cast<const std::uint64_t*>(payload + sec.occ);
+    if (!RankIndex::valid(occ, nwords, counts) || counts[RankIndex::count_entries(nwords) - 1] != l_.occupied)
+        throw std::runtime_error("dense: rank directory does not match its occupancy bits");
+    rank_ = RankIndex(occ, counts);
     records_ = reinterpret_cast<const std::uint64_t*>(payload + sec.records);
     part_codes_ = reinterpret_cast<const std::uint32_t*>(payload + sec.codes);
+    // Every part code must name a surface of the primitive: lookups evaluate its normal there.
+    for (std::uint32_t i = 0; i < l_.parts; ++i)
+        if (!ctx.primitive->names_surface({0.0, part_codes_[2 * i], part_codes_[2 * i + 1]}))
+            throw std::runtime_error("dense: a part code names no surface of the primitive");
     t_scale_ = 1.0 / double((1ull << l_.t_bits) - 1);
 }
 

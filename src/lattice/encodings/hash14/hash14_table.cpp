@@ -107,8 +107,9 @@ Hash14Table::Hash14Table(const std::uint8_t* payload, std::size_t size, std::uin
     : entries_(entries), size_(size) {
     if (size < kHeader) throw std::runtime_error("hash14: payload too small");
     std::memcpy(&buckets_, payload, 8);
-    const std::size_t need = kHeader + buckets_ * sizeof(Hash14Entry);
-    if (buckets_ == 0 || need > size || (size - kHeader) % sizeof(Hash14Entry) != 0)
+    // Compared by division: a forged bucket count must not overflow the product.
+    if (buckets_ == 0 || buckets_ > (size - kHeader) / sizeof(Hash14Entry) ||
+        (size - kHeader) % sizeof(Hash14Entry) != 0)
         throw std::runtime_error("hash14: inconsistent payload size");
     e_ = reinterpret_cast<const Hash14Entry*>(payload + kHeader);
     const std::uint64_t total = (size - kHeader) / sizeof(Hash14Entry);

@@ -1,0 +1,117 @@
+// Table files with forged headers (checksums recomputed, as a hostile file would have them):
+// every field is range-checked and consistent with the others before anything is sized by it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "geometry/chain.h"
+#include "lattice/boundary_grid.h"
+#include "lattice/encoding.h"
+#include "lattice/rasterizer.h"
+#include "lattice/table_file.h"
+#include "scene/table_metadata.h"
+#include "temp_dir.h"
+#include "util/error.h"
+
+namespace lat {
+namespace {
+
+class ForgedHeader : public ::testing::Test {
+protected:
+    ChainShape hook{{{{1, 1, 1}, 0.5}, {{1, 1, 3}, 0.5}, {{3, 1, 3}, 0.5}, {{3, 1, 2}, 0.5}},
+                    {{0, 1, 0.5}, {1, 2, 0.5}, {2, 3, 0.5}}};
+    TableContext ctx{{4, 2, 4}, 1.0, 1.0, &hook};
+    test::TempDir dir;
+    std::string path = (dir.path() / "t.lht").string();
+    TableHeader good;
+    ByteBuffer payload;
+
+    void SetUp() override {
+        const RasterizeResult r = rasterize(ctx);
+        payload = find_encoding("hash14").build(r.raw, ctx, {});
+        good.encoding = "hash14";
+        good.cells = ctx.cells;
+        good.pairs = r.pairs_eq2;
+        good.entries = r.hits;
+        good.metadata = R"({"primitive": "hook", "definition": {}})";
+    }
+    // The message of loading a file with this header and payload, "(no error)" if it loads.
+    std::string error_with(const TableHeader& h) {
+        write_table_file(path, h, payload);
+        try {
+            load_table_file(path, nullptr, &hook);
+        } catch (const InputError& e) {
+            return e.what();
+        }
+        return "(no error)";
+    }
+    void expect_refused(const TableHeader& h, const std::string& why) {
+        const std::string e = error_with(h);
+        EXPECT_NE(e.find(path + ": not a valid lattice table: " + why), std::string::npos) << e;
+    }
+};
+
+TEST_F(ForgedHeader, TheGoodOneLoads) { EXPECT_EQ(error_with(good), "(no error)"); }
+
+TEST_F(ForgedHeader, SigmaInvOutOfRange) {
+    for (const int k : {0, -1, 1025, std::numeric_limits<int>::max()}) {
+        TableHeader h = good;
+        h.sigma_inv = k;
+        expect_refused(h, "sigma^-1 = " + std::to_string(k) + " is out of range");
+    }
+}
+
+TEST_F(ForgedHeader, SigmaAndCellMustBeFiniteAndAgree) {
+    for (const double bad : {std::nan(""), 0.0, -1.0, 1e-320, std::numeric_limits<double>::infinity()}) {
+        TableHeader h = good;
+        h.sigma = bad;
+        h.cell = bad;
+        expect_refused(h, "sigma must be a positive finite number");
+    }
+    TableHeader h = good;
+    h.cell = 0.5;  // sigma 1, sigma^-1 1
+    expect_refused(h, "the cell size is not sigma / sigma^-1");
+}
+
+TEST_F(ForgedHeader, CellsMustBeSmallPositiveAndMatchNlp) {
+    for (const int c : {0, -4, std::numeric_limits<int>::max()}) {
+        TableHeader h = good;
+        h.cells[1] = c;
+        const std::string e = error_with(h);
+        EXPECT_NE(e.find("not a valid lattice table"), std::string::npos) << c << ": " << e;
+    }
+    TableHeader h = good;
+    h.cells = {7, 65535, 20};  // a lattice the payload was not built for
+    expect_refused(h, "N_lp does not match the cells");
+    h.pairs = static_cast<std::uint64_t>(BoundaryGrid::pair_count(h.cells));
+    expect_refused(h, "the hash14 encoding keys at most 65535 boundary points");
+    h = good;
+    h.entries = h.pairs + 1;
+    expect_refused(h, "more stored hits than point pairs");
+}
+
+TEST_F(ForgedHeader, Hash14BucketCountCannotOverflowTheSizeCheck) {
+    std::uint64_t buckets = std::uint64_t{1} << 63;
+    std::memcpy(payload.data(), &buckets, 8);
+    expect_refused(good, "hash14: inconsistent payload size");
+}
+
+TEST_F(ForgedHeader, MetadataMustDescribeThePrimitive) {
+    for (const char* meta : {R"({"primitive": 7, "definition": {}})", R"([1, 2])", "{", R"({"primitive": "x"})"}) {
+        TableHeader h = good;
+        h.metadata = meta;
+        write_table_file(path, h, payload);
+        std::string e = "(no error)";
+        try {
+            primitive_from_metadata(read_table_header(path), path);
+        } catch (const InputError& err) {
+            e = err.what();
+        }
+        EXPECT_NE(e.find(path + ": the table's metadata"), std::string::npos) << meta << ": " << e;
+    }
+}
+
+}  // namespace
+}  // namespace lat
