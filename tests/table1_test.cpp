@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "scene/table1.h"
+#include "scene/table1_file.h"
 #include "test_paths.h"
 
 namespace lat {

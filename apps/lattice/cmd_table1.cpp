@@ -5,7 +5,7 @@
 
 #include "commands.h"
 #include "common.h"
-#include "scene/table1.h"
+#include "scene/table1_file.h"
 #include "util/progress.h"
 
 namespace lat::cli {

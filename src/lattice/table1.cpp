@@ -1,21 +1,17 @@
-#include "scene/table1.h"
+#include "lattice/table1.h"
 
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 
 #include "lattice/boundary_grid.h"
-#include "lattice/cache/table_spec.h"
 #include "lattice/rasterizer.h"
-#include "scene/json_reader.h"
-#include "scene/scene_loader.h"
-#include "util/error.h"
 
 namespace lat {
 namespace {
 
-// Counting is exhaustive: beyond this many pairs (minutes of work) a row is refused.
+// Counting is exhaustive: beyond this many pairs (minutes of work) a cell is refused.
 constexpr double kMaxTable1Pairs = 1e11;
-constexpr double kMaxTable1Box = 4096;
 
 // Two significant digits, as the paper prints them.
 double round2(double v) {
@@ -47,60 +43,44 @@ bool matches_printed(double v, double printed) {
     return std::abs(rounded - printed) <= tol || std::abs(truncated - printed) <= tol;
 }
 
-std::vector<Table1Row> compute_table1(const std::string& path, bool progress) {
-    const nlohmann::json doc = parse_json_file(path);
-    const JsonValue root(doc, "", path);
-    if (!root.is_object()) root.fail("a Table 1 file must hold a JSON object");
-    root.allow_keys({"format", "rows"});
-    const JsonValue rows = root.at("rows");
-    std::vector<Table1Row> out;
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-        const JsonValue r = rows[i];
-        r.allow_keys({"primitive", "shape", "box_world", "paper"});
-        Table1Row row;
-        row.primitive = r.at("primitive").string();
-        const Primitive prim = parse_primitive(r.at("shape"), row.primitive);
-        const JsonValue box = r.at("box_world");
-        const Vec3 b = box.vec3();
-        for (std::size_t a = 0; a < 3; ++a) {
-            row.box[a] = b[a];
-            if (!(b[a] >= 1 && b[a] <= kMaxTable1Box && b[a] == std::floor(b[a])))
-                box[a].fail("the box must be a whole number of units (sigma = 1) along each axis, "
-                            "at most 4096");
-        }
-        const JsonValue paper = r.at("paper");
-        for (std::size_t k = 0; k < paper.size(); ++k) {
-            const JsonValue p = paper[k];
-            p.allow_keys({"sigma_inv", "N_lp", "N_ix", "ratio"});
-            Table1Cell c;
-            c.sigma_inv = p.at("sigma_inv").integer();
-            if (const std::string e = sigma_inv_error(c.sigma_inv); !e.empty()) p.at("sigma_inv").fail(e);
-            c.paper_n_lp = p.at("N_lp").number();
-            c.paper_n_ix = p.at("N_ix").number();
-            c.paper_ratio = p.at("ratio").number();
-            TableContext g{{}, 1.0 / c.sigma_inv, 1.0, prim.shape.get()};
-            for (std::size_t a = 0; a < 3; ++a) g.cells[a] = static_cast<int>(b[a]) * c.sigma_inv;
-            c.cells = g.cells;
-            if (BoundaryGrid::pair_count(g.cells) > kMaxTable1Pairs)
-                p.at("sigma_inv").fail("the lattice has too many point pairs to count here (more than " +
-                                       paper_notation(kMaxTable1Pairs) + ")");
-            RasterizeOptions opt;
-            opt.keep_hits = false;
-            opt.progress = progress;
-            const RasterizeResult res = rasterize(g, opt);
-            c.n_lp_eq2 = res.pairs_eq2;
-            c.n_lp_enumerated = res.pairs_enumerated;
-            c.n_ix = res.hits_counted;
-            c.ratio = double(c.n_ix) / double(c.n_lp_eq2);
-            c.seconds = res.seconds;
-            c.n_lp_matches = matches_printed(double(c.n_lp_eq2), c.paper_n_lp);
-            c.n_ix_matches = matches_printed(double(c.n_ix), c.paper_n_ix);
-            c.ratio_matches = std::abs(std::round(c.ratio * 100) / 100 - c.paper_ratio) < 1e-9;
-            row.cells.push_back(c);
-        }
-        out.push_back(std::move(row));
-    }
-    return out;
+Table1Cell count_table1_cell(const Shape& primitive, const std::array<int, 3>& box,
+                             int sigma_inv, bool progress) {
+    assert(table1_cell_error(box, sigma_inv).empty());
+    Table1Cell c;
+    c.sigma_inv = sigma_inv;
+    TableContext g{{}, 1.0 / sigma_inv, 1.0, &primitive};
+    for (std::size_t a = 0; a < 3; ++a) g.cells[a] = box[a] * sigma_inv;
+    c.cells = g.cells;
+    RasterizeOptions opt;
+    opt.keep_hits = false;
+    opt.progress = progress;
+    const RasterizeResult res = rasterize(g, opt);
+    c.n_lp_eq2 = res.pairs_eq2;
+    c.n_lp_enumerated = res.pairs_enumerated;
+    c.n_ix = res.hits_counted;
+    c.ratio = double(c.n_ix) / double(c.n_lp_eq2);
+    c.seconds = res.seconds;
+    return c;
+}
+
+void compare_with_paper(Table1Cell& c, double n_lp, double n_ix, double ratio) {
+    c.paper_n_lp = n_lp;
+    c.paper_n_ix = n_ix;
+    c.paper_ratio = ratio;
+    c.n_lp_matches = matches_printed(double(c.n_lp_eq2), n_lp);
+    c.n_ix_matches = matches_printed(double(c.n_ix), n_ix);
+    c.ratio_matches = std::abs(std::round(c.ratio * 100) / 100 - ratio) < 1e-9;
+}
+
+std::string table1_cell_error(const std::array<int, 3>& box, int sigma_inv) {
+    for (const int b : box)
+        if (b < 1 || b > kMaxTable1Box) return "the box must be 1 to 4096 units along each axis";
+    if (std::string e = sigma_inv_error(sigma_inv); !e.empty()) return e;
+    const std::array<int, 3> cells{box[0] * sigma_inv, box[1] * sigma_inv, box[2] * sigma_inv};
+    if (BoundaryGrid::pair_count(cells) > kMaxTable1Pairs)
+        return "the lattice has too many point pairs to count here (more than " +
+               paper_notation(kMaxTable1Pairs) + ")";
+    return {};
 }
 
 std::string table1_text(const std::vector<Table1Row>& rows) {

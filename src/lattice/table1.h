@@ -4,10 +4,13 @@
 // primitive, N_ix, and their ratio, beside the values the paper prints. Pairs are counted as
 // the paper counts: ordered, entry and exit on different faces, a point on an edge counted on
 // every face it lies on; solids are closed (a segment that touches the surface intersects it).
+#include <array>
+#include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include "geometry/shape.h"
 
 namespace lat {
 
@@ -28,9 +31,17 @@ struct Table1Row {
     std::vector<Table1Cell> cells;
 };
 
-// Reads a Table 1 file (the format of examples/table1.json, see
-// docs/table1.md) and counts every row; throws InputError for a malformed file.
-std::vector<Table1Row> compute_table1(const std::string& path, bool progress);
+// The largest box side (units) a Table 1 row may have.
+inline constexpr int kMaxTable1Box = 4096;
+
+// Empty when a cell of this box (whole units, sigma = 1) at this refinement can be counted
+// here, else why not.
+std::string table1_cell_error(const std::array<int, 3>& box, int sigma_inv);
+// Counts one cell (table1_cell_error must be empty): N_lp both ways, N_ix and the ratio.
+Table1Cell count_table1_cell(const Shape& primitive, const std::array<int, 3>& box,
+                             int sigma_inv, bool progress);
+// Sets the paper's printed values of a counted cell and whether ours match them.
+void compare_with_paper(Table1Cell& c, double n_lp, double n_ix, double ratio);
 
 // The paper's notation: 2.4 (3) for 2.4 x 10^3, rounded to two significant digits.
 std::string paper_notation(double v);
