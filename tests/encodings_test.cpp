@@ -59,7 +59,7 @@ TEST(EncodingDense, CertifiedWithinTargetsOnTheHair) {
 
 TEST(EncodingDense, OctahedralNormalsAndLooserTargets) {
     EncodeOptions oct;
-    oct.normals = "oct";
+    oct.normals = DenseNormals::kOct;
     const Built a = build("dense", 1, oct);
     const CertifyReport ra = certify_table(*a.table, a.ctx, false);
     EXPECT_LE(ra.max_point_error, 0.01);

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "lattice/cache/table_spec.h"
@@ -26,10 +27,14 @@ void add_table_options(CLI::App& app, TableSpec& spec) {
     app.add_option("--max-normal-error", spec.options.max_normal_error_deg,
                    "Quantising encodings: largest normal error, in degrees")
         ->check(CLI::PositiveNumber);
-    app.add_option("--dense-normals", spec.options.normals,
-                   "dense: normals as octahedral codes (oct), as the part hit, re-evaluated "
-                   "(part), or whichever is smaller (auto)")
-        ->check(CLI::IsMember({"auto", "oct", "part"}));
+    std::map<std::string, DenseNormals> normals;
+    for (const auto& [name, value] : kDenseNormalNames) normals.emplace(name, value);
+    app.add_option_function<std::string>(
+           "--dense-normals",
+           [&spec, normals](const std::string& name) { spec.options.normals = normals.at(name); },
+           "dense: normals as octahedral codes (oct), as the part hit, re-evaluated (part), or "
+           "whichever is smaller (auto)")
+        ->check(CLI::IsMember(normals));
 }
 
 struct ThreadLimit::Impl {

@@ -3,22 +3,31 @@
 // bounded. Each lives in its own folder (lattice/encodings/<name>/) and is listed once, in
 // lattice/encodings/registry.cpp; everything else finds it by name through find_encoding and
 // then only goes through the descriptor and the LatticeTable interface.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "lattice/table.h"
 #include "util/big_buffer.h"
 
 namespace lat {
 
+// How `dense` stores normals: octahedral codes, the part hit (its normal re-evaluated at the
+// decoded point), or whichever is smaller.
+enum class DenseNormals { kAuto, kOct, kPart };
+// Their option names, "auto", "oct" and "part": the one place they are spelled.
+inline constexpr std::array<std::pair<std::string_view, DenseNormals>, 3> kDenseNormalNames{
+    {{"auto", DenseNormals::kAuto}, {"oct", DenseNormals::kOct}, {"part", DenseNormals::kPart}}};
+
 // Error targets for the encodings that quantise (in units of the primitive's sigma, degrees).
 struct EncodeOptions {
     double max_point_error = 0.01;
     double max_normal_error_deg = 1.0;
-    std::string normals = "auto";  // dense: "oct", "part" or "auto" (the smaller)
+    DenseNormals normals = DenseNormals::kAuto;
 };
 
 struct Encoding {

@@ -12,6 +12,16 @@ void check_sigma_inv(long long k, const std::string& where) {
     if (const std::string e = sigma_inv_error(k); !e.empty()) throw InputError(where + ": " + e);
 }
 
+namespace {
+
+std::string normals_name(DenseNormals n) {
+    for (const auto& [name, value] : kDenseNormalNames)
+        if (value == n) return std::string(name);
+    return {};
+}
+
+}  // namespace
+
 TablePlan plan_table(const Primitive& p, const TableSpec& spec, const std::string& scene_file) {
     TablePlan plan;
     plan.primitive = &p;
@@ -46,7 +56,7 @@ TablePlan plan_table(const Primitive& p, const TableSpec& spec, const std::strin
                         .add(h.encoding)
                         .add(spec.options.max_point_error)
                         .add(spec.options.max_normal_error_deg)
-                        .add(spec.options.normals)
+                        .add(normals_name(spec.options.normals))
                         .add(kRasterizerVersion)
                         .value();
     h.metadata = nlohmann::json{{"primitive", p.name},

@@ -124,7 +124,7 @@ private:
     // Part codes: the normal re-evaluated at the decoded point; t may need more bits for it.
     // Returns false when the part normals cannot meet the target (or there is no primitive).
     bool choose_part_codes(std::uint32_t& part_t_bits, std::uint32_t& part_bits) {
-        if (ctx_.primitive == nullptr || opt_.normals == "oct") return false;
+        if (ctx_.primitive == nullptr || opt_.normals == DenseNormals::kOct) return false;
         for (const auto& chunk : raw_.chunks)
             for (const RawHit& h : chunk)
                 if (code_of_.emplace(std::make_pair(h.part, h.leaf), std::uint32_t(code_of_.size()))
@@ -175,14 +175,14 @@ private:
         const bool part_possible = choose_part_codes(part_t_bits, part_bits);
         // Octahedral codes are only worked out when part codes are not sure to be smaller.
         std::uint32_t oct_bits = 16;
-        const bool need_oct = !part_possible || opt_.normals == "oct" ||
-                              (opt_.normals == "auto" && t_bits + 2 * 4 < part_t_bits + part_bits);
+        const bool need_oct = !part_possible || opt_.normals == DenseNormals::kOct ||
+                              (opt_.normals == DenseNormals::kAuto && t_bits + 2 * 4 < part_t_bits + part_bits);
         if (need_oct) oct_bits = choose_oct_bits();
         const std::uint32_t oct_record = t_bits + 2 * oct_bits, part_record = part_t_bits + part_bits;
-        if (opt_.normals == "part" && !part_possible)
+        if (opt_.normals == DenseNormals::kPart && !part_possible)
             throw std::runtime_error("dense: part normals need the primitive");
         use_part_ = part_possible &&
-                    (opt_.normals == "part" || part_record < oct_record || !need_oct);
+                    (opt_.normals == DenseNormals::kPart || part_record < oct_record || !need_oct);
         l_.normal_mode = use_part_ ? 1 : 0;
         l_.t_bits = use_part_ ? part_t_bits : t_bits;
         l_.normal_bits = use_part_ ? part_bits : 2 * oct_bits;
