@@ -133,7 +133,17 @@ TEST(PolynomialParserErrors, NestingLimit) {
     EXPECT_EQ(parse_polynomial(ok, kConstants).degree(), 1);
     const std::string deep = std::string(300, '(') + "x" + std::string(300, ')');
     expect_error(deep, 257, "too deeply nested");
-    expect_error(std::string(100000, '-') + "x", 257, "too deeply nested");
+    // Unary operators nest too (kept within the length limit, which a longer text hits first).
+    expect_error(std::string(kMaxPolynomialLength - 1, '-') + "x", 257, "too deeply nested");
+}
+
+TEST(PolynomialParserErrors, LengthLimit) {
+    const std::string ok = "x" + std::string(kMaxPolynomialLength - 1, ' ');
+    EXPECT_EQ(parse_polynomial(ok, kConstants).degree(), 1);
+    expect_error(ok + " ", kMaxPolynomialLength + 1,
+                 "the text is 10001 characters long, over the limit of 10000");
+    expect_error(std::string(100000, '-') + "x", kMaxPolynomialLength + 1,
+                 "the text is 100001 characters long, over the limit of 10000");
 }
 
 TEST(PolynomialSuggestName, Hints) {

@@ -12,6 +12,7 @@
 #include "scene/lattice_tables.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
+#include "util/interrupt.h"
 #include "util/memory.h"
 #include "util/progress.h"
 
@@ -40,6 +41,7 @@ int run_render(const RenderArgs& a) {
     if (!a.stats.empty()) check_writable(a.stats);
 
     const Scene scene = load_scene(a.scene);
+    check_render_budget(scene.camera, a.spp, a.scene);
     const auto limit = limit_threads(a.threads);
     const bool progress = !a.quiet && ProgressBar::stderr_is_terminal();
     const auto t1 = clock::now();
@@ -59,6 +61,8 @@ int run_render(const RenderArgs& a) {
     const RenderScene rs(scene, instance_shape, accel);
     const auto t2 = clock::now();
 
+    // From here on a signal stops the render at the next tile and removes our temporaries.
+    install_interrupt_handlers();
     RenderOptions opt;
     opt.spp = a.spp;
     opt.progress = progress;

@@ -367,6 +367,10 @@ std::string term_string(const Monomial& m, double c) {
 }  // namespace
 
 Poly3 parse_polynomial(std::string_view text, const std::map<std::string, double>& constants) {
+    if (text.size() > kMaxPolynomialLength)
+        fail(kMaxPolynomialLength + 1,
+             cat("the text is ", std::to_string(text.size()),
+                 " characters long, over the limit of ", std::to_string(kMaxPolynomialLength)));
     for (const char* v : {"x", "y", "z"})
         if (constants.count(v)) fail(1, cat("constant '", v, "' clashes with the variable ", v));
     std::vector<Token> tokens = tokenize(text);
