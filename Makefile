@@ -75,8 +75,11 @@ test-sanitize: deps
 # Builds the libFuzzer harnesses (clang, ASan + UBSan) and runs each for FUZZ_SECONDS on a working
 # corpus in $(FUZZ_DIR) seeded from fuzz/corpus; findings go to $(FUZZ_DIR)/artifacts.
 fuzz: fuzz-deps
+	@# No -Werror here: clang warns where g++ does not (-Wdouble-promotion in src/lattice); the
+	@# normal build, with g++, is the one held to no warnings.
 	@CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	  -DLATTICE_FUZZ=ON -DLATTICE_BUILD_TESTS=OFF -DLATTICE_BUILD_BENCH=OFF $(CMAKE_FLAGS) > /dev/null
+	  -DLATTICE_FUZZ=ON -DLATTICE_WERROR=OFF -DLATTICE_BUILD_TESTS=OFF -DLATTICE_BUILD_BENCH=OFF \
+	  $(CMAKE_FLAGS) > /dev/null
 	@cmake --build $(FUZZ_DIR) -j $(JOBS) --target $(addprefix fuzz_,$(FUZZ_HARNESSES))
 	@mkdir -p $(FUZZ_DIR)/artifacts
 	@set -e; for h in $(FUZZ_HARNESSES); do \

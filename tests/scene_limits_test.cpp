@@ -138,6 +138,27 @@ TEST(SceneLimits, ExtremeQuarticRendersWithoutCrashing) {
     EXPECT_EQ(out.display.rgb.size(), 8u * 6u * 3u);
 }
 
+TEST(SceneLimits, CameraDistanceMustNotOverflow) {
+    const std::string text = scene_with(kSphere);
+    std::string far = text;
+    far.replace(far.find("[0, -6, 1]"), 10, "[0, -1e200, 1]");
+    EXPECT_EQ(load_error(far),
+              "scene.json: camera: eye and look_at are too far apart (the "
+              "distance overflows a double)");
+}
+
+// Bounds beyond Embree's float range used to drop the object silently: it is now tested
+// outside Embree, like unbounded objects.
+TEST(SceneLimits, ObjectsBeyondFloatRangeAreStillHit) {
+    const Scene s = load_scene_text(
+        scene_with(R"({"type": "sphere", "center": [0, 1e19, 0], "radius": 0.99999999999e19,
+                       "material": "m"})"),
+        "scene.json");
+    const RenderScene rs(s);
+    SurfaceHit hit;
+    EXPECT_TRUE(rs.intersect({{0, -6, 0}, {0, 1, 0}}, 0, kInfinity, hit));
+}
+
 TEST(SceneLimits, NonFiniteRaysMiss) {
     const Scene s = load_scene_text(scene_with(kSphere), "scene.json");
     const RenderScene rs(s);

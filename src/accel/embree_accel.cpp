@@ -78,6 +78,13 @@ bool embree_can_trace(const Ray& r, double tmin, double tmax) {
     return o && d && std::abs(tmin) < kLarge && !std::isnan(tmax);
 }
 
+// Embree drops primitives whose float bounds are not finite or exceed FLT_LARGE; objects that
+// large (or unbounded) are tested outside Embree instead, so that they are never lost.
+bool embree_can_hold(const Bounds3& b) {
+    constexpr double kLarge = 1.8e18;  // just below Embree's FLT_LARGE
+    return b.finite() && max_component(abs(b.lo)) < kLarge && max_component(abs(b.hi)) < kLarge;
+}
+
 // Rays with NaN or infinite parts hit nothing: no object can be tested against them.
 bool ray_is_finite(const Ray& r, double tmin, double tmax) {
     return is_finite(r.o) && is_finite(r.d) && std::isfinite(tmin) && !std::isnan(tmax);
@@ -285,7 +292,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
         const AccelObject& o = m.objects[i];
         const Bounds3 wb = o.xf->bounds(o.shape->bounds());
         if (wb.empty()) continue;
-        if (!wb.finite()) {
+        if (!embree_can_hold(wb)) {
             m.unbounded.push_back(i);
         } else if (o.shape->primitive_count() > 1 && m.flatten) {
             for (std::uint32_t p = 0; p < o.shape->primitive_count(); ++p) m.flat.push_back({i, p});

@@ -36,6 +36,8 @@ Camera parse_camera(const JsonValue& v) {
                " pixels is over the limit of " + std::to_string(kMaxImagePixels) + " pixels");
     const Vec3 w = c.look_at - c.eye;
     if (length_squared(w) == 0) v.fail("eye and look_at are the same point");
+    if (!std::isfinite(length_squared(w)))
+        v.fail("eye and look_at are too far apart (the distance overflows a double)");
     if (length_squared(cross(w, c.up)) <= 1e-12 * length_squared(w) * length_squared(c.up))
         v.at("up").fail("up is parallel to the viewing direction");
     return c;
