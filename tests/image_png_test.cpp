@@ -2,6 +2,7 @@
 // missing, truncated, corrupt and non-PNG files.
 #include <gtest/gtest.h>
 #include <png.h>
+#include <zlib.h>
 
 #include <csetjmp>
 #include <cstdio>
@@ -210,6 +211,37 @@ TEST(ImagePng, CorruptDataIsRejected) {
     spit(dir.file("a.png"), data);
     const std::string message = read_error(dir.file("a.png"));
     EXPECT_EQ(message.rfind(dir.file("a.png") + ": corrupt PNG file: ", 0), 0u) << message;
+}
+
+// A small valid PNG whose IHDR now claims width x height (with the CRC recomputed, so that
+// only the size is wrong): the reproducer of the 1.2 GB allocation from a 69-byte file.
+std::string png_claiming(const TempDir& dir, std::uint32_t width, std::uint32_t height) {
+    write_png(dir.file("small.png"), Image8{1, 1, Bytes(3, 9)});
+    std::string data = slurp(dir.file("small.png"));
+    auto put32 = [&](std::size_t at, std::uint32_t v) {
+        for (int b = 0; b < 4; ++b) data[at + b] = static_cast<char>(v >> (24 - 8 * b));
+    };
+    put32(16, width);  // IHDR data starts at 16: signature 8, length 4, type 4
+    put32(20, height);
+    const auto* ihdr = reinterpret_cast<const Bytef*>(data.data() + 12);
+    put32(29, static_cast<std::uint32_t>(crc32(0, ihdr, 17)));  // type + 13 data bytes
+    return data;
+}
+
+TEST(ImagePng, HeaderSizeIsCheckedBeforeAllocating) {
+    TempDir dir;
+    const std::string path = dir.file("claim.png");
+    spit(path, png_claiming(dir, 20000, 20000));
+    EXPECT_EQ(read_error(path),
+              path + ": PNG header claims 20000 x 20000 pixels, over the limit of 268435456");
+    const std::string small = png_claiming(dir, 10000, 10000);
+    spit(path, small);
+    EXPECT_EQ(read_error(path), path + ": PNG header claims 10000 x 10000 pixels, more than a " +
+                                    std::to_string(small.size()) +
+                                    "-byte file can hold (truncated or corrupt PNG file)");
+    // Beyond libpng's side limit, which we set.
+    spit(path, png_claiming(dir, 1u << 21, 1));
+    EXPECT_EQ(read_error(path).rfind(path + ": corrupt PNG file: ", 0), 0u) << read_error(path);
 }
 
 }  // namespace

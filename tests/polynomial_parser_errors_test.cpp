@@ -133,7 +133,35 @@ TEST(PolynomialParserErrors, NestingLimit) {
     EXPECT_EQ(parse_polynomial(ok, kConstants).degree(), 1);
     const std::string deep = std::string(300, '(') + "x" + std::string(300, ')');
     expect_error(deep, 257, "too deeply nested");
-    expect_error(std::string(100000, '-') + "x", 257, "too deeply nested");
+    // Unary operators nest too (kept within the length limit, which a longer text hits first).
+    expect_error(std::string(kMaxPolynomialLength - 1, '-') + "x", 257, "too deeply nested");
+}
+
+// Within the length limit, expansion could still take seconds: its work is bounded too.
+TEST(PolynomialParserErrors, ExpansionWorkLimit) {
+    std::string heavy;
+    while (heavy.size() < 9000) heavy += "(x+y+z+1)^16 - ";
+    heavy += "x";
+    try {
+        parse_polynomial(heavy, kConstants);
+        ADD_FAILURE() << "no error";
+    } catch (const PolynomialParseError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "too much to expand (over 5000000 term products); simplify the polynomial");
+    }
+    // A long but ordinary quartic is far within the limit.
+    std::string sum;
+    for (int i = 0; i < 100; ++i) sum += "(x^2+y^2+z^2+R^2-half^2)^2 - 4*R^2*(x^2+y^2) + ";
+    EXPECT_EQ(parse_polynomial(sum + "1", kConstants).degree(), 4);
+}
+
+TEST(PolynomialParserErrors, LengthLimit) {
+    const std::string ok = "x" + std::string(kMaxPolynomialLength - 1, ' ');
+    EXPECT_EQ(parse_polynomial(ok, kConstants).degree(), 1);
+    expect_error(ok + " ", kMaxPolynomialLength + 1,
+                 "the text is 10001 characters long, over the limit of 10000");
+    expect_error(std::string(100000, '-') + "x", kMaxPolynomialLength + 1,
+                 "the text is 100001 characters long, over the limit of 10000");
 }
 
 TEST(PolynomialSuggestName, Hints) {

@@ -12,6 +12,7 @@
 #include "render/scene_lattices.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
+#include "util/interrupt.h"
 #include "util/memory.h"
 #include "util/progress.h"
 
@@ -120,6 +121,7 @@ int run_render(const RenderArgs& a) {
 
     Timings t;
     const Scene scene = load_scene(a.scene);
+    check_render_budget(scene.camera, a.spp, a.scene);
     const ThreadLimit limit(a.threads);
     const bool progress = !a.quiet && ProgressBar::stderr_is_terminal();
     t.loaded = since_start();
@@ -139,6 +141,8 @@ int run_render(const RenderArgs& a) {
     const RenderScene rs(scene, instance_shape, accel);
     t.built = since_start();
 
+    // From here on a signal stops the render at the next tile and removes our temporaries.
+    install_interrupt_handlers();
     RenderOptions opt;
     opt.spp = a.spp;
     opt.progress = progress;

@@ -4,11 +4,11 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 
 #include "lattice/cache/table_spec.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace lat::cli {
@@ -50,19 +50,10 @@ ThreadLimit::ThreadLimit(int n) {
 ThreadLimit::~ThreadLimit() = default;
 
 void write_json_file(const std::string& path, const nlohmann::json& j) {
-    const std::string tmp = path + ".tmp";
-    {
-        std::ofstream f(tmp);
-        f << j.dump(2) << "\n";
-        if (!f) {
-            std::remove(tmp.c_str());
-            throw InputError(path + ": cannot write");
-        }
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw InputError(path + ": cannot write");
-    }
+    AtomicFile out(path);  // a unique temporary: concurrent writers of one path never collide
+    const std::string text = j.dump(2) + "\n";
+    out.write(text.data(), text.size());
+    out.commit();
 }
 
 }  // namespace lat::cli

@@ -6,7 +6,9 @@
 #include <vector>
 
 #include "commands.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/interrupt.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"lattice: ray tracing with three-dimensional lattice textures"};
@@ -36,6 +38,10 @@ int main(int argc, char** argv) {
     try {
         for (auto& c : commands)
             if (c.app->parsed()) return c.run();
+    } catch (const lat::Interrupted& e) {
+        lat::remove_temp_files();  // the unwinding removed ours already; this is belt and braces
+        std::fprintf(stderr, "lattice: %s\n", e.what());
+        return e.exit_code();
     } catch (const lat::InputError& e) {
         std::fprintf(stderr, "lattice: error: %s\n", e.what());
         return 2;

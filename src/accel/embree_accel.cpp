@@ -68,6 +68,28 @@ float float_above(double t) {
     return static_cast<double>(f) > t ? f : std::nextafter(f, INFINITY);
 }
 
+// Embree asserts (and aborts) on a ray whose float origin or direction exceeds FLT_LARGE
+// (1.844e18) or is NaN, or whose range is NaN. Such a ray comes only from degenerate input (an
+// extreme transform or polynomial); it must never reach rtcIntersect1 or rtcOccluded1.
+bool embree_can_trace(const Ray& r, double tmin, double tmax) {
+    constexpr double kLarge = 1.8e18;  // just below Embree's FLT_LARGE
+    const bool o = std::abs(r.o.x) < kLarge && std::abs(r.o.y) < kLarge && std::abs(r.o.z) < kLarge;
+    const bool d = std::abs(r.d.x) < kLarge && std::abs(r.d.y) < kLarge && std::abs(r.d.z) < kLarge;
+    return o && d && std::abs(tmin) < kLarge && !std::isnan(tmax);
+}
+
+// Embree drops primitives whose float bounds are not finite or exceed FLT_LARGE; objects that
+// large (or unbounded) are tested outside Embree instead, so that they are never lost.
+bool embree_can_hold(const Bounds3& b) {
+    constexpr double kLarge = 1.8e18;  // just below Embree's FLT_LARGE
+    return b.finite() && max_component(abs(b.lo)) < kLarge && max_component(abs(b.hi)) < kLarge;
+}
+
+// Rays with NaN or infinite parts hit nothing: no object can be tested against them.
+bool ray_is_finite(const Ray& r, double tmin, double tmax) {
+    return is_finite(r.o) && is_finite(r.d) && std::isfinite(tmin) && !std::isnan(tmax);
+}
+
 void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax) {
     ray.org_x = static_cast<float>(r.o.x);
     ray.org_y = static_cast<float>(r.o.y);
@@ -270,7 +292,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
         const AccelObject& o = m.objects[i];
         const Bounds3 wb = o.xf->bounds(o.shape->bounds());
         if (wb.empty()) continue;
-        if (!wb.finite()) {
+        if (!embree_can_hold(wb)) {
             m.unbounded.push_back(i);
         } else if (o.shape->primitive_count() > 1 && m.flatten) {
             for (std::uint32_t p = 0; p < o.shape->primitive_count(); ++p) m.flat.push_back({i, p});
@@ -314,14 +336,17 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
 EmbreeAccel::~EmbreeAccel() = default;
 
 bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hit) const {
+    if (!ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, hit);
 
-    alignas(16) RTCRayHit rh;
-    set_rtc_ray(rh.ray, r, tmin, tmax);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(m.scene, &ctx.rtc, &rh);
+    if (embree_can_trace(r, tmin, tmax)) {
+        alignas(16) RTCRayHit rh;
+        set_rtc_ray(rh.ray, r, tmin, tmax);
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(m.scene, &ctx.rtc, &rh);
+    }
 
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
@@ -336,6 +361,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 }
 
 bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t self) const {
+    if (!ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     AccelHit unused;
     QueryContext ctx(m, r, tmin, tmax, unused);
@@ -346,6 +372,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
         if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) return true;
     }
 
+    if (!embree_can_trace(r, tmin, tmax)) return false;
     alignas(16) RTCRay ray;
     set_rtc_ray(ray, r, tmin, tmax);
     rtcOccluded1(m.scene, &ctx.rtc, &ray);

@@ -32,6 +32,10 @@ bool AlgebraicShape::line_roots(const Ray& r, LineRoots& out) const {
     // Solve in u, the distance along the unit direction from the point nearest the centre.
     const double shift = dot(c - r.o, dn);
     f_.along_ray(r.o + dn * shift, dn, out.g);
+    // Extreme coefficients or a far-away ray can overflow the restriction; no root is then
+    // trustworthy, and the solver must not see infinities.
+    for (const double gi : out.g)
+        if (!std::isfinite(gi)) return false;
     double u[4];
     int n = 0;
     if (degree_ <= 2) {

@@ -22,6 +22,10 @@ namespace {
 constexpr int kMaxIntermediateDegree = 16;
 // Guards the stack against absurd nesting such as 100000 opening parentheses.
 constexpr int kMaxNesting = 256;
+// Bounds the cost of expansion, counted in term products (an m-term times an n-term polynomial
+// costs m * n): about 0.15 s. Real quartics need a few hundred; without a bound, 10,000
+// characters of "(x+y+z+1)^16 - ..." took seconds, and a scene may hold many polynomials.
+constexpr double kMaxExpansionWork = 5e6;
 
 enum class Tok { kNumber, kName, kPlus, kMinus, kStar, kSlash, kCaret, kLParen, kRParen, kEnd };
 
@@ -267,6 +271,9 @@ private:
         } else {
             const double degree = base.degree() * n;
             if (degree > kMaxIntermediateDegree) fail_degree(degree, op);
+            // Repeated squaring does at most n products, none bigger than base x result.
+            const double result_terms = (degree + 1) * (degree + 2) * (degree + 3) / 6;
+            charge(n * static_cast<double>(base.terms().size()) * result_terms, op);
             result = pow(base, static_cast<int>(n));
         }
         check_finite(result, op);
@@ -316,9 +323,17 @@ private:
     SparsePoly multiply(const SparsePoly& f, const SparsePoly& g, const Token& op) {
         if (f.degree() >= 0 && g.degree() >= 0 && f.degree() + g.degree() > kMaxIntermediateDegree)
             fail_degree(f.degree() + g.degree(), op);
+        charge(static_cast<double>(f.terms().size()) * static_cast<double>(g.terms().size()), op);
         SparsePoly h = f * g;
         check_finite(h, op);
         return h;
+    }
+
+    void charge(double work, const Token& op) {
+        work_ += work;
+        if (work_ > kMaxExpansionWork)
+            fail(op.column, cat("too much to expand (over ", format_number(kMaxExpansionWork, 15),
+                                " term products); simplify the polynomial"));
     }
 
     SparsePoly divide(const SparsePoly& f, const SparsePoly& g, const Token& op) {
@@ -342,6 +357,7 @@ private:
     const std::map<std::string, double>& constants_;
     std::size_t pos_ = 0;
     int depth_ = 0;
+    double work_ = 0.0;  // term products so far, see kMaxExpansionWork
 };
 
 std::string monomial_string(const Monomial& m) {
@@ -367,6 +383,10 @@ std::string term_string(const Monomial& m, double c) {
 }  // namespace
 
 Poly3 parse_polynomial(std::string_view text, const std::map<std::string, double>& constants) {
+    if (text.size() > kMaxPolynomialLength)
+        fail(kMaxPolynomialLength + 1,
+             cat("the text is ", std::to_string(text.size()),
+                 " characters long, over the limit of ", std::to_string(kMaxPolynomialLength)));
     for (const char* v : {"x", "y", "z"})
         if (constants.count(v)) fail(1, cat("constant '", v, "' clashes with the variable ", v));
     std::vector<Token> tokens = tokenize(text);

@@ -22,8 +22,13 @@ private:
     std::size_t column_;
 };
 
-// Throws PolynomialParseError on a syntax error, an unknown name, a division by a non-constant
-// or by zero, a non-integer or negative exponent, or a result of degree over 4.
+// Longest polynomial text accepted: a quartic written out in full is a few hundred characters;
+// the limit bounds parse time and memory for hostile input.
+constexpr std::size_t kMaxPolynomialLength = 10000;
+
+// Throws PolynomialParseError on text longer than kMaxPolynomialLength, a syntax error, an unknown
+// name, a division by a non-constant or by zero, a non-integer or negative exponent, or a result of
+// degree over 4.
 Poly3 parse_polynomial(std::string_view text, const std::map<std::string, double>& constants);
 
 }  // namespace lat

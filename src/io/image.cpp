@@ -18,12 +18,10 @@
 #include <exception>
 #include <filesystem>
 
-#include "io/temp_file.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace lat {
-
-using io_detail::TempFile;
 
 std::uint8_t to_byte(double c) {
     if (!(c > 0.0)) return 0;  // also catches NaN
@@ -51,9 +49,16 @@ ImageFormat image_format_for(const std::string& path) {
     throw InputError(located_message(path, "", what + " (use .png, .pfm or .exr)"));
 }
 
+void require_nonempty_image(const std::string& path, int width, int height) {
+    if (width <= 0 || height <= 0) {
+        throw_write_error(
+            path, "empty image (" + std::to_string(width) + "x" + std::to_string(height) + ")");
+    }
+}
+
 void check_writable(const std::string& path) {
     // The writers' own temporary: its constructor does every check, its destructor removes it.
-    const TempFile probe(path);
+    const AtomicFile probe(path);
 }
 
 void write_image(const std::string& path, const ImageF& img) {
@@ -68,9 +73,9 @@ void write_image(const std::string& path, const ImageF& img) {
 }
 
 void write_pfm(const std::string& path, const ImageF& img) {
-    io_detail::require_nonempty(path, img.width, img.height);
+    require_nonempty_image(path, img.width, img.height);
     assert(img.rgb.size() == 3 * static_cast<std::size_t>(img.width) * img.height);
-    TempFile out(path);
+    AtomicFile out(path);
     // A negative scale means little-endian floats; PFM stores the bottom row first.
     const std::string header =
         "PF\n" + std::to_string(img.width) + " " + std::to_string(img.height) + "\n-1.0\n";
@@ -126,9 +131,9 @@ class FileOStream : public Imf::OStream {
 }  // namespace
 
 void write_exr(const std::string& path, const ImageF& img) {
-    io_detail::require_nonempty(path, img.width, img.height);
+    require_nonempty_image(path, img.width, img.height);
     assert(img.rgb.size() == 3 * static_cast<std::size_t>(img.width) * img.height);
-    TempFile out(path);
+    AtomicFile out(path);
     FileOStream stream(out.file(), path);
     try {
         Imf::Header header(img.width, img.height);
@@ -146,10 +151,10 @@ void write_exr(const std::string& path, const ImageF& img) {
         file.setFrameBuffer(frame);
         file.writePixels(img.height);
     } catch (const std::exception& e) {
-        if (stream.error() != 0) io_detail::throw_write_errno(path, stream.error());
-        io_detail::throw_write_error(path, e.what());
+        if (stream.error() != 0) throw_write_errno(path, stream.error());
+        throw_write_error(path, e.what());
     }
-    if (stream.error() != 0) io_detail::throw_write_errno(path, stream.error());
+    if (stream.error() != 0) throw_write_errno(path, stream.error());
     out.commit();
 }
 

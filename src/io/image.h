@@ -20,8 +20,9 @@ struct Image8 {
 std::uint8_t to_byte(double c);  // round(255 * clamp(c, 0, 1)); NaN gives 0
 Image8 to_image8(const ImageF& img);
 
-// Writers go through a temporary file in the same directory and rename it into place, so a
-// failed write never leaves a partial image. Errors throw lat::InputError naming the path.
+// Writers go through a temporary file in the same directory and rename it into place
+// (util/atomic_file.h), so a failed or interrupted write never leaves a partial image. Errors throw
+// lat::InputError naming the path.
 void write_png(const std::string& path, const Image8& img);
 void write_pfm(const std::string& path, const ImageF& img);
 void write_exr(const std::string& path, const ImageF& img);
@@ -36,6 +37,8 @@ Image8 read_png(const std::string& path);
 enum class ImageFormat { png, pfm, exr };
 // By extension (case-insensitive): .png, .pfm, .exr; throws InputError for anything else.
 ImageFormat image_format_for(const std::string& path);
+// Image files cannot hold an empty image; throws InputError naming the path for one.
+void require_nonempty_image(const std::string& path, int width, int height);
 // Throws InputError if the file cannot be created there (missing directory, no permission,
 // a directory in the way), without leaving anything behind. It creates and removes the same
 // temporary file the writers would use, so it checks exactly what they need.

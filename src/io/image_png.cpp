@@ -5,22 +5,28 @@
 // C++ objects with destructors in their frames and change no locals after setjmp, so the jump
 // back skips nothing; everything they fill lives in their callers.
 #include <png.h>
+#include <sys/stat.h>
 
 #include <cassert>
 #include <cerrno>
 #include <csetjmp>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <vector>
 
 #include "io/image.h"
-#include "io/temp_file.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace lat {
 
 namespace {
+
+// Largest PNG we read: 2^28 pixels (768 MB as 8-bit RGB), each side at most 2^20.
+constexpr std::uint32_t kMaxPngSide = 1u << 20;
+constexpr std::uint64_t kMaxPngPixels = std::uint64_t{1} << 28;
 
 // Shared by libpng's callbacks and us; a plain struct, since callbacks run between setjmp and
 // longjmp.
@@ -83,12 +89,14 @@ bool encode(png_structp png, png_infop info, const Image8& img, png_bytepp rows)
 }
 
 // Reads the header and sets the transforms down to 8-bit RGB; returns false on a libpng error.
-bool decode_header(png_structp png, png_infop info) {
+// stored_bits: bits per pixel as stored (before the transforms), for the size check.
+bool decode_header(png_structp png, png_infop info, int& stored_bits) {
     if (setjmp(png_jmpbuf(png))) return false;
     png_set_sig_bytes(png, 8);
     png_read_info(png, info);
     const int type = png_get_color_type(png, info);
     const int depth = png_get_bit_depth(png, info);
+    stored_bits = depth * png_get_channels(png, info);
     if (type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
     if (type == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(png);
     if (depth == 16) png_set_scale_16(png);
@@ -124,12 +132,32 @@ struct FileCloser {
     throw_read_error(path, "corrupt PNG file: " + std::string(ctx.message));
 }
 
+// Before allocating for the pixels, the header's claim must be plausible: within our limit and
+// within what the file can hold. Deflate compresses at most 1032:1, so a file of n bytes holds
+// at most about 1032 n bytes of pixel data; a 69-byte file cannot be 20000 x 20000.
+void check_claimed_size(const std::string& path, std::FILE* file, int width, int height,
+                        int stored_bits) {
+    const std::uint64_t pixels =
+        static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
+    const std::string claim =
+        "PNG header claims " + std::to_string(width) + " x " + std::to_string(height) + " pixels";
+    if (pixels > kMaxPngPixels)
+        throw_read_error(path, claim + ", over the limit of " + std::to_string(kMaxPngPixels));
+    struct stat st {};
+    if (::fstat(::fileno(file), &st) != 0 || !S_ISREG(st.st_mode)) return;  // a pipe: no bound
+    const std::uint64_t pixel_bytes = (pixels * static_cast<std::uint64_t>(stored_bits) + 7) / 8;
+    const auto file_bytes = static_cast<std::uint64_t>(st.st_size);
+    if (pixel_bytes / 1032 > file_bytes)
+        throw_read_error(path, claim + ", more than a " + std::to_string(file_bytes) +
+                                   "-byte file can hold (truncated or corrupt PNG file)");
+}
+
 }  // namespace
 
 void write_png(const std::string& path, const Image8& img) {
-    io_detail::require_nonempty(path, img.width, img.height);
+    require_nonempty_image(path, img.width, img.height);
     assert(img.rgb.size() == 3 * static_cast<std::size_t>(img.width) * img.height);
-    io_detail::TempFile out(path);
+    AtomicFile out(path);
     PngContext ctx;
     ctx.file = out.file();
     std::vector<png_bytep> rows(static_cast<std::size_t>(img.height));
@@ -149,8 +177,8 @@ void write_png(const std::string& path, const Image8& img) {
     }
     png_destroy_write_struct(&png, &info);
     if (!ok) {
-        if (ctx.os_error != 0) io_detail::throw_write_errno(path, ctx.os_error);
-        io_detail::throw_write_error(path, ctx.message);
+        if (ctx.os_error != 0) throw_write_errno(path, ctx.os_error);
+        throw_write_error(path, ctx.message);
     }
     out.commit();
 }
@@ -179,11 +207,15 @@ Image8 read_png(const std::string& path) {
     } guard{png, info};
     if (info == nullptr) throw_read_error(path, "cannot read: out of memory");
     png_set_read_fn(png, &ctx, read_data);
-    if (!decode_header(png, info)) throw_decode_error(path, ctx);
+    // libpng refuses larger headers itself (with "Image width/height exceeds user limit").
+    png_set_user_limits(png, kMaxPngSide, kMaxPngSide);
+    int stored_bits = 0;
+    if (!decode_header(png, info, stored_bits)) throw_decode_error(path, ctx);
 
     Image8 img;
     img.width = static_cast<int>(png_get_image_width(png, info));
     img.height = static_cast<int>(png_get_image_height(png, info));
+    check_claimed_size(path, file.get(), img.width, img.height, stored_bits);
     const std::size_t row_bytes = 3 * static_cast<std::size_t>(img.width);
     if (png_get_rowbytes(png, info) != row_bytes) {
         throw_read_error(path, "unsupported PNG layout");  // the transforms above rule this out

@@ -14,6 +14,7 @@
 
 #include "lattice/boundary_grid.h"
 #include "lattice/encoding.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 #include "util/hash.h"
 
@@ -156,19 +157,11 @@ void write_table_file(const std::string& path, const TableHeader& h0,
     const std::uint64_t checksum =
         hash_bytes(h.metadata.data(), h.metadata.size(), hash_bytes(payload.data(), payload.size()));
     const auto header = encode_header(h, checksum);
-    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-    FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw InputError(path + ": cannot write lattice table: " + std::strerror(errno));
-    bool ok = std::fwrite(header.data(), 1, header.size(), f) == header.size() &&
-              std::fwrite(payload.data(), 1, payload.size(), f) == payload.size() &&
-              std::fwrite(h.metadata.data(), 1, h.metadata.size(), f) == h.metadata.size();
-    const int err = errno;
-    ok = (std::fclose(f) == 0) && ok;
-    if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-        const int e = ok ? errno : err;
-        std::remove(tmp.c_str());
-        throw InputError(path + ": cannot write lattice table: " + std::strerror(e));
-    }
+    AtomicFile out(path, "lattice table");
+    out.write(header.data(), header.size());
+    out.write(payload.data(), payload.size());
+    out.write(h.metadata.data(), h.metadata.size());
+    out.commit();
 }
 
 TableHeader read_table_header(const std::string& path) {

@@ -10,6 +10,8 @@
 
 #include "render/camera.h"
 #include "render/shading.h"
+#include "util/error.h"
+#include "util/interrupt.h"
 #include "util/progress.h"
 
 namespace lat {
@@ -28,6 +30,18 @@ std::uint64_t mix(std::uint64_t x) {
 double unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
 
 }  // namespace
+
+void check_render_budget(const Camera& camera, int spp, const std::string& file) {
+    const std::uint64_t samples = static_cast<std::uint64_t>(camera.width) *
+                                  static_cast<std::uint64_t>(camera.height) *
+                                  static_cast<std::uint64_t>(std::max(1, spp));
+    if (samples > kMaxRenderSamples)
+        throw InputError(located_message(
+            file, "camera",
+            std::to_string(camera.width) + " x " + std::to_string(camera.height) + " pixels x " +
+                std::to_string(spp) + " samples per pixel is over the limit of " +
+                std::to_string(kMaxRenderSamples) + " samples"));
+}
 
 void stratify(int n, int& nx, int& ny) {
     nx = static_cast<int>(std::sqrt(static_cast<double>(n)));
@@ -58,6 +72,9 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
             std::uint64_t rays = 0;
             for (int j = y0; j < std::min(h, y0 + kTile); ++j) {
                 for (int i = x0; i < std::min(w, x0 + kTile); ++i) {
+                    // One relaxed load per pixel (a tile can take seconds at high spp); the
+                    // rest is skipped, and Interrupted thrown below.
+                    if (interrupted()) return;
                     Vec3 sum, sum_clamped;
                     for (int k = 0; k < spp; ++k) {
                         double ox = 0.5, oy = 0.5;
@@ -88,6 +105,7 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
         }
     });
     bar.finish();
+    throw_if_interrupted();
     out.stats.render_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     out.stats.primary_rays = primary.load();

@@ -27,6 +27,13 @@ struct RenderOutput {
     RenderStats stats;
 };
 
+// The most samples (pixels x samples per pixel) one render may take: hours of work already,
+// so a larger request is surely a mistake rather than a job to start.
+constexpr std::uint64_t kMaxRenderSamples = std::uint64_t{1} << 32;
+// Throws InputError naming `file` (the scene) when width x height x spp is over the limit.
+void check_render_budget(const Camera& camera, int spp, const std::string& file);
+
+// Throws Interrupted (util/interrupt.h) when a signal arrives: it stops at the next pixel.
 RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt);
 
 // The sample grid for n samples: nx * ny = n with nx, ny as close as possible.

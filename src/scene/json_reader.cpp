@@ -1,6 +1,8 @@
 #include "scene/json_reader.h"
 
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 
 #include "util/error.h"
 #include "util/file.h"
@@ -63,6 +65,9 @@ void JsonValue::allow_keys(const std::vector<const char*>& allowed, const std::s
 
 std::size_t JsonValue::size() const {
     if (!j_->is_array()) fail("expected an array, found " + type_name());
+    if (j_->size() > kMaxJsonArray)
+        fail("array of " + std::to_string(j_->size()) + " entries is over the limit of " +
+             std::to_string(kMaxJsonArray));
     return j_->size();
 }
 
@@ -132,29 +137,86 @@ Vec3 JsonValue::vec3_or(const std::string& key, Vec3 def) const {
     return v ? v->vec3() : def;
 }
 
+namespace {
+
+// "file:line:col: what" for the byte at offset `at` (0-based) of text.
+std::string text_place(const std::string& text, std::size_t at, const std::string& file) {
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i < at && i < text.size(); ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            col = 1;
+        } else {
+            ++col;
+        }
+    }
+    return file + ":" + std::to_string(line) + ":" + std::to_string(col);
+}
+
+// A number token starting at text[i] (a '-' or a digit): its length.
+std::size_t number_token_length(const std::string& text, std::size_t i) {
+    std::size_t n = i;
+    while (n < text.size() &&
+           (std::isdigit(static_cast<unsigned char>(text[n])) || text[n] == '-' || text[n] == '+' ||
+            text[n] == '.' || text[n] == 'e' || text[n] == 'E'))
+        ++n;
+    return n - i;
+}
+
+// What nlohmann's parser does not report with a place, or does not limit: nesting depth (the
+// DOM and everything that walks it recurse, so a deep document could overflow the stack) and
+// numbers beyond the range of a double (nlohmann throws out_of_range without a position).
+// One linear pass over the raw text, skipping strings; syntax is left to the parser.
+void prescan_json(const std::string& text, const std::string& file) {
+    int depth = 0;
+    bool in_string = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (in_string) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                in_string = false;
+            continue;
+        }
+        if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth)
+                throw InputError(text_place(text, i, file) + ": invalid JSON: nested deeper than " +
+                                 std::to_string(kMaxJsonDepth) + " levels");
+        } else if (c == ']' || c == '}') {
+            --depth;
+        } else if (c == '-' || std::isdigit(static_cast<unsigned char>(c))) {
+            const std::size_t len = number_token_length(text, i);
+            const std::string token = text.substr(i, len);
+            // strtod saturates to HUGE_VAL on overflow; underflow to 0 or a denormal is fine.
+            if (std::isinf(std::strtod(token.c_str(), nullptr)))
+                throw InputError(text_place(text, i, file) + ": number " + token.substr(0, 40) +
+                                 " is out of the range of a double");
+            i += len - 1;
+        }
+    }
+}
+
+}  // namespace
+
 nlohmann::json parse_json_text(const std::string& text, const std::string& file) {
+    prescan_json(text, file);
     try {
         return nlohmann::json::parse(text);
     } catch (const nlohmann::json::parse_error& e) {
-        // Turn the byte offset into a line and column (1-based).
-        const std::size_t byte = std::min<std::size_t>(e.byte, text.size());
-        std::size_t line = 1, col = 1;
-        for (std::size_t i = 0; i + 1 < byte; ++i) {
-            if (text[i] == '\n') {
-                ++line;
-                col = 1;
-            } else {
-                ++col;
-            }
-        }
+        const std::size_t byte = e.byte > 0 ? e.byte - 1 : 0;  // e.byte is 1-based
         std::string what = e.what();
         // nlohmann's text: "[json.exception.parse_error.101] parse error at line 3, column 5:
         // syntax error while parsing value - invalid literal; last read: 'x'"; keep the reason.
         const auto pos = what.find("error while parsing");
         std::string reason = pos != std::string::npos ? what.substr(pos) : what;
         if (reason.rfind("error while ", 0) == 0) reason = "syntax " + reason;
-        throw InputError(file + ":" + std::to_string(line) + ":" + std::to_string(col) +
-                         ": invalid JSON: " + reason);
+        throw InputError(text_place(text, byte, file) + ": invalid JSON: " + reason);
+    } catch (const nlohmann::json::exception& e) {
+        // Anything else nlohmann can throw while parsing (the prescan should leave none).
+        throw InputError(file + ": invalid JSON: " + e.what());
     }
 }
 

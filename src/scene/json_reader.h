@@ -65,7 +65,15 @@ private:
     std::string type_name() const;
 };
 
-// Parses a whole file; syntax errors name the line and column.
+// Deepest nesting of arrays and objects a document may have: deep enough for any real scene
+// (a CSG level takes two), shallow enough that code walking the tree recursively is safe.
+constexpr int kMaxJsonDepth = 1024;
+// Longest array a scene may hold (objects, spheres, ...): far beyond real scenes, and it keeps
+// sizes derived from array lengths well within int range.
+constexpr std::size_t kMaxJsonArray = 10'000'000;
+
+// Parses a whole file; syntax errors, nesting deeper than kMaxJsonDepth and numbers beyond the
+// range of a double name the line and column.
 nlohmann::json parse_json_file(const std::string& path);
 nlohmann::json parse_json_text(const std::string& text, const std::string& file);
 

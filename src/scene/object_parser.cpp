@@ -26,6 +26,9 @@ Poly3 parse_quartic_polynomial(const JsonValue& v) {
             if (i < 0 || j < 0 || k < 0) term.fail("exponents must not be negative");
             if (i + j + k > 4) term.fail("degree " + std::to_string(i + j + k) + " is over 4");
             f.at(i, j, k) += term[3].number();
+            if (!std::isfinite(f.at(i, j, k)))
+                term.fail("the coefficients of x^" + std::to_string(i) + " y^" + std::to_string(j) +
+                          " z^" + std::to_string(k) + " add up beyond the range of a double");
         }
         if (f.degree() < 1) list.fail("the polynomial has no term in x, y or z");
         return f;
@@ -149,7 +152,9 @@ ObjectParser::Leaf ObjectParser::parse_leaf(const JsonValue& v, const std::strin
 }
 
 int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to_root,
-                          std::optional<std::uint32_t> override_material) const {
+                          std::optional<std::uint32_t> override_material, int depth) const {
+    if (depth > kMaxCsgDepth)
+        v.fail("csg tree nested deeper than " + std::to_string(kMaxCsgDepth) + " levels");
     if (!v.is_object()) v.fail("expected an object");
     const std::string type = v.at("type").string();
     Transform xf = to_root;
@@ -172,7 +177,7 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
             children.fail("a difference needs at least two children");
         std::vector<int> refs;
         for (std::size_t i = 0; i < children.size(); ++i)
-            refs.push_back(add_csg(csg, children[i], xf, override_material));
+            refs.push_back(add_csg(csg, children[i], xf, override_material, depth + 1));
         return csg.add_node(cop, std::move(refs));
     }
 
@@ -188,13 +193,15 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
         v.fail("missing field 'material' (needed unless an enclosing csg node sets one)");
     }
     if (override_material && v.has("material")) (void)material(v.at("material"));  // still check
-    return csg.add_leaf({leaf.shape, xf * leaf.placement, mat, leaf.primitive});
+    const Transform placed = xf * leaf.placement;
+    require_finite_transform(placed, v);
+    return csg.add_leaf({leaf.shape, placed, mat, leaf.primitive});
 }
 
 std::shared_ptr<const Shape> ObjectParser::parse_shape(const JsonValue& v) const {
     if (!v.is_object()) v.fail("expected an object");
     auto csg = std::make_shared<CsgShape>();
-    csg->set_root(add_csg(*csg, v, Transform{}, kNoMaterial));
+    csg->set_root(add_csg(*csg, v, Transform{}, kNoMaterial, 1));
     return csg;
 }
 
@@ -206,7 +213,7 @@ SceneObject ObjectParser::parse(const JsonValue& v) const {
     if (type == "csg") {
         // Transforms (the root's included) are folded into the leaves, so the object's is identity.
         auto csg = std::make_shared<CsgShape>();
-        csg->set_root(add_csg(*csg, v, Transform{}, std::nullopt));
+        csg->set_root(add_csg(*csg, v, Transform{}, std::nullopt, 1));
         obj.shape = csg;
         return obj;
     }
@@ -215,6 +222,7 @@ SceneObject ObjectParser::parse(const JsonValue& v) const {
     Leaf leaf = parse_leaf(v, type);
     obj.shape = leaf.shape;
     obj.xf = user * leaf.placement;
+    require_finite_transform(obj.xf, v);
     obj.primitive = leaf.primitive;
     obj.material = material(v.at("material"));
     return obj;

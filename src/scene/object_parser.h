@@ -11,6 +11,10 @@
 
 namespace lat {
 
+// Deepest CSG tree a scene may hold: far beyond real scenes; parsing and tracing recurse per
+// level, so the limit keeps the stack bounded.
+constexpr int kMaxCsgDepth = 256;
+
 class ObjectParser {
 public:
     ObjectParser(const std::map<std::string, std::uint32_t>& materials,
@@ -33,9 +37,10 @@ private:
         int primitive = -1;
     };
     Leaf parse_leaf(const JsonValue& v, const std::string& type) const;
-    // Adds v's subtree to csg; `to_root` maps v's parent frame to the CSG root frame.
+    // Adds v's subtree to csg; `to_root` maps v's parent frame to the CSG root frame; `depth`
+    // is v's depth in the tree (the root is 1), limited to kMaxCsgDepth.
     int add_csg(CsgShape& csg, const JsonValue& v, const Transform& to_root,
-                std::optional<std::uint32_t> override_material) const;
+                std::optional<std::uint32_t> override_material, int depth) const;
 };
 
 }  // namespace lat

@@ -12,6 +12,8 @@ namespace lat {
 namespace {
 
 constexpr int kMaxImageSide = 32768;
+// 8192 x 8192: the float and 8-bit buffers of the largest image take about 1 GB.
+constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 26;
 
 Camera parse_camera(const JsonValue& v) {
     v.allow_keys({"eye", "look_at", "up", "fov_y_deg", "width", "height"});
@@ -29,8 +31,13 @@ Camera parse_camera(const JsonValue& v) {
             s.fail("must be between 1 and " + std::to_string(kMaxImageSide) + " pixels");
         (key[0] == 'w' ? c.width : c.height) = n;
     }
+    if (std::int64_t{c.width} * c.height > kMaxImagePixels)
+        v.fail(std::to_string(c.width) + " x " + std::to_string(c.height) +
+               " pixels is over the limit of " + std::to_string(kMaxImagePixels) + " pixels");
     const Vec3 w = c.look_at - c.eye;
     if (length_squared(w) == 0) v.fail("eye and look_at are the same point");
+    if (!std::isfinite(length_squared(w)))
+        v.fail("eye and look_at are too far apart (the distance overflows a double)");
     if (length_squared(cross(w, c.up)) <= 1e-12 * length_squared(w) * length_squared(c.up))
         v.at("up").fail("up is parallel to the viewing direction");
     return c;

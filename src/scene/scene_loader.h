@@ -13,6 +13,9 @@ Scene load_scene_text(const std::string& text, const std::string& file);
 
 // Parts of the loader that other readers (e.g. Table 1 files) reuse.
 Transform parse_transform(const JsonValue& v);
+// Throws InputError at v unless t and its inverse are finite (composing finite transforms, e.g.
+// down a CSG tree, can overflow).
+void require_finite_transform(const Transform& t, const JsonValue& v);
 class ObjectParser;
 // `objects` parses primitives given as an object; without it only chains are accepted.
 Primitive parse_primitive(const JsonValue& v, const std::string& name,

@@ -64,12 +64,21 @@ Transform parse_op(const JsonValue& op) {
 
 }  // namespace
 
+void require_finite_transform(const Transform& t, const JsonValue& v) {
+    const Affine& f = t.forward();
+    const Affine& i = t.inverse_map();
+    bool ok = is_finite(f.t) && is_finite(i.t);
+    for (std::size_t r = 0; r < 3; ++r) ok = ok && is_finite(f.m.r[r]) && is_finite(i.m.r[r]);
+    if (!ok) v.fail("the transform overflows the range of a double (or its inverse does)");
+}
+
 Transform parse_transform(const JsonValue& v) {
     if (!v.is_array() || v.size() == 0)
         v.fail("expected a 3 x 4 matrix or a list of operations");
     if (v[0].is_array()) return checked(parse_matrix(v), v);
     Transform t;
     for (std::size_t i = 0; i < v.size(); ++i) t = parse_op(v[i]) * t;  // later ops apply last
+    require_finite_transform(t, v);
     return t;
 }
 

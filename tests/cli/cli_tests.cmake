@@ -24,6 +24,26 @@ lattice_cli_error(degree_five ${BAD}/degree-five.json "objects\\[1\\]\\.polynomi
 lattice_cli_error(missing_sphere ${BAD}/missing-sphere.json "primitives\\.hair\\.cylinders\\[0\\]\\[1\\]: sphere index 5 does not exist")
 lattice_cli_error(impossible_size ${BAD}/impossible-size.json "camera\\.width: must be between 1 and 32768")
 lattice_cli_error(missing_scene ${BAD}/no-such-file.json "no-such-file.json: cannot open scene file: No such file or directory")
+# Hostile inputs (issue 11): one located message, exit 2, never a crash or a huge allocation.
+lattice_cli_error(huge_number ${BAD}/huge-number.json "huge-number.json:2:69: number 1e400 is out of the range of a double")
+lattice_cli_error(overflowing_transform ${BAD}/overflowing-transform.json "objects\\[1\\]\\.transform: the transform overflows")
+add_test(NAME cli.too_many_samples
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--spp;256;${BAD}/too-many-samples.json;-o;${CLI_OUT}/spp.png"
+          -DEXIT=2 "-DPATTERN=too-many-samples.json: camera: 8192 x 8192 pixels x 256 samples per pixel is over the limit of 4294967296 samples"
+          -DNO_FILE=${CLI_OUT}/spp.png -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.extreme_quartic_renders
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;-q;${BAD}/extreme-quartic.json;-o;${CLI_OUT}/quartic.png"
+          -DEXIT=0 -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.png_claiming_huge_size
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;compare;${BAD}/claims-20000x20000.png;${BAD}/claims-20000x20000.png"
+          -DEXIT=2 "-DPATTERN=claims-20000x20000.png: PNG header claims 20000 x 20000 pixels, over the limit"
+          -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+foreach(case deep_csg concurrent_stats sigint)
+  add_test(NAME cli.hostile_${case}
+    COMMAND ${CMAKE_COMMAND} -DLATTICE=$<TARGET_FILE:lattice> -DDATA=${BAD}
+            -DWORK=${CLI_OUT}/hostile-${case} -DCASE=${case}
+            -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/hostile_cases.cmake)
+endforeach()
 
 add_test(NAME cli.unwritable_output
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;${BAD}/good.json;-o;${CLI_OUT}/no/such/dir/x.png"
