@@ -112,6 +112,7 @@ int run_render(const RenderArgs& a) {
             j["table_bytes"] = lattices.table_bytes;
             j["table_entries"] = lattices.table_entries;
             j["table_files"] = lattices.paths;
+            j["lattice_visits"] = st.lattice_visits;
         }
         j["render_ms"] = st.render_ms;
         j["total_ms"] = total_ms;
