@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "lattice/lattice_shape.h"
+#include "lattice/part_boxes.h"
 
 namespace lat {
 
@@ -28,11 +29,7 @@ private:
     std::shared_ptr<const LatticeTable> table_;
     const Shape* primitive_;
     LatticeFrame frame_;
-    // Each part's bounds, padded: a candidate whose box the real ray misses, or meets only
-    // outside the parameter range asked, cannot give a crossing there and costs a slab test
-    // instead of an exact intersection (lists hold every part within 0.71 cells of the
-    // snapped segment; the ray meets few of them).
-    std::vector<Bounds3> part_boxes_;
+    PartBoxes boxes_;  // rejects candidates whose box the ray misses (lattice/part_boxes.h)
 
     // The parts the ray can meet; false when none.
     bool candidates(const Ray& r, CandidateList& list) const;
