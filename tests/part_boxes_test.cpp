@@ -62,7 +62,8 @@ TEST(PartBoxes, FloatTestNeverRejectsAPartTheRayMeets) {
         const double scale = 0.01 + 10 * u(rng);  // instance scaling lengthens or shortens d
         const Ray r{p - d * dist, d * scale};
         const double t_hit = dist / scale;
-        const double tmin = n % 2 ? 0.0 : t_hit * u(rng), tmax = n % 5 ? kInfinity : t_hit * (1 + u(rng));
+        const double tmin = n % 2 ? 0.0 : t_hit * u(rng),
+                     tmax = n % 5 ? kInfinity : t_hit * (1 + u(rng));
         const PartBoxes::Ray4 q(boxes, r);
         const PartBoxes::Ray4::Range range = q.range(tmin, tmax);
         for (std::uint32_t i = 0; i < prim.parts.size(); ++i)

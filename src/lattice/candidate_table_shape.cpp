@@ -47,8 +47,7 @@ bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const
     const PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);
     for (int k = 0; k < list.count; ++k) {
         const std::uint32_t part = list.parts[k];
-        if (slabs.meets(part, range) &&
-            primitive_->occluded_primitive(part, r, tmin, tmax))
+        if (slabs.meets(part, range) && primitive_->occluded_primitive(part, r, tmin, tmax))
             return true;
     }
     return false;
@@ -61,8 +60,7 @@ void CandidateTableShape::spans(const Ray& r, SpanList& out) const {
     const PartBoxes::Ray4 slabs(boxes_, r);
     const PartBoxes::Ray4::Range range = slabs.range(-kInfinity, kInfinity);
     for (int k = 0; k < list.count; ++k)
-        if (slabs.meets(list.parts[k], range))
-            primitive_->primitive_spans(list.parts[k], r, out);
+        if (slabs.meets(list.parts[k], range)) primitive_->primitive_spans(list.parts[k], r, out);
     merge_span_union(out, first);  // the union of the candidate parts' spans
 }
 

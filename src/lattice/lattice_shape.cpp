@@ -12,7 +12,9 @@ namespace {
 thread_local std::uint64_t t_visits = 0;
 }  // namespace
 
-std::uint64_t lattice_visits_this_thread() { return t_visits; }
+std::uint64_t lattice_visits_this_thread() {
+    return t_visits;
+}
 
 LatticeFrame::LatticeFrame(const TableContext& ctx, double hit_error)
     : grid_(ctx.cells),

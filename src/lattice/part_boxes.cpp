@@ -33,7 +33,8 @@ PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box) : center_(box.c
         exact_.push_back(b);
         // Coordinates relative to the box centre, like the float ray's origin.
         const Bounds3 f = expand(b, kPad * d);
-        Box4 q{{down(f.lo.x - center_.x), down(f.lo.y - center_.y), down(f.lo.z - center_.z), -INFINITY},
+        Box4 q{{down(f.lo.x - center_.x), down(f.lo.y - center_.y), down(f.lo.z - center_.z),
+                -INFINITY},
                {up(f.hi.x - center_.x), up(f.hi.y - center_.y), up(f.hi.z - center_.z), INFINITY}};
         f_.push_back(q);
     }

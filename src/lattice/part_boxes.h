@@ -54,7 +54,8 @@ public:
             const __m128 o = _mm_load_ps(o_), inv = _mm_load_ps(inv_);
             const __m128 t0 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(b.lo), o), inv);
             const __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(b.hi), o), inv);
-            // Lanes 0-2: the slabs' entries and exits; lane 3 is neutral. Largest entry, least exit.
+            // Lanes 0-2: the slabs' entries and exits; lane 3 is neutral. Largest entry, least
+            // exit.
             __m128 tn = _mm_min_ps(t0, t1), tf = _mm_max_ps(t0, t1);
             tn = _mm_max_ps(tn, _mm_shuffle_ps(tn, tn, _MM_SHUFFLE(2, 3, 0, 1)));
             tn = _mm_max_ps(tn, _mm_shuffle_ps(tn, tn, _MM_SHUFFLE(1, 0, 3, 2)));

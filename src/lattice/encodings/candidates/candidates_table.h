@@ -46,9 +46,10 @@ public:
 private:
     RankIndex rank_;
     const std::uint64_t* ids_ = nullptr;
-    const std::uint32_t* offsets_ = nullptr;  // sets_ + 1: set i is parts_[offsets_[i], offsets_[i+1])
+    // sets_ + 1 offsets: set i is parts_[offsets_[i], offsets_[i + 1]).
+    const std::uint32_t* offsets_ = nullptr;
     const std::uint32_t* parts_ = nullptr;
-    std::vector<std::uint32_t> converted_;    // CAND1: the lists made from its masks
+    std::vector<std::uint32_t> converted_;  // CAND1: the lists made from its masks
     std::uint32_t points_ = 0, set_bits_ = 0, sets_ = 0;
     std::uint64_t occupied_ = 0;
     std::uint64_t entries_;
