@@ -2,7 +2,9 @@
 // sizes documented; candidates is exact (its images equal exact mode's).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
+#include <vector>
 
 #include "geometry/chain.h"
 #include "io/image_compare.h"
@@ -102,6 +104,45 @@ TEST(EncodingCandidates, ExactOnEveryPair) {
     EXPECT_EQ(r.false_misses, 0u);
     EXPECT_LT(r.max_point_error, 1e-5);
     EXPECT_LT(double(b.payload.size()) / double(b.raster.hits), 2.0);
+}
+
+TEST(EncodingCandidates, OldMaskTablesStillOpen) {
+    // A CAND1 payload (part sets as 64-bit masks, before issue 9) made from a CAND2 one: the
+    // same header and pair sections, then one mask per set. Both answer every pair alike.
+    const Built b = build("candidates", 1);
+    const std::uint8_t* p = b.payload.data();
+    std::uint32_t sets;
+    std::uint64_t list_total;
+    std::memcpy(&sets, p + 32, 4);
+    std::memcpy(&list_total, p + 40, 8);
+    auto pad8 = [](std::uint64_t n) { return (n + 7) / 8 * 8; };
+    const std::size_t prefix = b.payload.size() - pad8((sets + 1) * 4ull) - pad8(list_total * 4);
+    const auto* offsets = reinterpret_cast<const std::uint32_t*>(p + prefix);
+    const auto* parts = offsets + pad8((sets + 1) * 4ull) / 4;
+    ByteBuffer old(prefix + sets * 8ull);
+    std::memcpy(old.data(), p, prefix);
+    const std::uint64_t magic1 = 0x31444E4143'5441ull, zero = 0;
+    std::memcpy(old.data(), &magic1, 8);
+    std::memcpy(old.data() + 40, &zero, 8);
+    for (std::uint32_t i = 0; i < sets; ++i) {
+        std::uint64_t mask = 0;
+        for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) mask |= std::uint64_t{1} << parts[k];
+        std::memcpy(old.data() + prefix + i * 8ull, &mask, 8);
+    }
+    const CandidatesTable t1(old.data(), old.size(), b.table->entries(), b.ctx);
+    const BoundaryGrid grid(b.ctx.cells);
+    int answered = 0;
+    for (std::uint32_t x = 0; x < grid.count(); ++x)
+        for (std::uint32_t y = x; y < grid.count(); y += 3) {
+            CandidateList l1, l2;
+            const bool h1 = t1.candidates(x, y, l1), h2 = b.table->candidates(x, y, l2);
+            ASSERT_EQ(h1, h2) << x << " " << y;
+            if (!h1) continue;
+            ++answered;
+            ASSERT_EQ(std::vector<std::uint32_t>(l1.parts, l1.parts + l1.count),
+                      std::vector<std::uint32_t>(l2.parts, l2.parts + l2.count));
+        }
+    EXPECT_GT(answered, 1000);
 }
 
 TEST(EncodingCandidates, EveryPartARayMeetsIsACandidate) {

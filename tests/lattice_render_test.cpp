@@ -56,6 +56,20 @@ TEST_F(LatticeRender, PlatesAreCloseToExact) {
     }
 }
 
+TEST_F(LatticeRender, VisitsAreCounted) {
+    // render --stats' lattice_visits: none in exact mode; in lattice mode the same count every
+    // time, whichever threads rendered which tiles.
+    const Scene s = small("plate4-fuzzy-sphere-1000", 48);
+    EXPECT_EQ(render_image(RenderScene(s), {}).stats.lattice_visits, 0u);
+    TableSpec spec;
+    spec.encoding = "dense";
+    const SceneLattices l = scene_lattices(s, cache, spec, false);
+    const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
+    const RenderStats a = render_image(rs, {}).stats, b = render_image(rs, {}).stats;
+    EXPECT_GT(a.lattice_visits, a.primary_rays / 4);
+    EXPECT_EQ(a.lattice_visits, b.lattice_visits);
+}
+
 TEST_F(LatticeRender, CsgPrimitivesRasterizeToo) {
     // A primitive given as a CSG object (torus minus sphere), instanced twice.
     const Scene s = small("lattice-rings", 128);

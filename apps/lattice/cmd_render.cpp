@@ -98,6 +98,7 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const SceneLa
         j["table_bytes"] = lattices.table_bytes;
         j["table_entries"] = lattices.table_entries;
         j["table_files"] = lattices.paths;
+        j["lattice_visits"] = st.lattice_visits;
     }
     j["render_ms"] = st.render_ms;
     j["total_ms"] = t.written;

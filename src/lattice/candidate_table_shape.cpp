@@ -6,7 +6,10 @@ namespace lat {
 
 CandidateTableShape::CandidateTableShape(std::shared_ptr<const LatticeTable> table,
                                          const TableContext& ctx)
-    : table_(std::move(table)), primitive_(ctx.primitive), frame_(ctx, 0.0) {
+    : table_(std::move(table)),
+      primitive_(ctx.primitive),
+      frame_(ctx, 0.0),
+      boxes_(*ctx.primitive, frame_.box()) {
     assert(primitive_ && table_->kind() == LatticeTable::Kind::kCandidates);
 }
 
@@ -22,20 +25,31 @@ bool CandidateTableShape::candidates(const Ray& r, CandidateList& list) const {
 bool CandidateTableShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
     CandidateList list;
     if (!candidates(r, list)) return false;
+    const PartBoxes::Ray4 slabs(boxes_, r);
+    PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);
     bool found = false;
-    for (int k = 0; k < list.count; ++k)
-        if (primitive_->intersect_primitive(list.parts[k], r, tmin, tmax, hit)) {
+    for (int k = 0; k < list.count; ++k) {
+        const std::uint32_t part = list.parts[k];
+        if (!slabs.meets(part, range)) continue;
+        if (primitive_->intersect_primitive(part, r, tmin, tmax, hit)) {
             tmax = hit.t;
+            range = slabs.range(tmin, tmax);
             found = true;
         }
+    }
     return found;
 }
 
 bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const {
     CandidateList list;
     if (!candidates(r, list)) return false;
-    for (int k = 0; k < list.count; ++k)
-        if (primitive_->occluded_primitive(list.parts[k], r, tmin, tmax)) return true;
+    const PartBoxes::Ray4 slabs(boxes_, r);
+    const PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);
+    for (int k = 0; k < list.count; ++k) {
+        const std::uint32_t part = list.parts[k];
+        if (slabs.meets(part, range) && primitive_->occluded_primitive(part, r, tmin, tmax))
+            return true;
+    }
     return false;
 }
 
@@ -43,7 +57,10 @@ void CandidateTableShape::spans(const Ray& r, SpanList& out) const {
     CandidateList list;
     if (!candidates(r, list)) return;
     const std::size_t first = out.size();
-    for (int k = 0; k < list.count; ++k) primitive_->primitive_spans(list.parts[k], r, out);
+    const PartBoxes::Ray4 slabs(boxes_, r);
+    const PartBoxes::Ray4::Range range = slabs.range(-kInfinity, kInfinity);
+    for (int k = 0; k < list.count; ++k)
+        if (slabs.meets(list.parts[k], range)) primitive_->primitive_spans(list.parts[k], r, out);
     merge_span_union(out, first);  // the union of the candidate parts' spans
 }
 

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "lattice/lattice_shape.h"
+#include "lattice/part_boxes.h"
 
 namespace lat {
 
@@ -28,6 +29,7 @@ private:
     std::shared_ptr<const LatticeTable> table_;
     const Shape* primitive_;
     LatticeFrame frame_;
+    PartBoxes boxes_;  // rejects candidates whose box the ray misses (lattice/part_boxes.h)
 
     // The parts the ray can meet; false when none.
     bool candidates(const Ray& r, CandidateList& list) const;

@@ -49,9 +49,6 @@ struct Encoding {
     // infinity when it can answer pairs whose segment misses (perfect hashing). The renderer
     // culls rays far from the primitive by it without changing any answer.
     double (*error_bound)(const TableContext& ctx, const EncodeOptions& opt);
-    // Limits on the primitive beyond the point count: empty when it can be built, else why not
-    // (the caller adds the file and place). Null: no such limits.
-    std::string (*refuses)(const Shape& primitive) = nullptr;
 };
 
 // Every registered encoding, in the order they are listed to users.

@@ -8,6 +8,13 @@
 #include "lattice/hit_table_shape.h"
 
 namespace lat {
+namespace {
+thread_local std::uint64_t t_visits = 0;
+}  // namespace
+
+std::uint64_t lattice_visits_this_thread() {
+    return t_visits;
+}
 
 LatticeFrame::LatticeFrame(const TableContext& ctx, double hit_error)
     : grid_(ctx.cells),
@@ -67,6 +74,7 @@ void LatticeFrame::make_cull_boxes(const Shape* primitive, double hit_error) {
 }
 
 bool LatticeFrame::snap(const Ray& r, Snap& s) const {
+    ++t_visits;
     s.o = r.o * inv_cell_;
     s.d = r.d * inv_cell_;
     const Vec3 o = s.o, d = s.d;

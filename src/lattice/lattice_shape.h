@@ -46,6 +46,11 @@ private:
     void make_cull_boxes(const Shape* primitive, double hit_error);
 };
 
+// Lattice visits (snaps of a ray to a grid point pair: one per call of a lattice shape's
+// intersect, occluded, spans or inside) made by the calling thread so far. A thread-local count
+// costs one increment a visit and no contention; the renderer adds up its growth per tile.
+std::uint64_t lattice_visits_this_thread();
+
 // The shape for a table of either kind; ctx.primitive must be set (candidate tables intersect
 // it; both cull by it) and outlive the shape.
 std::shared_ptr<const Shape> make_lattice_shape(std::shared_ptr<const LatticeTable> table,

@@ -79,11 +79,11 @@ inline std::string sigma_inv_error(long long k) {
            std::to_string(kMaxSigmaInv) + ")";
 }
 
-// Up to this many parts per candidate list (a table with longer lists cannot be built).
-inline constexpr int kMaxCandidates = 64;
+// A candidate list: part indices in ascending order, pointing into the table's storage (no
+// copy a lookup, and no limit on the parts of a primitive).
 struct CandidateList {
     int count = 0;
-    std::uint32_t parts[kMaxCandidates];
+    const std::uint32_t* parts = nullptr;
 };
 
 class LatticeTable {

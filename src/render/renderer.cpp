@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "lattice/lattice_shape.h"
 #include "render/camera.h"
 #include "render/shading.h"
 #include "util/error.h"
@@ -61,7 +62,7 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     const int spp = sx_n * sy_n;
 
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-    std::atomic<std::uint64_t> primary{0}, shadow{0};
+    std::atomic<std::uint64_t> primary{0}, shadow{0}, visits{0};
     ProgressBar bar("render", static_cast<std::uint64_t>(tiles_x) * tiles_y, opt.progress);
     const auto start = std::chrono::steady_clock::now();
 
@@ -69,6 +70,8 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
         for (int tile = range.begin(); tile != range.end(); ++tile) {
             const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
             ShadeCounters counters;
+            // A tile runs on one thread from start to end: its visits are this thread's growth.
+            const std::uint64_t visits0 = lattice_visits_this_thread();
             std::uint64_t rays = 0;
             for (int j = y0; j < std::min(h, y0 + kTile); ++j) {
                 for (int i = x0; i < std::min(w, x0 + kTile); ++i) {
@@ -101,6 +104,7 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
             }
             primary.fetch_add(rays, std::memory_order_relaxed);
             shadow.fetch_add(counters.shadow_rays, std::memory_order_relaxed);
+            visits.fetch_add(lattice_visits_this_thread() - visits0, std::memory_order_relaxed);
             bar.add(1);
         }
     });
@@ -110,6 +114,7 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     out.stats.primary_rays = primary.load();
     out.stats.shadow_rays = shadow.load();
+    out.stats.lattice_visits = visits.load();
     out.stats.threads = tbb::this_task_arena::max_concurrency();
     return out;
 }

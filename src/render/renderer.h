@@ -18,6 +18,7 @@ struct RenderStats {
     double render_ms = 0;
     std::uint64_t primary_rays = 0;
     std::uint64_t shadow_rays = 0;
+    std::uint64_t lattice_visits = 0;  // see lattice_visits_this_thread
     int threads = 0;
 };
 

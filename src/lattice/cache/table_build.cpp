@@ -75,9 +75,6 @@ void check_points(const TablePlan& plan) {
 
 void check_buildable(const TablePlan& plan) {
     check_inside_box(plan);
-    if (plan.encoding->refuses)
-        if (const std::string why = plan.encoding->refuses(*plan.primitive->shape); !why.empty())
-            throw InputError(plan.place + "primitive '" + plan.primitive->name + "': " + why);
     const double pairs = static_cast<double>(pair_count(plan.header));
     const double per_hit = plan.encoding->bytes_per_hit + sizeof(RawHit);
     const double avail = static_cast<double>(available_memory_bytes());

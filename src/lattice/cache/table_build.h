@@ -10,7 +10,7 @@ namespace lat {
 
 // Throws InputError (naming the scene file and the primitive), before any long work, when the
 // table cannot be built here: the primitive leaves its lattice box, the encoding cannot key
-// that many points or refuses the primitive, or the table would not fit in memory (the message
+// that many points, or the table would not fit in memory (the message
 // gives the size it would need).
 void check_buildable(const TablePlan& plan);
 

@@ -21,13 +21,6 @@ const Encoding kCandidatesEncoding{
     .error_bound = [](const TableContext&, const EncodeOptions&) {
         return 0.0;  // exact hits on the real ray
     },
-    .refuses = [](const Shape& primitive) -> std::string {
-        if (primitive.primitive_count() <= CandidatesTable::kMaxParts) return {};
-        return "the candidates encoding handles primitives of at most " +
-               std::to_string(CandidatesTable::kMaxParts) + " parts; this one has " +
-               std::to_string(primitive.primitive_count()) +
-               " (choose another encoding, e.g. dense)";
-    },
 };
 
 }  // namespace lat

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
+#include <string_view>
 #include <unordered_map>
 
 #include "geometry/chain.h"
@@ -17,30 +18,39 @@
 namespace lat {
 namespace {
 
-constexpr std::uint64_t kMagic = 0x31444E4143'5441ull;  // tag for "CAND1"
+// Payload tags: "CAND1" stored part sets as 64-bit masks, "CAND2" as sorted index lists.
+constexpr std::uint64_t kMagicMasks = 0x31444E4143'5441ull;
+constexpr std::uint64_t kMagic = 0x32444E4143'5441ull;
 
 struct Header {
     std::uint64_t magic;
     std::uint32_t points, set_bits;
     std::uint64_t domain, occupied;
     std::uint32_t sets, pad;
-    std::uint64_t reserved[3];
+    std::uint64_t list_total;  // CAND2: entries of all part lists together (0 in CAND1)
+    std::uint64_t reserved[2];
 };
 static_assert(sizeof(Header) == 64);
 
-
 struct Sections {
-    std::uint64_t occ, counts, ids, masks, total;
+    std::uint64_t occ, counts, ids, sets, parts, total;  // CAND1: sets holds the masks
 };
 
-Sections sections(std::uint64_t domain, std::uint64_t occupied, std::uint32_t set_bits, std::uint32_t sets) {
+std::uint64_t padded8(std::uint64_t bytes) { return (bytes + 7) / 8 * 8; }
+
+Sections sections(const Header& h) {
     Sections s{};
-    const std::uint64_t nwords = words_for_bits(domain);
+    const std::uint64_t nwords = words_for_bits(h.domain);
     s.occ = sizeof(Header);
     s.counts = s.occ + nwords * 8;
-    s.ids = s.counts + (RankIndex::count_entries(nwords) * 4 + 7) / 8 * 8;
-    s.masks = s.ids + (words_for_bits(occupied * set_bits) + 1) * 8;
-    s.total = s.masks + static_cast<std::uint64_t>(sets) * 8;
+    s.ids = s.counts + padded8(RankIndex::count_entries(nwords) * 4);
+    s.sets = s.ids + (words_for_bits(h.occupied * h.set_bits) + 1) * 8;
+    if (h.magic == kMagicMasks) {
+        s.parts = s.total = s.sets + static_cast<std::uint64_t>(h.sets) * 8;
+    } else {
+        s.parts = s.sets + padded8((static_cast<std::uint64_t>(h.sets) + 1) * 4);
+        s.total = s.parts + padded8(h.list_total * 4);
+    }
     return s;
 }
 
@@ -109,24 +119,30 @@ std::vector<Part> parts_of(const Shape& shape, double cell) {
 }
 
 struct Scratch {
-    std::vector<std::uint64_t> mask;  // per face point
+    std::vector<std::vector<std::uint32_t>> parts;  // per face point: its parts, ascending
     std::vector<std::size_t> touched;
 };
 
+// A pair's part list, kept in its block's pool.
 struct Found {
-    std::uint64_t pair, mask;
+    std::uint64_t pair;
+    std::uint32_t first, count;
+};
+struct Block {
+    std::vector<Found> found;
+    std::vector<std::uint32_t> pool;
+    std::string_view list(const Found& f) const {
+        return {reinterpret_cast<const char*>(pool.data() + f.first), f.count * sizeof(std::uint32_t)};
+    }
 };
 
-}  // namespace
-
-ByteBuffer CandidatesTable::build(const TableContext& ctx, bool progress) {
-    if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
+// What the rasterizer does for hits, for reach: per block of entry points, the pairs (a, b > a,
+// and a with itself) and the parts within kSnapReach of the segment a b.
+std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& grid, bool progress) {
     const Shape& shape = *ctx.primitive;
-    if (shape.primitive_count() > kMaxParts)
-        throw std::runtime_error("candidates: the primitive has more than 64 parts");
-    const BoundaryGrid grid(ctx.cells);
     const std::vector<Part> parts = parts_of(shape, ctx.cell);
-    // Culling spheres, grown by the reach, grouped by part.
+    // Culling spheres, grown by the reach, grouped by part in ascending order: each face point's
+    // list is then built sorted, and a part already in it is its last entry.
     std::vector<PartSphere> cull;
     for (std::size_t i = 0; i < parts.size(); ++i) {
         std::vector<BoundingSphere> bs;
@@ -141,73 +157,99 @@ ByteBuffer CandidatesTable::build(const TableContext& ctx, bool progress) {
     const std::uint32_t npoints = grid.count();
     constexpr std::uint32_t kBlock = 32;
     const std::uint32_t nblocks = (npoints + kBlock - 1) / kBlock;
-    std::vector<std::vector<Found>> found(nblocks);
+    std::vector<Block> blocks(nblocks);
     tbb::enumerable_thread_specific<Scratch> scratch;
     ProgressBar bar("candidates", npoints, progress);
     tbb::parallel_for(std::uint32_t{0}, nblocks, [&](std::uint32_t blk) {
         Scratch& s = scratch.local();
-        std::vector<Found>& out = found[blk];
+        Block& out = blocks[blk];
+        auto emit = [&](std::uint64_t pair, const std::vector<std::uint32_t>& list) {
+            out.found.push_back({pair, static_cast<std::uint32_t>(out.pool.size()),
+                                 static_cast<std::uint32_t>(list.size())});
+            out.pool.insert(out.pool.end(), list.begin(), list.end());
+        };
+        std::vector<std::uint32_t> self;
         for (std::uint32_t a = blk * kBlock; a < std::min(npoints, (blk + 1) * kBlock); ++a) {
             const GridPoint ga = grid.point(a);
             const std::uint8_t fa = grid.faces(ga);
             const Vec3 p = to_vec(ga);
             // The pair of a point with itself: parts within reach of the point.
-            std::uint64_t self = 0;
+            self.clear();
             for (std::size_t i = 0; i < parts.size(); ++i)
-                if (parts[i].near(p, p, kSnapReach)) self |= std::uint64_t{1} << i;
-            if (self) out.push_back({pair_index(a, a), self});
+                if (parts[i].near(p, p, kSnapReach)) self.push_back(static_cast<std::uint32_t>(i));
+            if (!self.empty()) emit(CandidatesTable::pair_index(a, a), self);
             for (const FaceLayout& fl : faces) {
-                if (s.mask.size() < fl.mask.size()) s.mask.assign(fl.mask.size(), 0);
+                if (s.parts.size() < fl.mask.size()) s.parts.resize(fl.mask.size());
                 for (const PartSphere& ps : cull) {
-                    const std::uint64_t bit = std::uint64_t{1} << ps.part;
                     for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
-                        if (fl.ids[k] <= a || (s.mask[k] & bit)) return;
+                        std::vector<std::uint32_t>& l = s.parts[k];
+                        if (fl.ids[k] <= a || (!l.empty() && l.back() == ps.part)) return;
                         if (!BoundaryGrid::valid_pair(fa, fl.mask[k])) return;
                         if (!parts[ps.part].near(p, q, kSnapReach)) return;
-                        if (!s.mask[k]) s.touched.push_back(k);
-                        s.mask[k] |= bit;
+                        if (l.empty()) s.touched.push_back(k);
+                        l.push_back(ps.part);
                     });
                 }
                 for (const std::size_t k : s.touched) {
-                    out.push_back({pair_index(a, fl.ids[k]), s.mask[k]});
-                    s.mask[k] = 0;
+                    emit(CandidatesTable::pair_index(a, fl.ids[k]), s.parts[k]);
+                    s.parts[k].clear();
                 }
                 s.touched.clear();
             }
         }
-        std::sort(out.begin(), out.end(), [](const Found& x, const Found& y) { return x.pair < y.pair; });
+        std::sort(out.found.begin(), out.found.end(),
+                  [](const Found& x, const Found& y) { return x.pair < y.pair; });
         bar.add(std::min(npoints, (blk + 1) * kBlock) - blk * kBlock);
     });
     bar.finish();
+    return blocks;
+}
 
-    // Distinct part sets, numbered in first-seen order (deterministic).
-    std::unordered_map<std::uint64_t, std::uint32_t> set_id;
-    std::vector<std::uint64_t> sets;
+}  // namespace
+
+ByteBuffer CandidatesTable::build(const TableContext& ctx, bool progress) {
+    if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
+    if (ctx.primitive->primitive_count() > 0xFFFFFFFFull)
+        throw std::runtime_error("candidates: the primitive has more than 2^32 parts");
+    const BoundaryGrid grid(ctx.cells);
+    const std::vector<Block> blocks = find_candidates(ctx, grid, progress);
+
+    // Distinct part lists, numbered in first-seen order (deterministic), each stored once.
+    std::unordered_map<std::string_view, std::uint32_t> set_id;
+    std::vector<std::uint32_t> offsets{0}, lists;
     std::uint64_t occupied = 0;
-    for (const auto& block : found)
-        for (const Found& f : block) {
+    for (const Block& block : blocks)
+        for (const Found& f : block.found) {
             ++occupied;
-            if (set_id.emplace(f.mask, std::uint32_t(sets.size())).second) sets.push_back(f.mask);
+            if (!set_id.emplace(block.list(f), static_cast<std::uint32_t>(offsets.size() - 1)).second)
+                continue;
+            lists.insert(lists.end(), block.pool.begin() + f.first, block.pool.begin() + f.first + f.count);
+            if (lists.size() > 0xFFFFFFFFull) throw std::runtime_error("candidates: part lists too long");
+            offsets.push_back(static_cast<std::uint32_t>(lists.size()));
         }
+    const auto nsets = static_cast<std::uint32_t>(offsets.size() - 1);
     std::uint32_t set_bits = 0;
-    while ((1ull << set_bits) < sets.size()) ++set_bits;
-    const std::uint64_t domain = static_cast<std::uint64_t>(npoints) * (npoints + 1) / 2;
-    const std::uint64_t nwords = words_for_bits(domain);
-    const Sections sec = sections(domain, occupied, set_bits, std::uint32_t(sets.size()));
+    while ((1ull << set_bits) < nsets) ++set_bits;
+    const std::uint32_t npoints = grid.count();
+    const Header h{kMagic, npoints, set_bits, static_cast<std::uint64_t>(npoints) * (npoints + 1) / 2,
+                   occupied, nsets, 0, lists.size(), {0, 0}};
+    const Sections sec = sections(h);
     ByteBuffer payload(sec.total);
     std::memset(payload.data(), 0, sec.total);
     auto* occ = reinterpret_cast<std::uint64_t*>(payload.data() + sec.occ);
-    for (const auto& block : found)
-        for (const Found& f : block) occ[f.pair >> 6] |= std::uint64_t{1} << (f.pair & 63);
+    for (const Block& block : blocks)
+        for (const Found& f : block.found) occ[f.pair >> 6] |= std::uint64_t{1} << (f.pair & 63);
     auto* counts = reinterpret_cast<std::uint32_t*>(payload.data() + sec.counts);
+    const std::uint64_t nwords = words_for_bits(h.domain);
     RankIndex::build(occ, nwords, counts);
     const RankIndex rank(occ, counts);
     auto* ids = reinterpret_cast<std::uint64_t*>(payload.data() + sec.ids);
     if (set_bits)
-        for (const auto& block : found)
-            for (const Found& f : block) write_bits(ids, rank.rank(f.pair) * set_bits, set_bits, set_id[f.mask]);
-    std::memcpy(payload.data() + sec.masks, sets.data(), sets.size() * 8);
-    const Header h{kMagic, npoints, set_bits, domain, occupied, std::uint32_t(sets.size()), 0, {0, 0, 0}};
+        for (const Block& block : blocks)
+            for (const Found& f : block.found)
+                write_bits(ids, rank.rank(f.pair) * set_bits, set_bits, set_id.at(block.list(f)));
+    std::memcpy(payload.data() + sec.sets, offsets.data(), offsets.size() * 4);
+    std::memcpy(payload.data() + sec.parts, lists.data(), lists.size() * 4);
     std::memcpy(payload.data(), &h, sizeof h);
     return payload;
 }
@@ -219,13 +261,13 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
     if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
     Header h;
     std::memcpy(&h, payload, sizeof h);
-    if (h.magic != kMagic) throw std::runtime_error("candidates: bad payload tag");
+    if (h.magic != kMagic && h.magic != kMagicMasks) throw std::runtime_error("candidates: bad payload tag");
     points_ = h.points, set_bits_ = h.set_bits, sets_ = h.sets, occupied_ = h.occupied;
     if (points_ != grid_.count() || h.domain != std::uint64_t(points_) * (points_ + 1) / 2 ||
         set_bits_ > 32 || (sets_ > 1 && (1ull << set_bits_) < sets_) || occupied_ > h.domain ||
-        sets_ > occupied_ + 1)
+        sets_ > occupied_ + 1 || (h.magic == kMagic && h.list_total > 0xFFFFFFFFull))
         throw std::runtime_error("candidates: inconsistent layout");
-    const Sections sec = sections(h.domain, h.occupied, h.set_bits, h.sets);
+    const Sections sec = sections(h);
     if (sec.total != size) throw std::runtime_error("candidates: payload size does not match its layout");
     const std::uint64_t nwords = words_for_bits(h.domain);
     const auto* counts = reinterpret_cast<const std::uint32_t*>(payload + sec.counts);
@@ -234,11 +276,42 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
         throw std::runtime_error("candidates: rank directory does not match its occupancy bits");
     rank_ = RankIndex(occ, counts);
     ids_ = reinterpret_cast<const std::uint64_t*>(payload + sec.ids);
-    masks_ = reinterpret_cast<const std::uint64_t*>(payload + sec.masks);
-    const std::uint64_t nparts = ctx.primitive->primitive_count();
-    for (std::uint32_t i = 0; i < sets_; ++i)
-        if (nparts < 64 && (masks_[i] >> nparts) != 0)
-            throw std::runtime_error("candidates: a part set names parts the primitive does not have");
+    if (h.magic == kMagicMasks) {
+        lists_from_masks(reinterpret_cast<const std::uint64_t*>(payload + sec.sets));
+    } else {
+        offsets_ = reinterpret_cast<const std::uint32_t*>(payload + sec.sets);
+        parts_ = reinterpret_cast<const std::uint32_t*>(payload + sec.parts);
+    }
+    check_lists(h.magic == kMagic ? h.list_total : converted_.size() - (sets_ + 1));
+}
+
+// CAND1: each 64-bit mask becomes the list of its set bits, kept in converted_ (offsets first,
+// then the parts) so that lookups read both formats alike.
+void CandidatesTable::lists_from_masks(const std::uint64_t* masks) {
+    std::vector<std::uint32_t> offsets{0}, parts;
+    for (std::uint32_t i = 0; i < sets_; ++i) {
+        for (std::uint64_t m = masks[i]; m; m &= m - 1)
+            parts.push_back(static_cast<std::uint32_t>(std::countr_zero(m)));
+        offsets.push_back(static_cast<std::uint32_t>(parts.size()));
+    }
+    converted_ = std::move(offsets);
+    converted_.insert(converted_.end(), parts.begin(), parts.end());
+    offsets_ = converted_.data();
+    parts_ = converted_.data() + sets_ + 1;
+}
+
+// Every list lies within the index array, ascending, and names parts the primitive has.
+void CandidatesTable::check_lists(std::uint64_t total) const {
+    const std::uint64_t nparts = ctx_.primitive->primitive_count();
+    if (offsets_[0] != 0 || offsets_[sets_] != total)
+        throw std::runtime_error("candidates: part list offsets do not match their count");
+    for (std::uint32_t i = 0; i < sets_; ++i) {
+        if (offsets_[i] > offsets_[i + 1])
+            throw std::runtime_error("candidates: part list offsets out of order");
+        for (std::uint32_t k = offsets_[i]; k < offsets_[i + 1]; ++k)
+            if (parts_[k] >= nparts || (k > offsets_[i] && parts_[k] <= parts_[k - 1]))
+                throw std::runtime_error("candidates: a part set names parts the primitive does not have");
+    }
 }
 
 std::string CandidatesTable::details() const {
@@ -254,12 +327,8 @@ bool CandidatesTable::candidates(std::uint32_t a, std::uint32_t b, CandidateList
     if (!rank_.test(i)) return false;
     const std::uint64_t id = set_bits_ ? read_bits(ids_, rank_.rank(i) * set_bits_, set_bits_) : 0;
     if (id >= sets_) return false;  // corrupt
-    std::uint64_t m = masks_[id];
-    out.count = 0;
-    while (m) {
-        out.parts[out.count++] = static_cast<std::uint32_t>(std::countr_zero(m));
-        m &= m - 1;
-    }
+    out.parts = parts_ + offsets_[id];
+    out.count = static_cast<int>(offsets_[id + 1] - offsets_[id]);
     return true;
 }
 

@@ -1,0 +1,79 @@
+// lattice/part_boxes.h: the float box test never rejects a part whose exact box the ray meets
+// in the range asked (what keeps candidates images identical to exact mode), from near and
+// from far, along axes and grazing box corners.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "lattice/part_boxes.h"
+
+namespace lat {
+namespace {
+
+// A primitive of boxes only: PartBoxes asks for nothing else.
+class Boxes final : public Shape {
+public:
+    std::vector<Bounds3> parts;
+    Bounds3 bounds() const override { return {{0, 0, 0}, {7, 7, 20}}; }
+    bool intersect(const Ray&, double, double, Crossing&) const override { return false; }
+    void spans(const Ray&, SpanList&) const override {}
+    Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
+    bool inside(Vec3) const override { return false; }
+    using Shape::primitive_bounds;
+    std::size_t primitive_count() const override { return parts.size(); }
+    Bounds3 primitive_bounds(std::size_t i) const override { return parts[i]; }
+};
+
+// The exact answer, in long double, on the unpadded box.
+bool meets_exact(const Bounds3& b, const Ray& r, double tmin, double tmax) {
+    long double lo = tmin, hi = tmax;
+    for (std::size_t k = 0; k < 3; ++k) {
+        const long double o = r.o[k], d = r.d[k];
+        if (d == 0) {
+            if (o < b.lo[k] || o > b.hi[k]) return false;
+            continue;
+        }
+        const long double t0 = (b.lo[k] - o) / d, t1 = (b.hi[k] - o) / d;
+        lo = std::max(lo, std::min(t0, t1));
+        hi = std::min(hi, std::max(t0, t1));
+    }
+    return lo <= hi;
+}
+
+TEST(PartBoxes, FloatTestNeverRejectsAPartTheRayMeets) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    Boxes prim;
+    for (int i = 0; i < 200; ++i) {
+        const Vec3 c{7 * u(rng), 7 * u(rng), 20 * u(rng)};
+        const Vec3 h{0.3 * u(rng), 0.3 * u(rng), 1.5 * u(rng)};
+        prim.parts.push_back(lat::intersect(Bounds3{c - h, c + h}, prim.bounds()));
+    }
+    const PartBoxes boxes(prim, prim.bounds());
+    int met = 0;
+    for (int n = 0; n < 20000; ++n) {
+        const Bounds3& target = prim.parts[static_cast<std::size_t>(n) % prim.parts.size()];
+        // Aim at a corner of a part (grazing) or inside it, from 1 to 1e5 units away.
+        Vec3 p = target.lo + (target.hi - target.lo) * Vec3{u(rng), u(rng), u(rng)};
+        if (n % 3 == 0) p = target.hi;
+        Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+        if (n % 7 == 0) d = {0, 0, 1};  // along an axis: the double fallback
+        const double dist = std::pow(10.0, 5 * u(rng));
+        const double scale = 0.01 + 10 * u(rng);  // instance scaling lengthens or shortens d
+        const Ray r{p - d * dist, d * scale};
+        const double t_hit = dist / scale;
+        const double tmin = n % 2 ? 0.0 : t_hit * u(rng),
+                     tmax = n % 5 ? kInfinity : t_hit * (1 + u(rng));
+        const PartBoxes::Ray4 q(boxes, r);
+        const PartBoxes::Ray4::Range range = q.range(tmin, tmax);
+        for (std::uint32_t i = 0; i < prim.parts.size(); ++i)
+            if (meets_exact(prim.parts[i], r, tmin, tmax)) {
+                ++met;
+                ASSERT_TRUE(q.meets(i, range)) << "ray " << n << " part " << i;
+            }
+    }
+    EXPECT_GT(met, 20000);
+}
+
+}  // namespace
+}  // namespace lat
