@@ -2,12 +2,16 @@
 // every field is range-checked and consistent with the others before anything is sized by it.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <cstring>
 #include <limits>
 
 #include "geometry/chain.h"
 #include "lattice/boundary_grid.h"
+#include "lattice/cache/table_cache.h"
 #include "lattice/encoding.h"
 #include "lattice/rasterizer.h"
 #include "lattice/table_file.h"
@@ -111,6 +115,23 @@ TEST_F(ForgedHeader, MetadataMustDescribeThePrimitive) {
         }
         EXPECT_NE(e.find(path + ": the table's metadata"), std::string::npos) << meta << ": " << e;
     }
+}
+
+// A killed table build leaves its temporary behind; the next run that opens the cache removes
+// it once it is old enough that no live writer can own it, and leaves fresh ones alone.
+TEST(TableCacheTest, StaleTemporariesAreRemoved) {
+    test::TempDir dir;
+    const auto old_one = dir.path() / "hair-s1-hash14-0123456789abcdef.lht.tmp-AbC123";
+    const auto fresh = dir.path() / "hair-s1-dense-0123456789abcdef.lht.tmp-XyZ789";
+    const auto other = dir.path() / "notes.tmp-old";
+    for (const auto& p : {old_one, fresh, other}) std::ofstream(p) << "partial";
+    const auto long_ago = std::filesystem::file_time_type::clock::now() - std::chrono::hours(2);
+    std::filesystem::last_write_time(old_one, long_ago);
+    std::filesystem::last_write_time(other, long_ago);
+    const TableCache cache(dir.path().string(), true);
+    EXPECT_FALSE(std::filesystem::exists(old_one));
+    EXPECT_TRUE(std::filesystem::exists(fresh));
+    EXPECT_TRUE(std::filesystem::exists(other));  // not ours
 }
 
 }  // namespace

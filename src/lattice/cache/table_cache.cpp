@@ -40,6 +40,21 @@ TableCache::TableCache(const std::string& dir, bool explicit_dir) : dir_(dir) {
     if (::access(dir_.c_str(), R_OK | W_OK | X_OK) != 0)
         throw InputError(dir_ + ": lattice cache directory is not readable and writable: " +
                          std::strerror(errno));
+    remove_stale_temporaries();
+}
+
+// A table is written whole into TARGET.tmp-XXXXXX and renamed (util/atomic_file.h), which takes
+// seconds; one untouched for kStaleTemporary was left by a process that was killed, and no
+// writer can still own it, so it is removed. Failures are ignored: another run may race us.
+void TableCache::remove_stale_temporaries() const {
+    std::error_code ec;
+    const auto now = std::filesystem::file_time_type::clock::now();
+    for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
+        const std::string name = entry.path().filename().string();
+        if (name.find(".lht.tmp-") == std::string::npos || !entry.is_regular_file(ec)) continue;
+        const auto modified = entry.last_write_time(ec);
+        if (!ec && now - modified > kStaleTemporary) std::filesystem::remove(entry.path(), ec);
+    }
 }
 
 std::string TableCache::path_for(const TablePlan& plan) const {

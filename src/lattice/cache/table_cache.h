@@ -1,6 +1,7 @@
 #pragma once
 // The on-disk cache of lattice tables that `render` uses, so that a lattice-mode render builds
 // each table once and then reuses it. A table's file name carries its plan's fingerprint.
+#include <chrono>
 #include <memory>
 #include <string>
 
@@ -31,8 +32,13 @@ public:
     // Loads the cached table, or builds and caches it.
     Entry get(const TablePlan& plan, bool progress) const;
 
+    // Temporaries of killed table writes older than this are removed when a cache is opened.
+    static constexpr std::chrono::minutes kStaleTemporary{10};
+
 private:
     std::string dir_;
+
+    void remove_stale_temporaries() const;
 };
 
 }  // namespace lat
