@@ -73,9 +73,10 @@ float float_above(double t) {
 // extreme transform or polynomial); it must never reach rtcIntersect1 or rtcOccluded1.
 bool embree_can_trace(const Ray& r, double tmin, double tmax) {
     constexpr double kLarge = 1.8e18;  // just below Embree's FLT_LARGE
-    const bool o = std::abs(r.o.x) < kLarge && std::abs(r.o.y) < kLarge && std::abs(r.o.z) < kLarge;
-    const bool d = std::abs(r.d.x) < kLarge && std::abs(r.d.y) < kLarge && std::abs(r.d.z) < kLarge;
-    return o && d && std::abs(tmin) < kLarge && !std::isnan(tmax);
+    // Comparisons with NaN are false, so NaN fails too; `&` keeps it one branch per ray.
+    return (std::abs(r.o.x) < kLarge) & (std::abs(r.o.y) < kLarge) & (std::abs(r.o.z) < kLarge) &
+           (std::abs(r.d.x) < kLarge) & (std::abs(r.d.y) < kLarge) & (std::abs(r.d.z) < kLarge) &
+           (std::abs(tmin) < kLarge) & !std::isnan(tmax);
 }
 
 // Embree drops primitives whose float bounds are not finite or exceed FLT_LARGE; objects that
@@ -336,11 +337,13 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
 EmbreeAccel::~EmbreeAccel() = default;
 
 bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hit) const {
-    if (!ray_is_finite(r, tmin, tmax)) return false;
+    // Every traceable ray is finite: the second test is only for the rare huge one.
+    const bool traceable = embree_can_trace(r, tmin, tmax);
+    if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, hit);
 
-    if (embree_can_trace(r, tmin, tmax)) {
+    if (traceable) {
         alignas(16) RTCRayHit rh;
         set_rtc_ray(rh.ray, r, tmin, tmax);
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -361,7 +364,8 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 }
 
 bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t self) const {
-    if (!ray_is_finite(r, tmin, tmax)) return false;
+    const bool traceable = embree_can_trace(r, tmin, tmax);
+    if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     AccelHit unused;
     QueryContext ctx(m, r, tmin, tmax, unused);
@@ -372,7 +376,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
         if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) return true;
     }
 
-    if (!embree_can_trace(r, tmin, tmax)) return false;
+    if (!traceable) return false;
     alignas(16) RTCRay ray;
     set_rtc_ray(ray, r, tmin, tmax);
     rtcOccluded1(m.scene, &ctx.rtc, &ray);
