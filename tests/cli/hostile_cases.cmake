@@ -1,15 +1,7 @@
 # Hostile-input and interruption scenarios (issue 11) that need files generated or several
 # processes; -DCASE=... picks one.
 #   cmake -DLATTICE=path/to/lattice -DDATA=tests/data/bad -DWORK=dir -DCASE=name -P hostile_cases.cmake
-function(run expect_code pattern)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT code EQUAL expect_code)
-    message(FATAL_ERROR "${ARGN}\nexit code ${code}, expected ${expect_code}\n${out}\n${err}")
-  endif()
-  if(pattern AND NOT err MATCHES "${pattern}")
-    message(FATAL_ERROR "${ARGN}\nstderr does not match '${pattern}':\n${err}")
-  endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/run.cmake)
 
 # Fails if anything but the listed names is in WORK (e.g. a *.tmp-* left behind).
 function(expect_only)

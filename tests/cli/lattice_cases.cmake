@@ -1,14 +1,6 @@
 # Lattice-table scenarios that need files prepared first; -DCASE=... picks one.
 #   cmake -DLATTICE=path/to/lattice -DEXAMPLES=dir -DWORK=dir -DCASE=name -P lattice_cases.cmake
-function(run expect_code pattern)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT code EQUAL expect_code)
-    message(FATAL_ERROR "${ARGN}\nexit code ${code}, expected ${expect_code}\n${out}\n${err}")
-  endif()
-  if(pattern AND NOT err MATCHES "${pattern}")
-    message(FATAL_ERROR "${ARGN}\nstderr does not match '${pattern}':\n${err}")
-  endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/run.cmake)
 
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
