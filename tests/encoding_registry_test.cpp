@@ -68,6 +68,13 @@ std::string load_error(const std::string& path) {
     return "(no error)";
 }
 
+// The table's answer for a pair, whichever its kind: a hit, or the candidate parts.
+bool answer(const LatticeTable& t, std::uint32_t a, std::uint32_t b, TableHit& hit,
+            CandidateList& list) {
+    return t.kind() == LatticeTable::Kind::kCandidates ? t.candidates(a, b, list)
+                                                       : t.lookup(a, b, hit);
+}
+
 class EveryEncoding : public ::testing::TestWithParam<const Encoding*> {};
 
 TEST_P(EveryEncoding, IsFoundByItsNameOnly) {
@@ -120,10 +127,7 @@ TEST_P(EveryEncoding, RoundTripsThroughATableFile) {
         for (std::uint32_t c = 0; c < grid.count(); c += 5) {
             TableHit x, y;
             CandidateList cx, cy;
-            const bool hx = e.kind == LatticeTable::Kind::kCandidates ? b.table->candidates(a, c, cx)
-                                                                      : b.table->lookup(a, c, x);
-            const bool hy = e.kind == LatticeTable::Kind::kCandidates ? t.table->candidates(a, c, cy)
-                                                                      : t.table->lookup(a, c, y);
+            const bool hx = answer(*b.table, a, c, x, cx), hy = answer(*t.table, a, c, y, cy);
             ASSERT_EQ(hx, hy) << a << " " << c;
             EXPECT_EQ(x.t, y.t);
             EXPECT_EQ(x.normal, y.normal);
@@ -187,15 +191,11 @@ TEST_P(EveryEncoding, ForgedPayloadsAreRefusedOrSafe) {
                 for (std::uint32_t y = 0; y < grid.count(); y += 11) {
                     TableHit hit;
                     CandidateList list;
-                    if (e.kind == LatticeTable::Kind::kCandidates) {
-                        if (t.table->candidates(x, y, list)) {
-                            ASSERT_LE(static_cast<std::size_t>(list.count), hook().primitive_count());
-                            for (int k = 0; k < list.count; ++k)
-                                ASSERT_LT(list.parts[k], hook().primitive_count());
-                        }
-                    } else if (t.table->lookup(x, y, hit)) {
-                        ASSERT_TRUE(std::isfinite(hit.t) && std::isfinite(hit.normal.x)) << at;
-                    }
+                    if (!answer(*t.table, x, y, hit, list)) continue;
+                    ASSERT_LE(static_cast<std::size_t>(list.count), hook().primitive_count());
+                    for (int k = 0; k < list.count; ++k)
+                        ASSERT_LT(list.parts[k], hook().primitive_count());
+                    ASSERT_TRUE(std::isfinite(hit.t) && std::isfinite(hit.normal.x)) << at;
                 }
         }
     }

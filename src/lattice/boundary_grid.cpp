@@ -50,6 +50,13 @@ std::uint64_t BoundaryGrid::pairs_eq2() const {
     return 8 * (xy * yz + yz * zx + zx * xy) + 2 * (xy * xy + yz * yz + zx * zx);
 }
 
+bool BoundaryGrid::indexable(const std::array<int, 3>& cells) {
+    const long double nx = cells[0], ny = cells[1], nz = cells[2];
+    // An upper bound on the points (edges counted twice), in floating point: no overflow.
+    return 2 * ((nx + 1) * (ny + 1) + (ny + 1) * (nz + 1) + (nz + 1) * (nx + 1)) <
+           static_cast<long double>(0xFFFFFFFFu);
+}
+
 long double BoundaryGrid::pair_count(const std::array<int, 3>& cells) {
     const long double nx = cells[0], ny = cells[1], nz = cells[2];
     const long double yz = (ny + 1) * (nz + 1), zx = (nz + 1) * (nx + 1), xy = (nx + 1) * (ny + 1);

@@ -51,6 +51,9 @@ public:
     std::uint64_t pairs_eq2() const;
     // The same for any cells, in floating point, so that absurd lattices cannot overflow it.
     static long double pair_count(const std::array<int, 3>& cells);
+    // Whether ids of the lattice's boundary points fit in 32 bits (a grid can be built), for any
+    // cells; positive cells assumed.
+    static bool indexable(const std::array<int, 3>& cells);
 
     // A pair of boundary points can carry a ray through the lattice only if they are on
     // different faces: not both on the same single face.

@@ -84,8 +84,7 @@ std::string lattice_error(const TableHeader& h) {
     for (const int c : h.cells)
         if (c < 1 || c % h.sigma_inv != 0)
             return "the cells must be positive multiples of sigma^-1";
-    const long double nx = h.cells[0], ny = h.cells[1], nz = h.cells[2];
-    if (2 * ((nx + 1) * (ny + 1) + (ny + 1) * (nz + 1) + (nz + 1) * (nx + 1)) >= 0xFFFFFFFFu)
+    if (!BoundaryGrid::indexable(h.cells))
         return "the lattice has too many boundary points to index";
     if (BoundaryGrid::pair_count(h.cells) != static_cast<long double>(h.pairs))
         return "N_lp does not match the cells";

@@ -58,10 +58,7 @@ long double pair_count(const TableHeader& h) {
 
 void check_points(const TablePlan& plan) {
     const TableHeader& h = plan.header;
-    const long double nx = h.cells[0], ny = h.cells[1], nz = h.cells[2];
-    // An upper bound (edges counted twice).
-    const long double points = 2 * ((nx + 1) * (ny + 1) + (ny + 1) * (nz + 1) + (nz + 1) * (nx + 1));
-    if (points >= static_cast<long double>(0xFFFFFFFFu))
+    if (!BoundaryGrid::indexable(h.cells))
         throw InputError(plan.place + "a lattice of " + lattice_size(h) +
                          " has too many boundary points to index");
     const std::uint64_t count = BoundaryGrid(h.cells).count();
