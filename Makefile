@@ -3,7 +3,9 @@
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
-DEMO_SCENE ?= examples/torus-bite.json
+# The demo is the product's point: fur grown over a scanned mesh, traced through lattices.
+DEMO_SCENE ?= examples/furry-bunny.json
+DEMO_FLAGS ?= --mode lattice
 DEMO_OUT ?= out/demo.png
 
 # Sanitizer build (`make test-sanitize`): its own directory; SANITIZE_TESTS passes ctest a
@@ -62,7 +64,7 @@ build: configure
 
 demo: build
 	@mkdir -p $(dir $(DEMO_OUT))
-	@$(BUILD_DIR)/bin/lattice render $(DEMO_SCENE) -o $(DEMO_OUT)
+	@$(BUILD_DIR)/bin/lattice render $(DEMO_SCENE) $(DEMO_FLAGS) -o $(DEMO_OUT)
 	@echo "demo image: $(abspath $(DEMO_OUT))"
 
 test: build

@@ -13,6 +13,8 @@
 #include "render/renderer.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
+#include "test_paths.h"
+#include "io/image.h"
 #include "util/hash.h"
 
 namespace lat {
@@ -237,6 +239,19 @@ TEST(Scatter, BadParametersAreInputErrors) {
                   .find("objects[0].box: the box holds none of the surface"), std::string::npos);
     EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5, "material": "fur", "on": 3})")
                   .find("objects[0].on: object index 3 does not exist"), std::string::npos);
+}
+
+TEST(Scatter, CommandWritesExplicitInstancesThatRenderTheSameImage) {
+    const test::TempDir dir;
+    const std::string scene = test::source_path("tests/data/bad/scatter-mesh-good.json");
+    const std::string placed = dir.file("placed.json");
+    const std::string cmd = test::lattice_binary() + " scatter " + scene + " -o " + placed + " > /dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const Scene a = load_scene(scene), b = load_scene(placed);
+    ASSERT_EQ(a.objects.size(), b.objects.size());
+    EXPECT_TRUE(b.scatters.empty());
+    EXPECT_EQ(placement_hash(a), placement_hash(b));  // the mesh path was moved to stay found
+    EXPECT_EQ(render_image(RenderScene(a), {}).display.rgb, render_image(RenderScene(b), {}).display.rgb);
 }
 
 }  // namespace

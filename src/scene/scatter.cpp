@@ -187,8 +187,10 @@ Transform placement(const SurfaceSample& s, const ScatterParams& p, Vec3 root, C
     const Vec3 y = cross(z, x);
     const double k = p.scale_lo + (p.scale_hi - p.scale_lo) * rng.uniform();
     Affine a;
-    for (std::size_t r = 0; r < 3; ++r) a.m.r[r] = Vec3{x[r], y[r], z[r]} * k;
-    a.t = s.p - a.m * root;
+    // Adding +0 turns -0 into 0: JSON writers drop the sign of zero, and `lattice scatter`
+    // must write matrices that read back bit for bit.
+    for (std::size_t r = 0; r < 3; ++r) a.m.r[r] = Vec3{x[r], y[r], z[r]} * k + Vec3{0, 0, 0};
+    a.t = s.p - a.m * root + Vec3{0, 0, 0};
     return *Transform::from_affine(a);  // a rotation times k > 0: never singular
 }
 
