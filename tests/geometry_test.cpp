@@ -7,6 +7,7 @@
 #include "geometry/capped_cylinder.h"
 #include "geometry/chain.h"
 #include "geometry/halfspace.h"
+#include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
 #include "math/transform.h"
 
@@ -205,6 +206,37 @@ TEST(Capsule, ChainCapsulesHoldTheirPartsAndJointSpheresAreContained) {
     EXPECT_TRUE(cyl.contains(joint));
     EXPECT_FALSE(thin.contains(joint));
     EXPECT_TRUE(joint.contains(joint));
+}
+
+// A placed torus is bounded by its exact extent (ring + ball support), under rotations and
+// non-uniform scales: it holds every surface point and is touched by them on every side.
+TEST(Torus, PlacedBoundsAreExact) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int k = 0; k < 20; ++k) {
+        const PlacedShape t = make_torus({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng) + 1.5},
+                                         3.0, 0.35);
+        const Transform user = Transform::translate({u(rng), u(rng), u(rng)}) *
+                               Transform::rotate({u(rng), u(rng), 1.0}, 3 * u(rng)) *
+                               Transform::scale({1.2 + u(rng), 1.2 + u(rng), 1.2 + u(rng)});
+        const Transform xf = user * t.placement;
+        const Bounds3 b = t.shape->placed_bounds(xf);
+        Bounds3 seen;
+        for (int i = 0; i < 400; ++i)
+            for (int j = 0; j < 100; ++j) {
+                const double a = 2 * M_PI * i / 400, v = 2 * M_PI * j / 100;
+                const double ring = 3.0 + 0.35 * std::cos(v);
+                const Vec3 p = xf.point({ring * std::cos(a), ring * std::sin(a), 0.35 * std::sin(v)});
+                seen = merge(seen, Bounds3{p, p});
+            }
+        const double scale = max_component(b.extent());
+        for (std::size_t axis = 0; axis < 3; ++axis) {
+            EXPECT_LE(b.lo[axis], seen.lo[axis] + 1e-9) << k;
+            EXPECT_GE(b.hi[axis], seen.hi[axis] - 1e-9) << k;
+            EXPECT_NEAR(b.lo[axis], seen.lo[axis], 2e-3 * scale) << k;
+            EXPECT_NEAR(b.hi[axis], seen.hi[axis], 2e-3 * scale) << k;
+        }
+    }
 }
 
 }  // namespace

@@ -303,7 +303,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
 
     for (std::uint32_t i = 0; i < m.objects.size(); ++i) {
         const AccelObject& o = m.objects[i];
-        const Bounds3 wb = o.xf->bounds(o.shape->bounds());
+        const Bounds3 wb = o.shape->placed_bounds(*o.xf);
         if (wb.empty()) continue;
         if (!embree_can_hold(wb)) {
             m.unbounded.push_back(i);
