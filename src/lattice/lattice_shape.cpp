@@ -22,90 +22,111 @@ LatticeFrame::LatticeFrame(const TableContext& ctx, double reach)
       inv_cell_(1.0 / ctx.cell),
       box_{{0, 0, 0},
            Vec3{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])} * ctx.cell} {
-    if (!make_cull_capsules(ctx.primitive, reach)) make_cull_boxes(ctx.primitive, reach);
+    make_cull_parts(ctx.primitive, reach);
 }
 
-// Every answer's ray point lies within the reach of the primitive, so rays whose lines keep
-// farther than that from every part lose nothing (images are identical). A capsule around
-// each part grown by the reach tests that with a few dot products, before any snapping, and
-// rejects most of the rays that only graze a part's box: on the fur plates four in five rays
+// Every answer's ray point lies within the reach of the primitive (make_lattice_shape), so
+// rays whose lines keep farther than that from every part lose nothing (images are
+// identical). The accelerator culls with boxes around the parts grown by the reach, grouped
+// along the box's longest axis into at most kMaxCullParts (fewer boxes than parts keep the
+// accelerator small, and each is far tighter than the lattice box). When the parts are a few
+// capsules (a hair), each is a cull part of its own and its capsule grown by the reach is
+// tested too, a few dot products before any snapping: on the fur plates four in five rays
 // that met the boxes found no stored hit.
-bool LatticeFrame::make_cull_capsules(const Shape* primitive, double reach) {
-    if (!primitive || !std::isfinite(reach)) return false;
-    std::vector<Capsule> capsules;
-    std::vector<Bounds3> boxes;
-    for (std::size_t i = 0; i < primitive->primitive_count(); ++i) {
-        Capsule c;
-        if (!primitive->primitive_capsule(i, c)) return false;
-        c.r += reach;
-        const Bounds3 b = lat::intersect(c.placed_bounds(Transform{}), box_);
-        if (b.empty()) continue;
-        capsules.push_back(c);
-        boxes.push_back(b);
+void LatticeFrame::make_cull_parts(const Shape* primitive, double reach) {
+    const std::size_t n = primitive ? primitive->primitive_count() : 0;
+    if (!std::isfinite(reach) || n == 0) {
+        cull_.push_back({box_, 0, 0});
+        return;
     }
-    if (boxes.empty()) return false;  // nothing in the box: make_cull_boxes says so
-    // A chain's joint sphere lies inside its cylinders' grown capsules: every culling part
-    // costs a callback per ray that meets its box, so parts inside another are dropped (of
-    // equal ones, the first is kept). Rounding in the test is far inside kSnapReach's slack.
-    for (std::size_t i = 0; i < capsules.size(); ++i) {
+    const Vec3 ext = box_.extent();
+    const std::size_t axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    std::vector<Piece> pieces;
+    bool capsules = true;
+    for (std::size_t i = 0; i < n; ++i) {
+        Piece p;
+        p.box = lat::intersect(expand(primitive->primitive_bounds(i), reach), box_);
+        capsules = capsules && primitive->primitive_capsule(i, p.capsule);
+        p.capsule.r += reach;
+        if (!p.box.empty()) pieces.push_back(p);
+    }
+    if (pieces.empty()) {  // nothing in the box: nothing to hit (the table is empty)
+        cull_.push_back({Bounds3{}, 0, 0});
+        return;
+    }
+    std::vector<Piece> few;  // the capsules, if a few hold them all
+    if (capsules && pieces.size() <= 4 * kMaxCullParts) {
+        few = pieces;
+        // A kept capsule stands for those it covers, so its box is its own (not its part's).
+        for (Piece& p : few) p.box = lat::intersect(p.capsule.placed_bounds(Transform{}), box_);
+        drop_covered(few);
+    }
+    capsules = capsules && !few.empty() && few.size() <= kMaxCullParts;
+    if (capsules) pieces = std::move(few);
+    for (Piece& p : pieces) p.key = p.box.center()[axis];
+    std::stable_sort(pieces.begin(), pieces.end(),
+                     [](const Piece& a, const Piece& b) { return a.key < b.key; });
+    group(pieces, capsules);
+}
+
+// A chain's joint sphere lies inside its cylinders' grown capsules: every culling part costs a
+// callback per ray that meets its box, so pieces inside another are dropped (of equal ones, the
+// first is kept). Quadratic: only for primitives of a few parts. Rounding in the test is far
+// inside kSnapReach's slack.
+void LatticeFrame::drop_covered(std::vector<Piece>& pieces) {
+    std::vector<Piece> kept;
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
         bool covered = false;
-        for (std::size_t j = 0; j < capsules.size() && !covered; ++j)
-            covered = j != i && capsules[j].contains(capsules[i]) &&
-                      (j < i || !capsules[i].contains(capsules[j]));
-        if (!covered) {
-            capsules_.push_back(capsules[i]);
-            cull_.push_back(boxes[i]);
-        }
+        for (std::size_t j = 0; j < pieces.size() && !covered; ++j)
+            covered = j != i && pieces[j].capsule.contains(pieces[i].capsule) &&
+                      (j < i || !pieces[i].capsule.contains(pieces[j].capsule));
+        if (!covered) kept.push_back(pieces[i]);
     }
-    return true;
+    pieces = std::move(kept);
+}
+
+void LatticeFrame::group(const std::vector<Piece>& pieces, bool capsules) {
+    // Boxes alone: two neighbouring parts a box (for a chain, a sphere and its cylinder) was
+    // fastest on the plates among 1, 3, 6, 10 and 19 boxes for the 19-part hair. Capsules pay
+    // only one to a part: groups of them (tufts of 200 parts in 16 groups) cost 1.5x the
+    // instructions of boxes alone, for fatter boxes and longer tests.
+    const std::size_t groups =
+        capsules ? pieces.size() : std::min((pieces.size() + 1) / 2, kMaxCullParts);
+    auto volume = [](const Bounds3& b) { return b.extent().x * b.extent().y * b.extent().z; };
+    double total = 0;
+    bool tested = false;
+    for (std::size_t g = 0; g < groups; ++g) {
+        const std::size_t first = g * pieces.size() / groups, end = (g + 1) * pieces.size() / groups;
+        CullPart part{{}, 0, 0};
+        for (std::size_t i = first; i < end; ++i) part.box = merge(part.box, pieces[i].box);
+        if (capsules) {
+            part.first = static_cast<std::uint32_t>(capsules_.size());
+            part.count = static_cast<std::uint32_t>(end - first);
+            for (std::size_t i = first; i < end; ++i) capsules_.push_back(pieces[i].capsule);
+            tested = true;
+        }
+        cull_.push_back(part);
+        total += volume(part.box);
+    }
+    // A primitive that fills its box (a thin spike) gains nothing from several boxes.
+    if (!tested && total >= volume(box_)) cull_.assign(1, {box_, 0, 0});
+}
+
+bool LatticeFrame::cull_meets(std::size_t i, const Ray& r) const {
+    const CullPart& p = cull_[i];
+    if (p.count == 0) return true;
+    for (std::uint32_t k = p.first; k < p.first + p.count; ++k)
+        if (capsules_[k].meets_line(r.o, r.d)) return true;
+    return false;
 }
 
 Bounds3 LatticeFrame::cull_bounds(std::size_t i, const Transform& xf) const {
-    const Bounds3 clipped = xf.bounds(cull_[i]);
-    return capsules_.empty() ? clipped : lat::intersect(clipped, capsules_[i].placed_bounds(xf));
-}
-
-// Without a grown primitive: boxes around the primitive's parts grown by the reach. Parts are
-// grouped along the box's longest axis into a few boxes: fewer boxes than parts keep the
-// accelerator small, and each is far tighter than the lattice box.
-void LatticeFrame::make_cull_boxes(const Shape* primitive, double reach) {
-    const std::size_t n = primitive ? primitive->primitive_count() : 0;
-    if (!std::isfinite(reach) || n == 0) {
-        cull_.push_back(box_);
-        return;
-    }
-    const double grow = reach;
-    struct Part {
-        Bounds3 b;
-        double key;
-    };
-    const Vec3 ext = box_.extent();
-    const std::size_t axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-    std::vector<Part> parts;
-    for (std::size_t i = 0; i < n; ++i) {
-        const Bounds3 b = lat::intersect(expand(primitive->primitive_bounds(i), grow), box_);
-        if (!b.empty()) parts.push_back({b, b.center()[axis]});
-    }
-    if (parts.empty()) {  // nothing in the box: nothing to hit (the table is empty)
-        cull_.push_back(Bounds3{});
-        return;
-    }
-    std::stable_sort(parts.begin(), parts.end(),
-                     [](const Part& a, const Part& b) { return a.key < b.key; });
-    // Two neighbouring parts a box (for a chain, a sphere and its cylinder) was fastest on the
-    // plates among 1, 3, 6, 10 and 19 boxes for the 19-part hair.
-    const std::size_t groups = std::min<std::size_t>((parts.size() + 1) / 2, 16);
-    auto volume = [](const Bounds3& b) { return b.extent().x * b.extent().y * b.extent().z; };
-    double total = 0;
-    for (std::size_t g = 0; g < groups; ++g) {
-        Bounds3 b;
-        for (std::size_t i = g * parts.size() / groups; i < (g + 1) * parts.size() / groups; ++i)
-            b = merge(b, parts[i].b);
-        cull_.push_back(b);
-        total += volume(b);
-    }
-    // A primitive that fills its box (a thin spike) gains nothing from several boxes.
-    if (total >= volume(box_)) cull_.assign(1, box_);
+    const CullPart& p = cull_[i];
+    Bounds3 placed;
+    for (std::uint32_t k = p.first; k < p.first + p.count; ++k)
+        placed = merge(placed, capsules_[k].placed_bounds(xf));
+    const Bounds3 clipped = xf.bounds(p.box);
+    return p.count == 0 ? clipped : lat::intersect(clipped, placed);
 }
 
 bool LatticeFrame::snap(const Ray& r, Snap& s) const {

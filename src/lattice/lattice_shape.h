@@ -30,9 +30,7 @@ public:
     // See Shape::cull_count, cull_bounds and cull_meets.
     std::size_t cull_count() const { return cull_.size(); }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf) const;
-    bool cull_meets(std::size_t i, const Ray& r) const {
-        return capsules_.empty() || capsules_[i].meets_line(r.o, r.d);
-    }
+    bool cull_meets(std::size_t i, const Ray& r) const;
 
     // The ray's line in lattice units, and its snapped entry and exit points.
     struct Snap {
@@ -47,13 +45,24 @@ private:
     BoundaryGrid grid_;
     double cell_, inv_cell_;
     Bounds3 box_;  // primitive units
-    // Culling, primitive units: capsules around the primitive's parts grown by the reach, when
-    // it has them, with their boxes clipped to the lattice box; else boxes alone.
+    // Culling, primitive units (see make_cull_parts): a box per part, and the capsules the
+    // part's rays are tested against, capsules_[first, first + count), if any.
+    static constexpr std::size_t kMaxCullParts = 16;
+    struct CullPart {
+        Bounds3 box;
+        std::uint32_t first, count;
+    };
+    std::vector<CullPart> cull_;
     std::vector<Capsule> capsules_;
-    std::vector<Bounds3> cull_;
 
-    void make_cull_boxes(const Shape* primitive, double reach);
-    bool make_cull_capsules(const Shape* primitive, double reach);
+    struct Piece {  // one part of the primitive, as culling sees it
+        Bounds3 box;
+        Capsule capsule;
+        double key = 0;
+    };
+    void make_cull_parts(const Shape* primitive, double reach);
+    static void drop_covered(std::vector<Piece>& pieces);
+    void group(const std::vector<Piece>& pieces, bool capsules);
 };
 
 // Lattice visits (snaps of a ray to a grid point pair: one per call of a lattice shape's
