@@ -157,3 +157,64 @@ TEST(ImageCompare, BadDiffPathFailsBeforeReading) {
 
 }  // namespace
 }  // namespace lat
+
+// SSIM: identical images give 1; flat images give the luminance term alone; a random pair
+// agrees with the formula evaluated window by window.
+namespace lat {
+namespace {
+
+Image8 flat_image(int w, int h, std::uint8_t v) {
+    return {w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 3, v)};
+}
+
+TEST(Ssim, IdenticalImagesGiveOne) {
+    Image8 a = flat_image(20, 16, 0);
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) a.rgb[i] = static_cast<std::uint8_t>((i * 37) % 251);
+    EXPECT_NEAR(ssim(a, a), 1.0, 1e-12);
+}
+
+TEST(Ssim, FlatImagesGiveTheLuminanceTerm) {
+    const double c1 = 2.55 * 2.55, x = 100, y = 140;
+    EXPECT_NEAR(ssim(flat_image(16, 16, 100), flat_image(16, 16, 140)),
+                (2 * x * y + c1) / (x * x + y * y + c1), 1e-9);
+}
+
+TEST(Ssim, MatchesTheFormulaWindowByWindow) {
+    const int w = 14, h = 12;
+    Image8 a = flat_image(w, h, 0), b = flat_image(w, h, 0);
+    std::uint32_t state = 12345;
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) {
+        state = state * 1664525u + 1013904223u;
+        a.rgb[i] = static_cast<std::uint8_t>(state >> 24);
+        b.rgb[i] = static_cast<std::uint8_t>((a.rgb[i] + (state >> 16) % 40) % 256);
+    }
+    double g[11], gs = 0;
+    for (int k = 0; k < 11; ++k) gs += g[k] = std::exp(-(k - 5) * (k - 5) / 4.5);
+    const double c1 = 2.55 * 2.55, c2 = 7.65 * 7.65;
+    double total = 0;
+    for (int ch = 0; ch < 3; ++ch) {
+        double sum = 0;
+        for (int y0 = 0; y0 + 11 <= h; ++y0)
+            for (int x0 = 0; x0 + 11 <= w; ++x0) {
+                double mx = 0, my = 0, xx = 0, yy = 0, xy = 0;
+                for (int j = 0; j < 11; ++j)
+                    for (int i = 0; i < 11; ++i) {
+                        const double wt = g[i] * g[j] / (gs * gs);
+                        const std::size_t p = (static_cast<std::size_t>(y0 + j) * w + x0 + i) * 3 + ch;
+                        mx += wt * a.rgb[p];
+                        my += wt * b.rgb[p];
+                        xx += wt * a.rgb[p] * a.rgb[p];
+                        yy += wt * b.rgb[p] * b.rgb[p];
+                        xy += wt * a.rgb[p] * b.rgb[p];
+                    }
+                sum += (2 * mx * my + c1) * (2 * (xy - mx * my) + c2) /
+                       ((mx * mx + my * my + c1) * (xx - mx * mx + yy - my * my + c2));
+            }
+        total += sum / ((w - 10) * (h - 10));
+    }
+    EXPECT_NEAR(ssim(a, b), total / 3, 1e-9);
+    EXPECT_LT(ssim(a, b), 0.99);
+}
+
+}  // namespace
+}  // namespace lat

@@ -8,8 +8,7 @@
 #include "commands.h"
 #include "common.h"
 #include "io/image.h"
-#include "render/renderer.h"
-#include "render/scene_lattices.h"
+#include "render/render_modes.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
 #include "util/interrupt.h"
@@ -19,11 +18,13 @@
 namespace lat::cli {
 namespace {
 
-enum class RenderMode { kExact, kLattice };
-
 // The option values, each said once: they both check the option and convert it.
-const std::map<std::string, RenderMode> kModes{{"exact", RenderMode::kExact},
-                                               {"lattice", RenderMode::kLattice}};
+std::map<std::string, RenderMode> mode_names() {
+    std::map<std::string, RenderMode> m;
+    for (const ModeDescription& d : render_modes()) m.emplace(std::string(d.name), d.mode);
+    return m;
+}
+const std::map<std::string, RenderMode> kModes = mode_names();
 const std::map<std::string, Instancing> kInstancing{
     {"auto", Instancing::kAuto}, {"always", Instancing::kAlways}, {"never", Instancing::kNever}};
 
@@ -37,6 +38,8 @@ struct RenderArgs {
     std::string lattice_dir;
     TableSpec spec;
     std::string instancing = "auto";
+    TextureOptions texture;
+    int shadow_map_size = ParticleOptions{}.shadow_map_size;
     bool quiet = false;
 
     bool lattice_mode() const { return kModes.at(mode) == RenderMode::kLattice; }
@@ -44,7 +47,7 @@ struct RenderArgs {
 
 // Wall-clock milestones of a render command, in milliseconds from its start.
 struct Timings {
-    double loaded = 0, tables = 0, built = 0, written = 0;
+    double loaded = 0, written = 0;
 };
 
 void write_image(const std::string& path, ImageFormat format, const RenderOutput& out) {
@@ -60,8 +63,9 @@ double mrays_per_s(const RenderStats& st) {
     return st.render_ms > 0 ? static_cast<double>(rays) / (st.render_ms * 1e3) : 0.0;
 }
 
-void print_summary(const RenderArgs& a, const Scene& scene, const SceneLattices& lattices,
-                   const RenderStats& st, const Timings& t) {
+void print_summary(const RenderArgs& a, const Scene& scene, const ModeResult& r, const Timings& t) {
+    const SceneLattices& lattices = r.lattices;
+    const RenderStats& st = r.out.stats;
     if (a.lattice_mode())
         std::fprintf(stderr, "lattice: %zu table%s (%s, %s hits), %d built in %.1f s\n",
                      lattices.paths.size(), lattices.paths.size() == 1 ? "" : "s",
@@ -78,8 +82,10 @@ void print_summary(const RenderArgs& a, const Scene& scene, const SceneLattices&
                  static_cast<double>(peak_rss_bytes()) / (1 << 20));
 }
 
-nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const SceneLattices& lattices,
-                          const RenderStats& st, const Timings& t) {
+nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeResult& r,
+                          const Timings& t) {
+    const SceneLattices& lattices = r.lattices;
+    const RenderStats& st = r.out.stats;
     nlohmann::json j;
     j["scene"] = a.scene;
     j["output"] = a.output;
@@ -89,11 +95,13 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const SceneLa
     j["spp"] = std::max(1, a.spp);
     j["threads"] = st.threads;
     j["load_ms"] = t.loaded;
-    j["build_ms"] = t.built - t.tables;
+    j["build_ms"] = r.build_ms;
+    j["prepare_ms"] = r.prepare_ms;
+    j["bytes_added"] = r.bytes_added;
     if (a.lattice_mode()) {
         j["sigma_inv"] = a.spec.sigma_inv;
         j["encoding"] = a.spec.encoding;
-        j["tables_ms"] = t.tables - t.loaded;
+        j["tables_ms"] = r.prepare_ms;
         j["tables_built"] = lattices.built;
         j["table_bytes"] = lattices.table_bytes;
         j["table_entries"] = lattices.table_entries;
@@ -126,33 +134,23 @@ int run_render(const RenderArgs& a) {
     const ThreadLimit limit(a.threads);
     const bool progress = !a.quiet && ProgressBar::stderr_is_terminal();
     t.loaded = since_start();
-    SceneLattices lattices;
-    RenderScene::InstanceShapeFn instance_shape;
-    if (a.lattice_mode()) {
-        const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
-                               !a.lattice_dir.empty());
-        lattices = scene_lattices(scene, cache, a.spec, progress);
-        instance_shape = [&lattices](int prim) {
-            return lattices.shapes[static_cast<std::size_t>(prim)];
-        };
-    }
-    t.tables = since_start();
-    AccelOptions accel;
-    accel.instancing = kInstancing.at(a.instancing);
-    const RenderScene rs(scene, instance_shape, accel);
-    t.built = since_start();
-
-    // From here on a signal stops the render at the next tile and removes our temporaries.
-    install_interrupt_handlers();
-    RenderOptions opt;
-    opt.spp = a.spp;
-    opt.progress = progress;
-    const RenderOutput out = render_image(rs, opt);
+    ModeSettings settings;
+    settings.spp = a.spp;
+    settings.progress = progress;
+    settings.lattice_dir = a.lattice_dir;
+    settings.spec = a.spec;
+    settings.accel.instancing = kInstancing.at(a.instancing);
+    settings.texture = a.texture;
+    settings.shadow_map_size = a.shadow_map_size;
+    // From the render on a signal stops it at the next tile and removes our temporaries.
+    settings.before_render = [] { install_interrupt_handlers(); };
+    const ModeResult r = render_in_mode(scene, kModes.at(a.mode), settings);
+    const RenderOutput& out = r.out;
     write_image(a.output, format, out);
     t.written = since_start();
 
-    if (!a.quiet) print_summary(a, scene, lattices, out.stats, t);
-    if (!a.stats.empty()) write_json_file(a.stats, stats_json(a, scene, lattices, out.stats, t));
+    if (!a.quiet) print_summary(a, scene, r, t);
+    if (!a.stats.empty()) write_json_file(a.stats, stats_json(a, scene, r, t));
     return 0;
 }
 
@@ -169,10 +167,19 @@ Command add_render_command(CLI::App& parent) {
     c.app->add_option("--spp", args->spp, "Stratified samples per pixel (1 = pixel centre)")
         ->check(CLI::Range(1, 65536));
     c.app->add_option("--stats", args->stats, "Write timing and ray counts as JSON");
-    c.app->add_option("--mode", args->mode,
-                      "exact: full ray trace of every primitive; lattice: instances through their "
-                      "lattice tables (built on first use and cached)")
-        ->check(CLI::IsMember(kModes));
+    std::string mode_help;
+    for (const ModeDescription& d : render_modes())
+        mode_help += (mode_help.empty() ? "" : "; ") + std::string(d.name) + ": " + std::string(d.help);
+    c.app->add_option("--mode", args->mode, mode_help)->check(CLI::IsMember(kModes));
+    c.app->add_option("--texture-size", args->texture.width,
+                      "texture mode: the baked map's width in texels (height is half)")
+        ->check(CLI::Range(2, 16384));
+    c.app->add_option("--texture-subsamples", args->texture.subsamples,
+                      "texture mode: rays per texel side when baking")
+        ->check(CLI::Range(1, 16));
+    c.app->add_option("--shadow-map-size", args->shadow_map_size,
+                      "particles mode: texels on a side of each light's shadow map")
+        ->check(CLI::Range(16, 16384));
     c.app->add_option("--lattice-dir", args->lattice_dir,
                       "Directory of cached lattice tables (default: $LATTICE_CACHE_DIR, "
                       "$XDG_CACHE_HOME/lattice or ~/.cache/lattice)");

@@ -1,4 +1,5 @@
-// `lattice`: one binary, several subcommands (render, rasterize, table1, compare, inspect, scatter).
+// `lattice`: one binary, several subcommands (render, rasterize, table1, compare, inspect, scatter,
+// table2).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
     commands.push_back(lat::cli::add_compare_command(app));
     commands.push_back(lat::cli::add_inspect_command(app));
     commands.push_back(lat::cli::add_scatter_command(app));
+    commands.push_back(lat::cli::add_table2_command(app));
 
     try {
         app.parse(argc, argv);

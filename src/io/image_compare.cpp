@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
+#include <vector>
 
 #include "util/error.h"
 
@@ -92,6 +94,53 @@ ImageDiffStats compare_images(const Image8& a, const Image8& b, int threshold) {
     if (sum_sq != 0) s.psnr_db = 20.0 * std::log10(255.0 / s.rmse);
     s.share_over_8 = static_cast<double>(s.pixels_over_8) / static_cast<double>(pixels);
     return s;
+}
+
+double ssim(const Image8& a, const Image8& b) {
+    require_same_size(a, "first image", b, "second image");
+    constexpr int kWin = 11, kHalf = kWin / 2;
+    const int w = a.width, h = a.height;
+    if (w < kWin || h < kWin) return std::numeric_limits<double>::quiet_NaN();
+    std::array<double, kWin> g{};
+    double gsum = 0;
+    for (int k = 0; k < kWin; ++k) gsum += g[k] = std::exp(-(k - kHalf) * (k - kHalf) / (2 * 1.5 * 1.5));
+    for (double& x : g) x /= gsum;
+    const double c1 = (0.01 * 255) * (0.01 * 255), c2 = (0.03 * 255) * (0.03 * 255);
+    // The five moments, filtered along rows ("valid" columns only), then along columns.
+    const int vw = w - kWin + 1, vh = h - kWin + 1;
+    double total = 0;
+    std::vector<double> rows(static_cast<std::size_t>(h) * vw * 5);
+    for (int ch = 0; ch < 3; ++ch) {
+        auto at = [&](const Image8& im, int x, int y) {
+            return static_cast<double>(im.rgb[(static_cast<std::size_t>(y) * w + x) * 3 + ch]);
+        };
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < vw; ++x) {
+                double m[5] = {0, 0, 0, 0, 0};
+                for (int k = 0; k < kWin; ++k) {
+                    const double p = at(a, x + k, y), q = at(b, x + k, y);
+                    m[0] += g[k] * p;
+                    m[1] += g[k] * q;
+                    m[2] += g[k] * p * p;
+                    m[3] += g[k] * q * q;
+                    m[4] += g[k] * p * q;
+                }
+                std::copy(m, m + 5, rows.begin() + (static_cast<std::ptrdiff_t>(y) * vw + x) * 5);
+            }
+        double sum = 0;
+        for (int y = 0; y < vh; ++y)
+            for (int x = 0; x < vw; ++x) {
+                double m[5] = {0, 0, 0, 0, 0};
+                for (int k = 0; k < kWin; ++k)
+                    for (int i = 0; i < 5; ++i)
+                        m[i] += g[k] * rows[(static_cast<std::size_t>(y + k) * vw + x) * 5 + i];
+                const double vx = m[2] - m[0] * m[0], vy = m[3] - m[1] * m[1], cxy = m[4] - m[0] * m[1];
+                sum += (2 * m[0] * m[1] + c1) * (2 * cxy + c2) /
+                       ((m[0] * m[0] + m[1] * m[1] + c1) * (vx + vy + c2));
+            }
+        total += sum / (static_cast<double>(vw) * vh);
+    }
+    return total / 3;
 }
 
 Image8 difference_heatmap(const Image8& a, const Image8& b) {

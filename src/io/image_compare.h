@@ -33,6 +33,15 @@ void require_same_size(const Image8& a, const std::string& name_a, const Image8&
 
 ImageDiffStats compare_images(const Image8& a, const Image8& b, int threshold = 8);
 
+// The structural similarity index (Wang, Bovik, Sheikh and Simoncelli 2004) in its standard
+// form: an 11 x 11 Gaussian window of sigma 1.5 (weights normalised over the window),
+// K1 = 0.01, K2 = 0.03, L = 255, population (not sample) covariances, the SSIM map over the
+// windows that lie wholly inside the image, averaged, per RGB channel, then over the channels.
+// This is scikit-image's structural_similarity(a, b, channel_axis=2, data_range=255,
+// gaussian_weights=True, sigma=1.5, use_sample_covariance=False). 1 for identical images;
+// images smaller than the window give NaN.
+double ssim(const Image8& a, const Image8& b);
+
 // Per pixel, the largest channel error e through the "inferno" colour map at
 // t = sqrt(min(e, 64) / 64): no error is black, an error of 1 already a visible dark purple, the
 // threshold 8 is magenta-red (t = 0.35), and 64 or more saturates to pale yellow.

@@ -89,8 +89,9 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
                         const Ray ray = cam.ray(i, j, ox, oy);
                         ++rays;
                         SurfaceHit hit;
-                        const Vec3 c = rs.intersect(ray, 0.0, kInfinity, hit) ? shade(rs, ray, hit, counters)
-                                                                               : s.background;
+                        Vec3 c = s.background;
+                        if (rs.intersect(ray, 0.0, kInfinity, hit))
+                            c = opt.shader ? opt.shader(ray, hit, counters) : shade(rs, ray, hit, counters);
                         sum += c;
                         sum_clamped += Vec3{std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0),
                                             std::clamp(c.z, 0.0, 1.0)};

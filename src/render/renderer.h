@@ -2,16 +2,23 @@
 // The tile renderer: oneTBB over image tiles on all cores. Every pixel depends only on its own
 // coordinates, so images are bit-identical for any thread count.
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "io/image.h"
 #include "render/render_scene.h"
+#include "render/shading.h"
 
 namespace lat {
+
+// Radiance seen along a ray at a hit, in place of shade() (render/shading.h): how a mode that
+// changes surfaces, not geometry, shades them (e.g. the texture mode's baked maps).
+using SurfaceShader = std::function<Vec3(const Ray&, const SurfaceHit&, ShadeCounters&)>;
 
 struct RenderOptions {
     int spp = 1;  // stratified samples per pixel; 1 is the pixel centre
     bool progress = false;
+    SurfaceShader shader;  // empty: shade()
 };
 
 struct RenderStats {

@@ -24,11 +24,7 @@ Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCo
             ++counters.shadow_rays;
             if (rs.occluded({hit.p, l}, eps, dist * (1 - 1e-12), hit.object)) continue;
         }
-        const double nl = dot(n, l);
-        const Vec3 r = 2 * nl * n - l;
-        const double rv = std::max(0.0, dot(r, v));
-        const double spec = m.ks * std::pow(rv, m.shininess);
-        c += light.intensity * (m.kd * std::max(0.0, nl) * m.color + Vec3{spec, spec, spec});
+        c += phong_term(m, m.color, n, l, v, light.intensity);
     }
     return c;
 }

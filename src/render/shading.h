@@ -1,5 +1,7 @@
 #pragma once
 // Phong shading with shadows, exactly as the reference format states it (docs/scene-format.md).
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include "render/render_scene.h"
@@ -9,6 +11,18 @@ namespace lat {
 struct ShadeCounters {
     std::uint64_t shadow_rays = 0;
 };
+
+// One light's Phong term (diffuse + specular, before shadowing) at a surface of colour `color`
+// and material m, unit normal n facing the viewer, unit direction l to the light and v to the
+// viewer. The one home of the reflection rule: exact and lattice shading, and the texture
+// mode's baked surfaces, all use it.
+inline Vec3 phong_term(const Material& m, Vec3 color, Vec3 n, Vec3 l, Vec3 v, Vec3 intensity) {
+    const double nl = dot(n, l);
+    const Vec3 r = 2 * nl * n - l;
+    const double rv = std::max(0.0, dot(r, v));
+    const double spec = m.ks * std::pow(rv, m.shininess);
+    return intensity * (m.kd * std::max(0.0, nl) * color + Vec3{spec, spec, spec});
+}
 
 // Radiance (linear, unclamped) seen along `ray` at `hit`.
 Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters);

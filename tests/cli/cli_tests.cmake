@@ -112,3 +112,35 @@ add_test(NAME cli.scatter_command_unknown_name
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;scatter;${BAD}/scatter-mesh-good.json;--object;fur;-o;${CLI_OUT}/placed.json"
           -DEXIT=2 "-DPATTERN=scatter-mesh-good.json: objects: no scatter is named 'fur'"
           -DNO_FILE=${CLI_OUT}/placed.json -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+
+# Table 2 (issue 13): the texture and particle modes' own errors, their options, and table2.
+add_test(NAME cli.texture_needs_a_sphere
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;texture;${BAD}/texture-no-sphere.json;-o;${CLI_OUT}/tex.png"
+          -DEXIT=2 "-DPATTERN=texture-no-sphere.json: objects\\[1\\]: texture mode maps instances onto the sphere or ellipsoid"
+          -DNO_FILE=${CLI_OUT}/tex.png -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.particles_need_a_chain
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;particles;${BAD}/particles-not-chain.json;-o;${CLI_OUT}/par.png"
+          -DEXIT=2 "-DPATTERN=particles-not-chain.json: objects\\[1\\]: particle mode needs a sphere/cylinder chain primitive; 'ring'"
+          -DNO_FILE=${CLI_OUT}/par.png -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+foreach(mode texture particles)
+  add_test(NAME cli.${mode}_mode_renders
+    COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;-q;--mode;${mode};--spp;4;${BAD}/good.json;-o;${CLI_OUT}/${mode}.png"
+            -DEXIT=0 -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+endforeach()
+add_test(NAME cli.texture_size_range
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;texture;--texture-size;1;${BAD}/good.json;-o;${CLI_OUT}/ts.png"
+          -DEXIT=2 "-DPATTERN=--texture-size" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.shadow_map_size_range
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;particles;--shadow-map-size;8;${BAD}/good.json;-o;${CLI_OUT}/sm.png"
+          -DEXIT=2 "-DPATTERN=--shadow-map-size" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.table2_unknown_encoding
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/good.json;-o;${CLI_OUT}/t2bad;--encodings;hash14,nope"
+          -DEXIT=2 "-DPATTERN=nope" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.table2_texture_needs_a_sphere
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/texture-no-sphere.json;-o;${CLI_OUT}/t2tex;--truth-spp;1"
+          -DEXIT=2 "-DPATTERN=texture-no-sphere.json: objects\\[1\\]: texture mode" -DWORKDIR=${CLI_OUT}
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+file(MAKE_DIRECTORY ${CLI_OUT}/t2-cache)
+add_test(NAME cli.table2_runs
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/good.json;-o;${CLI_OUT}/t2;--truth-spp;4;--spp;2;--encodings;hash14,dense;--lattice-dir;${CLI_OUT}/t2-cache;--texture-size;64"
+          -DEXIT=0 "-DPATTERN=table2: lattice-dense" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)

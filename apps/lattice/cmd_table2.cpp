@@ -1,0 +1,208 @@
+// lattice table2 SCENE.json [-o DIR] [--spp N] [--truth-spp N] [--threads N] [--encodings a,b]
+// The paper's Table 2 measured: the scene in every render mode (texture, particles, exact,
+// lattice per encoding) against an exact render at many samples per pixel: fidelity (PSNR,
+// SSIM, share of pixels off by more than 8/255), speed (render and preparation, separately)
+// and space (bytes the mode adds to the scene without its instances). docs/table2.md.
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.h"
+#include "common.h"
+#include "io/image.h"
+#include "io/image_compare.h"
+#include "lattice/encoding.h"
+#include "render/render_modes.h"
+#include "render/scene_parts.h"
+#include "scene/scene_loader.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+#include "util/memory.h"
+
+namespace lat::cli {
+namespace {
+
+struct Table2Args {
+    std::string scene;
+    std::string out_dir = "table2-out";
+    int spp = 16;
+    int truth_spp = 256;
+    int threads = 2;
+    std::vector<std::string> encodings;
+    std::string lattice_dir;
+    TextureOptions texture;
+    int shadow_map_size = ParticleOptions{}.shadow_map_size;
+};
+
+struct Row {
+    std::string name;  // the image's name: the mode, or lattice-<encoding>
+    const ModeDescription* mode;
+    ModeResult result;
+    ImageDiffStats diff;
+    double ssim = 0;
+};
+
+// Images side by side, 4 background-grey pixels apart, in the order given.
+Image8 strip(const std::vector<const Image8*>& images) {
+    constexpr int kGap = 4;
+    int w = 0, h = 0;
+    for (const Image8* im : images) {
+        w += im->width + (w ? kGap : 0);
+        h = std::max(h, im->height);
+    }
+    Image8 out{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 3, 128)};
+    int x0 = 0;
+    for (const Image8* im : images) {
+        for (int y = 0; y < im->height; ++y)
+            std::copy_n(im->rgb.begin() + static_cast<std::ptrdiff_t>(y) * im->width * 3, im->width * 3,
+                        out.rgb.begin() + (static_cast<std::ptrdiff_t>(y) * w + x0) * 3);
+        x0 += im->width + kGap;
+    }
+    return out;
+}
+
+std::string fixed(double v, int digits) {
+    if (std::isinf(v)) return "inf";
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*f", digits, v);
+    return text;
+}
+
+std::string markdown(const Table2Args& a, const std::vector<Row>& rows, double truth_ms) {
+    std::ostringstream md;
+    md << "Scene `" << a.scene << "`, " << a.spp << " spp per mode against exact at " << a.truth_spp
+       << " spp (" << fixed(truth_ms / 1000, 1) << " s), " << a.threads << " threads.\n\n";
+    md << "| technique | mode | paper: fidelity / speed / space | PSNR dB | SSIM | pixels off > 8 | "
+          "render ms | build/bake ms | bytes added |\n";
+    md << "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    for (const Row& r : rows)
+        md << "| " << r.mode->paper_technique << " | " << r.name << " | " << r.mode->paper_fidelity << " / "
+           << r.mode->paper_speed << " / " << r.mode->paper_space << " | " << fixed(r.diff.psnr_db, 2) << " | "
+           << fixed(r.ssim, 4) << " | " << fixed(100 * r.diff.share_over_8, 2) << " % | "
+           << fixed(r.result.out.stats.render_ms, 0) << " | "
+           << fixed(r.result.prepare_ms + r.result.build_ms, 0) << " | "
+           << human_bytes(static_cast<double>(r.result.bytes_added)) << " |\n";
+    return md.str();
+}
+
+nlohmann::json row_json(const Row& r) {
+    auto num = [](double v) { return std::isinf(v) ? nlohmann::json("inf") : nlohmann::json(v); };
+    return {{"name", r.name},
+            {"mode", r.mode->name},
+            {"paper", {{"technique", r.mode->paper_technique},
+                       {"fidelity", r.mode->paper_fidelity},
+                       {"speed", r.mode->paper_speed},
+                       {"space", r.mode->paper_space}}},
+            {"image", r.name + ".png"},
+            {"psnr_db", num(r.diff.psnr_db)},
+            {"ssim", r.ssim},
+            {"share_over_8", r.diff.share_over_8},
+            {"render_ms", r.result.out.stats.render_ms},
+            {"prepare_ms", r.result.prepare_ms},
+            {"build_ms", r.result.build_ms},
+            {"bytes_added", r.result.bytes_added},
+            {"primary_rays", r.result.out.stats.primary_rays},
+            {"shadow_rays", r.result.out.stats.shadow_rays}};
+}
+
+int run_table2(const Table2Args& a) {
+    namespace fs = std::filesystem;
+    // Mistakes first: the encodings, the scene, the output directory.
+    std::vector<std::string> encodings = a.encodings;
+    if (encodings.empty())
+        for (const Encoding* e : lat::encodings()) encodings.emplace_back(e->name);
+    for (const std::string& e : encodings) find_encoding(e);
+    const Scene scene = load_scene(a.scene);
+    check_render_budget(scene.camera, std::max(a.spp, a.truth_spp), a.scene);
+    texture_base(scene);    // the texture mode needs a base surface,
+    make_particles(scene);  // the particle mode chains
+    for (const std::string& e : encodings) {  // and the lattice mode tables of every encoding
+        TableSpec spec;
+        spec.encoding = e;
+        for (const std::size_t i : instance_objects(scene))
+            plan_table(scene.primitives[static_cast<std::size_t>(scene.objects[i].primitive)], spec, scene.file);
+    }
+    std::error_code ec;
+    fs::create_directories(a.out_dir, ec);
+    if (ec) throw InputError(a.out_dir + ": cannot create the output directory: " + ec.message());
+    const std::string md_path = (fs::path(a.out_dir) / "table2.md").string();
+    check_writable(md_path);
+    const ThreadLimit limit(a.threads);
+
+    ModeSettings settings;
+    settings.lattice_dir = a.lattice_dir;
+    settings.texture = a.texture;
+    settings.shadow_map_size = a.shadow_map_size;
+    settings.spp = a.truth_spp;
+    std::fprintf(stderr, "table2: truth, exact at %d spp\n", a.truth_spp);
+    const ModeResult truth = render_in_mode(scene, RenderMode::kExact, settings);
+    write_png((fs::path(a.out_dir) / "truth.png").string(), truth.out.display);
+
+    settings.spp = a.spp;
+    std::vector<Row> rows;
+    auto run = [&](const std::string& name, RenderMode mode) {
+        std::fprintf(stderr, "table2: %s\n", name.c_str());
+        Row r{name, &mode_description(mode), render_in_mode(scene, mode, settings), {}, 0};
+        r.diff = compare_images(r.result.out.display, truth.out.display);
+        r.ssim = ssim(r.result.out.display, truth.out.display);
+        write_png((fs::path(a.out_dir) / (name + ".png")).string(), r.result.out.display);
+        rows.push_back(std::move(r));
+    };
+    run("texture", RenderMode::kTexture);
+    run("particles", RenderMode::kParticles);
+    run("exact", RenderMode::kExact);
+    for (const std::string& e : encodings) {
+        settings.spec.encoding = e;
+        run("lattice-" + e, RenderMode::kLattice);
+    }
+
+    std::vector<const Image8*> images{&truth.out.display};
+    for (const Row& r : rows) images.push_back(&r.result.out.display);
+    write_png((fs::path(a.out_dir) / "strip.png").string(), strip(images));
+
+    std::string md = markdown(a, rows, truth.out.stats.render_ms);
+    md += "\nStrip (`strip.png`), left to right: truth";
+    for (const Row& r : rows) md += ", " + r.name;
+    md += ".\n";
+    std::printf("%s", md.c_str());
+    AtomicFile file(md_path);
+    file.write(md.data(), md.size());
+    file.commit();
+    nlohmann::json j = {{"scene", a.scene},  {"spp", a.spp},         {"truth_spp", a.truth_spp},
+                        {"threads", a.threads}, {"width", scene.camera.width}, {"height", scene.camera.height},
+                        {"truth_render_ms", truth.out.stats.render_ms}};
+    for (const Row& r : rows) j["rows"].push_back(row_json(r));
+    write_json_file((fs::path(a.out_dir) / "table2.json").string(), j);
+    return 0;
+}
+
+}  // namespace
+
+Command add_table2_command(CLI::App& parent) {
+    auto args = std::make_shared<Table2Args>();
+    Command c;
+    c.app = parent.add_subcommand(
+        "table2", "The paper's Table 2 measured: every render mode against an exact many-sample render");
+    c.app->add_option("scene", args->scene, "Scene file (JSON)")->required();
+    c.app->add_option("-o,--output-dir", args->out_dir, "Directory for images, table2.md and table2.json");
+    c.app->add_option("--spp", args->spp, "Samples per pixel of every mode")->check(CLI::Range(1, 65536));
+    c.app->add_option("--truth-spp", args->truth_spp, "Samples per pixel of the exact ground truth")
+        ->check(CLI::Range(1, 65536));
+    c.app->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 4096));
+    c.app->add_option("--encodings", args->encodings, "Lattice encodings to measure (default: all)")
+        ->delimiter(',');
+    c.app->add_option("--lattice-dir", args->lattice_dir, "Directory of cached lattice tables");
+    c.app->add_option("--texture-size", args->texture.width, "Texture mode: the map's width in texels")
+        ->check(CLI::Range(2, 16384));
+    c.app->add_option("--texture-subsamples", args->texture.subsamples, "Texture mode: rays per texel side")
+        ->check(CLI::Range(1, 16));
+    c.app->add_option("--shadow-map-size", args->shadow_map_size, "Particles mode: shadow map texels a side")
+        ->check(CLI::Range(16, 16384));
+    c.run = [args] { return run_table2(*args); };
+    return c;
+}
+
+}  // namespace lat::cli

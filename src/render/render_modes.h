@@ -1,0 +1,60 @@
+#pragma once
+// The render modes, each one entry here: its name on the command line, what it is, the
+// column of the paper's Table 2 it stands for, and how a scene is rendered in it. `render`
+// and `table2` both go through render_in_mode, so a mode is never dispatched by name twice.
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "accel/embree_accel.h"
+#include "lattice/cache/table_spec.h"
+#include "render/particle_mode.h"
+#include "render/renderer.h"
+#include "render/scene_lattices.h"
+#include "render/texture_mode.h"
+
+namespace lat {
+
+enum class RenderMode { kExact, kLattice, kTexture, kParticles };
+
+struct ModeDescription {
+    std::string_view name;
+    RenderMode mode;
+    std::string_view help;
+    // The paper's Table 2 row for the technique: its name and its fidelity, speed and space.
+    std::string_view paper_technique, paper_fidelity, paper_speed, paper_space;
+};
+
+std::span<const ModeDescription> render_modes();
+const ModeDescription& mode_description(RenderMode mode);
+
+struct ModeSettings {
+    int spp = 1;
+    bool progress = false;
+    std::string lattice_dir;  // empty: default_cache_dir()
+    TableSpec spec;           // lattice mode
+    AccelOptions accel;
+    TextureOptions texture;
+    int shadow_map_size = ParticleOptions{}.shadow_map_size;
+    // Called once, when preparation (tables, maps, particles, acceleration) is done and the
+    // render proper begins: `render` installs its interrupt handlers there, since table builds
+    // do not poll for signals.
+    std::function<void()> before_render;
+};
+
+struct ModeResult {
+    RenderOutput out;
+    double prepare_ms = 0;  // tables loaded or built, maps baked, particles made
+    double build_ms = 0;    // the acceleration structure (exact and lattice modes)
+    // Bytes the mode adds to the scene without its instances: the instances' exact geometry
+    // (primitive parts and one transform per instance), plus the tables in lattice mode; the
+    // maps in texture mode; the particle buffer in particle mode.
+    std::uint64_t bytes_added = 0;
+    SceneLattices lattices;  // lattice mode
+};
+
+ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSettings& settings);
+
+}  // namespace lat

@@ -1,0 +1,34 @@
+#include "render/scene_parts.h"
+
+namespace lat {
+namespace {
+
+Scene filtered(const Scene& scene, bool instances) {
+    Scene out;
+    out.file = scene.file;
+    out.format = scene.format;
+    out.camera = scene.camera;
+    out.background = scene.background;
+    out.ambient = scene.ambient;
+    out.shadows = scene.shadows;
+    out.lights = scene.lights;
+    out.materials = scene.materials;
+    out.primitives = scene.primitives;
+    for (const SceneObject& o : scene.objects)
+        if ((o.primitive >= 0) == instances) out.objects.push_back(o);
+    return out;  // scatter groups index the full list, so they are not carried over
+}
+
+}  // namespace
+
+Scene base_scene(const Scene& scene) { return filtered(scene, false); }
+Scene instance_scene(const Scene& scene) { return filtered(scene, true); }
+
+std::vector<std::size_t> instance_objects(const Scene& scene) {
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i)
+        if (scene.objects[i].primitive >= 0) out.push_back(i);
+    return out;
+}
+
+}  // namespace lat
