@@ -1,6 +1,7 @@
 // lattice render SCENE.json -o OUT.png [--threads N] [--spp N] [--stats FILE.json] [--mode M]
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -24,6 +25,12 @@ enum class RenderMode { kExact, kLattice };
 // The option values, each said once: they both check the option and convert it.
 const std::map<std::string, RenderMode> kModes{{"exact", RenderMode::kExact},
                                                {"lattice", RenderMode::kLattice}};
+const std::map<std::string, bool> kOnOff{{"on", true}, {"off", false}};
+const std::map<std::string, LatticeFilter> kFilters = [] {
+    std::map<std::string, LatticeFilter> m;
+    for (const auto& [name, value] : kLatticeFilterNames) m.emplace(name, value);
+    return m;
+}();
 const std::map<std::string, Instancing> kInstancing{
     {"auto", Instancing::kAuto}, {"always", Instancing::kAlways}, {"never", Instancing::kNever}};
 
@@ -37,6 +44,9 @@ struct RenderArgs {
     std::string lattice_dir;
     TableSpec spec;
     std::string instancing = "auto";
+    std::string filter = "none";
+    std::string lod = "on";
+    bool encoding_given = false;  // else a filter picks the encoding that stores coverage
     bool quiet = false;
 
     bool lattice_mode() const { return kModes.at(mode) == RenderMode::kLattice; }
@@ -93,6 +103,8 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const SceneLa
     if (a.lattice_mode()) {
         j["sigma_inv"] = a.spec.sigma_inv;
         j["encoding"] = a.spec.encoding;
+        j["filter"] = a.filter;
+        j["lod"] = a.lod;
         j["tables_ms"] = t.tables - t.loaded;
         j["tables_built"] = lattices.built;
         j["table_bytes"] = lattices.table_bytes;
@@ -131,7 +143,14 @@ int run_render(const RenderArgs& a) {
     if (a.lattice_mode()) {
         const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
                                !a.lattice_dir.empty());
-        lattices = scene_lattices(scene, cache, a.spec, progress);
+        LatticeFiltering filtering;
+        filtering.filter = kFilters.at(a.filter);
+        filtering.lod = kOnOff.at(a.lod);
+        filtering.spread = 2 * std::tan(scene.camera.fov_y_deg * M_PI / 360.0) /
+                           scene.camera.height / std::sqrt(double(std::max(1, a.spp)));
+        TableSpec spec = a.spec;
+        if (filtering.filter != LatticeFilter::kNone && !a.encoding_given) spec.encoding = "coverage";
+        lattices = scene_lattices(scene, cache, spec, progress, filtering);
         instance_shape = [&lattices](int prim) {
             return lattices.shapes[static_cast<std::size_t>(prim)];
         };
@@ -147,6 +166,7 @@ int run_render(const RenderArgs& a) {
     RenderOptions opt;
     opt.spp = a.spp;
     opt.progress = progress;
+    opt.layered = a.lattice_mode() && kFilters.at(a.filter) != LatticeFilter::kNone;
     const RenderOutput out = render_image(rs, opt);
     write_image(a.output, format, out);
     t.written = since_start();
@@ -177,12 +197,24 @@ Command add_render_command(CLI::App& parent) {
                       "Directory of cached lattice tables (default: $LATTICE_CACHE_DIR, "
                       "$XDG_CACHE_HOME/lattice or ~/.cache/lattice)");
     add_table_options(*c.app, args->spec);
+    c.app->add_option("--filter", args->filter,
+                      "lattice mode: none (point-sampled tables, as rasterized), box (each pair's "
+                      "coverage) or smooth (coverage blended over the neighbouring pairs); a filter "
+                      "uses the coverage encoding")
+        ->check(CLI::IsMember(kFilters));
+    c.app->add_option("--lod", args->lod,
+                      "lattice mode with a filter: levels of detail, sigma^-1 = K, 2K, 4K, 8K as "
+                      "the pixels' footprints need (on), or only K (off)")
+        ->check(CLI::IsMember(kOnOff));
     c.app->add_option("--instancing", args->instancing,
                       "Multi-part objects as Embree instances (always), flattened into one "
                       "hierarchy (never), or flattened unless that would be huge (auto)")
         ->check(CLI::IsMember(kInstancing));
     c.app->add_flag("-q,--quiet", args->quiet, "No progress bar or summary line");
-    c.run = [args] { return run_render(*args); };
+    c.run = [args, app = c.app] {
+        args->encoding_given = app->get_option("--encoding")->count() > 0;
+        return run_render(*args);
+    };
     return c;
 }
 

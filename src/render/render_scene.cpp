@@ -31,6 +31,7 @@ bool RenderScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& 
     hit.t = h.t;
     hit.object = h.object;
     hit.material = shape.tag(h.crossing, o.material);
+    hit.alpha = h.crossing.coverage;
     if (o.xf.is_identity()) {
         const SurfacePoint s = shape.surface(r, h.crossing);
         hit.p = s.p;

@@ -16,6 +16,7 @@ struct SurfaceHit {
     Vec3 n;  // outward unit normal, world space
     std::uint32_t material = 0;
     std::uint32_t object = 0;
+    double alpha = 1;  // coverage: below 1 only for prefiltered lattices (render/layers.h)
 };
 
 class RenderScene {
@@ -34,6 +35,8 @@ public:
     }
 
     const Scene& scene() const { return scene_; }
+    // The shape traced for an object (its lattice, in lattice mode).
+    const Shape& shape(std::uint32_t object) const { return *shapes_[object]; }
 
 private:
     const Scene& scene_;

@@ -11,6 +11,8 @@ namespace lat {
 
 struct RenderOptions {
     int spp = 1;  // stratified samples per pixel; 1 is the pixel centre
+    // Trace rays front to back through partial hits (prefiltered lattices, render/layers.h).
+    bool layered = false;
     bool progress = false;
 };
 

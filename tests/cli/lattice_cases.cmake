@@ -66,7 +66,7 @@ elseif(CASE STREQUAL "sigma_inv_range")
   run(2 "--sigma-inv: sigma\\^-1 = 0 is out of range"
       ${LATTICE} render -q ${P3} --mode lattice --sigma-inv 0 --lattice-dir ${WORK} -o ${WORK}/x.png)
 elseif(CASE STREQUAL "unknown_encoding")
-  run(2 "--encoding: unknown table encoding 'nope' \\(known: hash14, dense, candidates, perfect5, perfect6, perfect7, learned\\)"
+  run(2 "--encoding: unknown table encoding 'nope' \\(known: hash14, dense, candidates, perfect5, perfect6, perfect7, learned, coverage\\)"
       ${LATTICE} rasterize -q ${P3} --primitive hair --encoding nope -o ${WORK}/t.lht)
 elseif(CASE STREQUAL "point_limit")
   run(2 "primitives\\.hair: the hash14 encoding keys at most 65535 boundary points; a lattice of 84 x 84 x 240 cells \\(sigma\\^-1 = 12\\) has 94754"

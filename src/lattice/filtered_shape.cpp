@@ -1,0 +1,140 @@
+#include "lattice/filtered_shape.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace lat {
+namespace {
+
+thread_local RayFootprint t_footprint;
+
+// A level's cell should be this many footprints wide: the box filter over a cell, widened by
+// the smooth filter's linear blend, then matches a pixel's box about as well as it can.
+constexpr double kCellPerFootprint = 1.0;
+
+// How far (in cells of a level) a ray answered through a level can pass from the primitive: a
+// pair blended in has its ends within sqrt(2) cells of the ray's (smooth: a neighbouring grid
+// point in both face directions; box: kSnapReach), and a sub-ray of that pair that meets the
+// primitive lies within kSnapReach of the pair's segment.
+double reach_cells(LatticeFilter f) {
+    return (f == LatticeFilter::kSmooth ? std::sqrt(2.0) : kSnapReach) + kSnapReach;
+}
+
+}  // namespace
+
+void set_ray_footprint(const RayFootprint& f) { t_footprint = f; }
+const RayFootprint& ray_footprint() { return t_footprint; }
+
+FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
+                                           double table_error)
+    : filter_(filter), point_(levels.back().table, levels.back().ctx, table_error) {
+    assert(!levels.empty() && filter != LatticeFilter::kNone);
+    for (std::size_t i = 0; i < levels.size(); ++i) {
+        const FilterLevel& l = levels[i];
+        // Only the coarsest level's frame culls (its reach is the largest); LatticeFrame grows
+        // its boxes by kSnapReach cells plus the error it is given.
+        const double grow = i == 0 ? (reach_cells(filter) - kSnapReach) * l.ctx.cell + table_error
+                                   : kInfinity;
+        levels_.push_back({l.table, LatticeFrame(l.ctx, grow), BoundaryGrid(l.ctx.cells)});
+    }
+}
+
+void FilteredLatticeShape::cull_boxes(std::vector<Bounds3>& out) const {
+    const auto& boxes = levels_.front().frame.cull_boxes();
+    out.insert(out.end(), boxes.begin(), boxes.end());
+}
+
+void FilteredLatticeShape::add_pair(const Level& l, const GridPoint& a, const GridPoint& b, double w,
+                                    Sheet& s) const {
+    const std::uint32_t ia = l.grid.id(a), ib = l.grid.id(b);
+    CoverageHit h;
+    if (ia == ib || !l.table->coverage(ia, ib, h)) return;
+    s.add(w, h, lerp(to_vec(a), to_vec(b), h.t) * l.frame.cell());
+}
+
+void FilteredLatticeShape::sheet(const Level& l, const Ray& r, double weight, Sheet& s) const {
+    LatticeFrame::Snap sn;
+    if (!l.frame.snap(r, sn)) return;
+    if (filter_ == LatticeFilter::kBox) {
+        add_pair(l, sn.pa, sn.pb, weight, s);
+        return;
+    }
+    // The real entry and exit points, on the faces snap chose (the axes that clip first and
+    // last, found by the same loop), in face coordinates u, v (the next two axes).
+    const auto& n = l.grid.cells();
+    double t0 = -kInfinity, t1 = kInfinity;
+    int ax[2] = {0, 0};
+    for (int k = 0; k < 3; ++k) {
+        const auto uk = static_cast<std::size_t>(k);
+        if (sn.d[uk] == 0) continue;
+        double tn = -sn.o[uk] / sn.d[uk], tf = (n[uk] - sn.o[uk]) / sn.d[uk];
+        if (tn > tf) std::swap(tn, tf);
+        if (tn > t0) t0 = tn, ax[0] = k;
+        if (tf < t1) t1 = tf, ax[1] = k;
+    }
+    const Vec3 x[2] = {sn.o + sn.d * t0, sn.o + sn.d * t1};
+    const GridPoint g[2] = {sn.pa, sn.pb};
+    // The 4-D coordinates (u, v of the entry, u, v of the exit), their cell and fractions.
+    std::array<int, 4> base{}, axis_of{};
+    std::array<double, 4> frac{};
+    for (int e = 0; e < 2; ++e)
+        for (int j = 0; j < 2; ++j) {
+            const int a = (ax[e] + 1 + j) % 3;
+            const auto ua = static_cast<std::size_t>(a);
+            const double v = std::clamp(x[e][ua], 0.0, double(n[ua]));
+            const int b = std::min(static_cast<int>(std::floor(v)), std::max(0, n[ua] - 1));
+            base[static_cast<std::size_t>(2 * e + j)] = b;
+            frac[static_cast<std::size_t>(2 * e + j)] = std::clamp(v - b, 0.0, 1.0);
+            axis_of[static_cast<std::size_t>(2 * e + j)] = a;
+        }
+    std::array<int, 4> order{0, 1, 2, 3};
+    std::sort(order.begin(), order.end(), [&](int i, int j) {
+        return frac[static_cast<std::size_t>(i)] > frac[static_cast<std::size_t>(j)];
+    });
+    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn).
+    GridPoint c[2] = {g[0], g[1]};
+    for (int k = 0; k < 4; ++k) c[k / 2][axis_of[static_cast<std::size_t>(k)]] = base[static_cast<std::size_t>(k)];
+    double prev = 1;
+    for (int step = 0; step <= 4; ++step) {
+        const double f = step < 4 ? frac[static_cast<std::size_t>(order[static_cast<std::size_t>(step)])] : 0;
+        if (prev - f > 0) add_pair(l, c[0], c[1], weight * (prev - f), s);
+        prev = f;
+        if (step < 4) {
+            const int k = order[static_cast<std::size_t>(step)];
+            ++c[k / 2][axis_of[static_cast<std::size_t>(k)]];
+        }
+    }
+}
+
+bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    // The level whose cell is the footprint wide, at the box's centre along the ray.
+    const double dd = dot(r.d, r.d);
+    const RayFootprint& fp = t_footprint;
+    const double tc = dot(bounds().center() - r.o, r.d) / dd;
+    const double width = (fp.width0 + fp.spread * std::max(0.0, tc)) * std::sqrt(dd);
+    const double top = double(levels_.size() - 1);
+    const double level =
+        width > 0 ? std::clamp(std::log2(levels_.front().frame.cell() / (width * kCellPerFootprint)), 0.0, top)
+                  : top;
+    const auto lo = static_cast<std::size_t>(std::floor(level));
+    const double w_hi = level - double(lo);
+    Sheet s;
+    sheet(levels_[lo], r, 1 - w_hi, s);
+    if (w_hi > 0) sheet(levels_[lo + 1], r, w_hi, s);
+    if (s.alpha <= 1e-6) return false;
+    const Vec3 p = s.p / s.alpha;
+    const double t = dot(p - r.o, r.d) / dd;
+    if (!(t > tmin && t < tmax)) return false;
+    const double ln = length(s.n);
+    hit = Crossing(t, 0, SurfacePoint{p, ln > 0 ? s.n / ln : -r.d / std::sqrt(dd)});
+    hit.coverage = static_cast<float>(std::min(1.0, s.alpha));
+    return true;
+}
+
+bool FilteredLatticeShape::occluded(const Ray& r, double tmin, double tmax) const {
+    Crossing c;
+    return intersect(r, tmin, tmax, c) && c.coverage >= 0.5f;
+}
+
+}  // namespace lat
