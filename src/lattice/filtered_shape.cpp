@@ -9,9 +9,6 @@ namespace {
 
 thread_local RayFootprint t_footprint;
 
-// A level's cell should be this many footprints wide: the box filter over a cell, widened by
-// the smooth filter's linear blend, then matches a pixel's box about as well as it can.
-constexpr double kCellPerFootprint = 1.0;
 
 // How far (in cells of a level) a ray answered through a level can pass from the primitive: a
 // pair blended in has its ends within sqrt(2) cells of the ray's (smooth: a neighbouring grid
@@ -24,6 +21,10 @@ double reach_cells(LatticeFilter f) {
 }  // namespace
 
 void set_ray_footprint(const RayFootprint& f) { t_footprint = f; }
+
+double lod_level(double cell0, double width) {
+    return std::log2(cell0 / (width * kCellPerFootprint));
+}
 const RayFootprint& ray_footprint() { return t_footprint; }
 
 FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
@@ -53,10 +54,11 @@ void FilteredLatticeShape::add_pair(const Level& l, const GridPoint& a, const Gr
     s.add(w, h, lerp(to_vec(a), to_vec(b), h.t) * l.frame.cell());
 }
 
-void FilteredLatticeShape::sheet(const Level& l, const Ray& r, double weight, Sheet& s) const {
+void FilteredLatticeShape::sheet(const Level& l, const Ray& r, double weight, bool smooth,
+                                 Sheet& s) const {
     LatticeFrame::Snap sn;
     if (!l.frame.snap(r, sn)) return;
-    if (filter_ == LatticeFilter::kBox) {
+    if (!smooth) {
         add_pair(l, sn.pa, sn.pb, weight, s);
         return;
     }
@@ -115,20 +117,21 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
     const double width = (fp.width0 + fp.spread * std::max(0.0, tc)) * std::sqrt(dd);
     const double top = double(levels_.size() - 1);
     const double level =
-        width > 0 ? std::clamp(std::log2(levels_.front().frame.cell() / (width * kCellPerFootprint)), 0.0, top)
-                  : top;
+        width > 0 ? std::clamp(lod_level(levels_.front().frame.cell(), width), 0.0, top) : top;
     const auto lo = static_cast<std::size_t>(std::floor(level));
     const double w_hi = level - double(lo);
+    const bool smooth = filter_ == LatticeFilter::kSmooth;
     Sheet s;
-    sheet(levels_[lo], r, 1 - w_hi, s);
-    if (w_hi > 0) sheet(levels_[lo + 1], r, w_hi, s);
+    sheet(levels_[lo], r, 1 - w_hi, smooth, s);
+    if (w_hi > 0) sheet(levels_[lo + 1], r, w_hi, smooth, s);
     if (s.alpha <= 1e-6) return false;
     const Vec3 p = s.p / s.alpha;
     const double t = dot(p - r.o, r.d) / dd;
     if (!(t > tmin && t < tmax)) return false;
     const double ln = length(s.n);
     hit = Crossing(t, 0, SurfacePoint{p, ln > 0 ? s.n / ln : -r.d / std::sqrt(dd)});
-    hit.coverage = static_cast<float>(std::min(1.0, s.alpha));
+    // Blends of full pairs round to just under 1: they are opaque (and end the ray's traversal).
+    hit.coverage = s.alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(s.alpha);
     return true;
 }
 

@@ -33,6 +33,14 @@ struct RayFootprint {
 void set_ray_footprint(const RayFootprint& f);
 const RayFootprint& ray_footprint();
 
+// A level's cell is made this many footprints wide: the box over a cell, widened by the smooth
+// filter's linear blend, then matches a pixel's box best (Plate 4 at 512^2: 0.7, 0.85, 1.0 and
+// 1.2 gave 35.9, 36.0, 35.8 and 34.9 dB against the 256-spp exact image).
+inline constexpr double kCellPerFootprint = 0.85;
+// The level (real; 0 is the lattice of cell cell0, each next one halves it) for a footprint of
+// this width, in the same units.
+double lod_level(double cell0, double width);
+
 // One level: a coverage table and its lattice.
 struct FilterLevel {
     std::shared_ptr<const LatticeTable> table;
@@ -77,7 +85,7 @@ private:
     LatticeFilter filter_;
     HitTableShape point_;  // the finest level, point-sampled
 
-    void sheet(const Level& l, const Ray& r, double weight, Sheet& s) const;
+    void sheet(const Level& l, const Ray& r, double weight, bool smooth, Sheet& s) const;
     void add_pair(const Level& l, const GridPoint& a, const GridPoint& b, double w, Sheet& s) const;
 };
 

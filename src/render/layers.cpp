@@ -6,38 +6,32 @@ namespace lat {
 
 double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tmax,
                      std::uint32_t self) {
-    // As EmbreeAccel::occluded: the surface's own shape is skipped within its tolerance.
-    double self_until = tmin;
-    if (self != EmbreeAccel::kNoObject) {
-        const double tol = rs.shape(self).surface_tolerance();
-        if (tol > 0) self_until += tol / length(rs.scene().objects[self].xf.inverse_vector(r.d));
-    }
-    double trans = 1, t = tmin;
-    for (int layer = 0; layer < kMaxLayers; ++layer) {
-        SurfaceHit h;
-        if (!rs.intersect(r, t, tmax, h)) return trans;
-        t = h.t;
-        if (h.object == self && h.t <= self_until) continue;
-        trans *= 1 - h.alpha;
-        if (trans <= kMinTransmittance) return 0;
-    }
-    return 0;  // deeper than kMaxLayers: taken as blocked, as the last layer of a camera ray
+    thread_local std::vector<SurfaceHit> partial;
+    SurfaceHit opaque;
+    if (rs.intersect_layers(r, tmin, tmax, self, opaque, partial)) return 0;
+    double trans = 1;
+    for (const SurfaceHit& h : partial) trans *= 1 - h.alpha;
+    return trans <= kMinTransmittance ? 0 : trans;
 }
 
 Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCounters& counters) {
+    thread_local std::vector<SurfaceHit> partial;
+    set_ray_footprint({0, spread});
+    SurfaceHit opaque;
+    const bool found = rs.intersect_layers(ray, 0.0, kInfinity, EmbreeAccel::kNoObject, opaque, partial);
+    // Shading moves the footprint (shadow rays): the layers are all found first.
+    const std::vector<SurfaceHit> layers = partial;
     Vec3 c;
-    double left = 1, tmin = 0;
-    for (int layer = 0; layer < kMaxLayers; ++layer) {
-        set_ray_footprint({0, spread});
-        SurfaceHit hit;
-        if (!rs.intersect(ray, tmin, kInfinity, hit)) return c + rs.scene().background * left;
-        const double alpha = layer + 1 == kMaxLayers ? 1.0 : hit.alpha;
-        c += shade_transmitted(rs, ray, hit, spread * hit.t, counters) * (left * alpha);
+    double left = 1;
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+        const SurfaceHit& h = layers[i];
+        const double alpha = i + 1 == kMaxLayers ? 1.0 : h.alpha;
+        c += shade_transmitted(rs, ray, h, spread * h.t, counters) * (left * alpha);
         left *= 1 - alpha;
-        if (left <= kMinTransmittance) break;
-        tmin = hit.t;
+        if (left <= kMinTransmittance) return c;
     }
-    return c;
+    return c + (found ? shade_transmitted(rs, ray, opaque, spread * opaque.t, counters)
+                      : rs.scene().background) * left;
 }
 
 }  // namespace lat

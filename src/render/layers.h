@@ -9,9 +9,10 @@
 
 namespace lat {
 
-// Surfaces a ray is traced through, at most: the last one met is taken as opaque. A pixel's
-// share left behind eight hairs of coverage 1/2 is 1/256, under an 8-bit step; deeper stacks of
-// partial sheets are rare (the edges of overlapping hairs).
+// Partial surfaces shaded along a camera ray, at most: the last one is taken as opaque. A
+// pixel's share left behind eight hairs of coverage 1/2 is 1/256, under an 8-bit step; deeper
+// stacks of partial sheets are rare (the edges of overlapping hairs). One traversal finds them
+// all (EmbreeAccel::intersect_layers).
 inline constexpr int kMaxLayers = 8;
 // Below this share left uncovered, the rest of a ray is not traced.
 inline constexpr double kMinTransmittance = 1.0 / 1024;

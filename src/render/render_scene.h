@@ -28,6 +28,10 @@ public:
                          const AccelOptions& accel = {});
 
     bool intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const;
+    // Through partial hits (render/layers.h): the closest opaque hit, if any, and every partial
+    // hit before it, in ray order. `self` as for occluded.
+    bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
+                          SurfaceHit& hit, std::vector<SurfaceHit>& partial) const;
     // `self`: the object whose surface the ray leaves (see EmbreeAccel::occluded).
     bool occluded(const Ray& r, double tmin, double tmax,
                   std::uint32_t self = EmbreeAccel::kNoObject) const {
@@ -43,6 +47,8 @@ private:
     std::vector<std::shared_ptr<const Shape>> shapes_;  // per object, as traced
     std::vector<AccelObject> accel_objects_;
     std::unique_ptr<EmbreeAccel> accel_;
+
+    void surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const;
 };
 
 }  // namespace lat
