@@ -46,7 +46,6 @@ struct RenderArgs {
     std::string instancing = "auto";
     std::string filter = "none";
     std::string lod = "on";
-    bool encoding_given = false;  // else a filter picks the encoding that stores coverage
     bool quiet = false;
 
     bool lattice_mode() const { return kModes.at(mode) == RenderMode::kLattice; }
@@ -148,9 +147,7 @@ int run_render(const RenderArgs& a) {
         filtering.lod = kOnOff.at(a.lod);
         filtering.spread = 2 * std::tan(scene.camera.fov_y_deg * M_PI / 360.0) /
                            scene.camera.height / std::sqrt(double(std::max(1, a.spp)));
-        TableSpec spec = a.spec;
-        if (filtering.filter != LatticeFilter::kNone && !a.encoding_given) spec.encoding = "coverage";
-        lattices = scene_lattices(scene, cache, spec, progress, filtering);
+        lattices = scene_lattices(scene, cache, a.spec, progress, filtering);
         instance_shape = [&lattices](int prim) {
             return lattices.shapes[static_cast<std::size_t>(prim)];
         };
@@ -203,7 +200,7 @@ Command add_render_command(CLI::App& parent) {
                       "uses the coverage encoding")
         ->check(CLI::IsMember(kFilters));
     c.app->add_option("--lod", args->lod,
-                      "lattice mode with a filter: levels of detail, sigma^-1 = K, 2K, 4K, 8K as "
+                      "lattice mode with a filter: levels of detail, sigma^-1 = K, 2K, 4K as "
                       "the pixels' footprints need (on), or only K (off)")
         ->check(CLI::IsMember(kOnOff));
     c.app->add_option("--instancing", args->instancing,
@@ -212,7 +209,9 @@ Command add_render_command(CLI::App& parent) {
         ->check(CLI::IsMember(kInstancing));
     c.app->add_flag("-q,--quiet", args->quiet, "No progress bar or summary line");
     c.run = [args, app = c.app] {
-        args->encoding_given = app->get_option("--encoding")->count() > 0;
+        // A filter needs coverage: unless an encoding was asked for, it takes the one with it.
+        if (kFilters.at(args->filter) != LatticeFilter::kNone && app->get_option("--encoding")->count() == 0)
+            args->spec.encoding = "coverage";
         return run_render(*args);
     };
     return c;

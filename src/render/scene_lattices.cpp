@@ -82,7 +82,7 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const 
             for (const int p : csg->leaf_primitives()) used[static_cast<std::size_t>(p)] = true;
     }
     if (filtering.filter != LatticeFilter::kNone && !find_encoding(spec.encoding).coverage)
-        throw InputError("filtered lattices need a table encoding that stores coverage "
+        throw InputError("--filter: filtered lattices need a table encoding that stores coverage "
                          "(--encoding coverage), not '" + spec.encoding + "'");
     for (std::size_t i = 0; i < scene.primitives.size(); ++i) {
         if (!used[i]) continue;

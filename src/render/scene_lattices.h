@@ -28,7 +28,8 @@ struct LatticeFiltering {
     bool lod = false;
     double spread = 0;
 };
-inline constexpr int kMaxLodLevels = 4;
+// Three levels, K to 4K: the next (8K) of the paper's hair would take 28 GB to build.
+inline constexpr int kMaxLodLevels = 3;
 
 // With filtering, spec's encoding must store coverage (Encoding::coverage; else InputError).
 SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const TableSpec& spec,
