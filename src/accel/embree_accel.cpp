@@ -29,8 +29,11 @@ struct QueryContext {
     AccelHit* hit;
     bool found = false;
     std::uint32_t self = EmbreeAccel::kNoObject;  // occlusion: the object the ray leaves
-    // intersect_layers: where crossings of partial coverage go (they do not end the ray).
+    // intersect_layers: where crossings of partial coverage go (they do not end the ray), and
+    // for transmittance queries, the product of their 1 - coverage and the value below which
+    // it counts as blocked (the product does not depend on the order they are met in).
     std::vector<AccelHit>* partial = nullptr;
+    double transmitted = 1, blocked_below = 0;
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;
@@ -205,7 +208,8 @@ struct EmbreeAccel::Impl {
         if (!hit) return;
         if (ctx->partial && c.coverage < 1.0f) {  // kept, and the ray goes on
             ctx->partial->push_back({c.t, t.object, c});
-            return;
+            ctx->transmitted *= 1.0 - double(c.coverage);
+            if (ctx->transmitted >= ctx->blocked_below) return;
         }
         self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), t.object, c, args->geomID,
                      args->primID, K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
@@ -371,7 +375,8 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 }
 
 bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
-                                   AccelHit& hit, std::vector<AccelHit>& partial) const {
+                                   AccelHit& hit, std::vector<AccelHit>& partial,
+                                   double blocked_below) const {
     partial.clear();
     const bool traceable = embree_can_trace(r, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
@@ -379,6 +384,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     QueryContext ctx(m, r, tmin, tmax, hit);
     ctx.self = self;
     ctx.partial = &partial;
+    ctx.blocked_below = blocked_below;
     if (traceable) {
         alignas(16) RTCRayHit rh;
         set_rtc_ray(rh.ray, r, tmin, tmax);

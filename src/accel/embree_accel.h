@@ -53,8 +53,11 @@ public:
     // One traversal for rays that see through partial crossings (Crossing::coverage < 1, from
     // prefiltered lattices): `hit`, as intersect() finds it, is the closest opaque crossing, and
     // `partial` every partial crossing before it, in ray order. `self` as for occluded().
+    // blocked_below > 0 (shadow rays): once the partial crossings met let less than that
+    // through, the last one is taken as opaque and the traversal ends (`hit` is then no closest
+    // crossing; only "blocked" is meant).
     bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self, AccelHit& hit,
-                          std::vector<AccelHit>& partial) const;
+                          std::vector<AccelHit>& partial, double blocked_below = 0) const;
 
     struct Impl;
 

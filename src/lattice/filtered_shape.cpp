@@ -94,19 +94,32 @@ void FilteredLatticeShape::sheet(const Level& l, const Ray& r, double weight, bo
     std::sort(order.begin(), order.end(), [&](int i, int j) {
         return frac[static_cast<std::size_t>(i)] > frac[static_cast<std::size_t>(j)];
     });
-    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn).
+    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn); the
+    // corners' pairs are looked up together.
     GridPoint c[2] = {g[0], g[1]};
     for (int k = 0; k < 4; ++k) c[k / 2][axis_of[static_cast<std::size_t>(k)]] = base[static_cast<std::size_t>(k)];
+    std::uint32_t ia[5], ib[5];
+    GridPoint ca[5], cb[5];
+    double w[5];
+    int m = 0;
     double prev = 1;
     for (int step = 0; step <= 4; ++step) {
         const double f = step < 4 ? frac[static_cast<std::size_t>(order[static_cast<std::size_t>(step)])] : 0;
-        if (prev - f > 0) add_pair(l, c[0], c[1], weight * (prev - f), s);
+        if (prev - f > 0) {
+            ia[m] = l.grid.id(c[0]), ib[m] = l.grid.id(c[1]);
+            if (ia[m] != ib[m]) ca[m] = c[0], cb[m] = c[1], w[m] = weight * (prev - f), ++m;
+        }
         prev = f;
         if (step < 4) {
             const int k = order[static_cast<std::size_t>(step)];
             ++c[k / 2][axis_of[static_cast<std::size_t>(k)]];
         }
     }
+    CoverageHit h[5];
+    bool found[5];
+    l.table->coverage_many(ia, ib, m, h, found);
+    for (int i = 0; i < m; ++i)
+        if (found[i]) s.add(w[i], h[i], lerp(to_vec(ca[i]), to_vec(cb[i]), h[i].t) * l.frame.cell());
 }
 
 bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {

@@ -112,6 +112,12 @@ public:
     // Prefiltered tables (Encoding::coverage): the pair's coverage; false when the pair's rays
     // (nearly) all miss.
     virtual bool coverage(std::uint32_t, std::uint32_t, CoverageHit&) const { return false; }
+    // The coverage of n pairs (a[i], b[i]) at once, found[i] saying whether each has one: lets
+    // a table overlap the memory accesses of the pairs a smooth filter blends.
+    virtual void coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
+                               CoverageHit* out, bool* found) const {
+        for (int i = 0; i < n; ++i) found[i] = coverage(a[i], b[i], out[i]);
+    }
 
     virtual std::string encoding() const = 0;
     // Encoding-specific facts for `lattice inspect` (widths, counts), one line; may be empty.

@@ -8,7 +8,7 @@ double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tm
                      std::uint32_t self) {
     thread_local std::vector<SurfaceHit> partial;
     SurfaceHit opaque;
-    if (rs.intersect_layers(r, tmin, tmax, self, opaque, partial)) return 0;
+    if (rs.intersect_layers(r, tmin, tmax, self, opaque, partial, kMinTransmittance)) return 0;
     double trans = 1;
     for (const SurfaceHit& h : partial) trans *= 1 - h.alpha;
     return trans <= kMinTransmittance ? 0 : trans;

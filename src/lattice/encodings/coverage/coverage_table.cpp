@@ -136,6 +136,8 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
     points_ = h.points;
     occupied_ = h.occupied;
     rank_ = RankIndex(occ, counts);
+    occ_ = occ;
+    counts_ = counts;
     records_ = payload + s.records;
     std::uint64_t centers = 0;
     for (std::uint64_t i = 0; i < occupied_; ++i) {
@@ -165,13 +167,46 @@ bool CoverageTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) cons
     return true;
 }
 
-bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const {
-    const std::uint8_t* r = record(a, b);
-    if (!r || field(r, kAlpha) == 0) return false;
+void CoverageTable::decode(const std::uint8_t* r, CoverageHit& hit) {
     hit.alpha = field(r, kAlpha) / kAlphaScale;
     hit.t = field(r, kMeanT) / kTScale;
     hit.normal = oct_decode({field(r, kMeanNu), field(r, kMeanNv)}, kRawNormalBits);
+}
+
+bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const {
+    const std::uint8_t* r = record(a, b);
+    if (!r || field(r, kAlpha) == 0) return false;
+    decode(r, hit);
     return true;
+}
+
+void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
+                                  CoverageHit* out, bool* found) const {
+    // Three passes, each prefetching what the next reads, so that the cache misses of the pairs
+    // (occupancy word, rank count, record: three a pair in a table of hundreds of MB) overlap
+    // instead of following one another.
+    constexpr int kMax = 16;
+    std::uint64_t idx[kMax];
+    const std::uint8_t* rec[kMax];
+    for (int base = 0; base < n; base += kMax) {
+        const int m = std::min(kMax, n - base);
+        for (int i = 0; i < m; ++i) {
+            const std::uint32_t x = a[base + i], y = b[base + i];
+            idx[i] = x < points_ && y < points_ ? static_cast<std::uint64_t>(x) * points_ + y : ~0ull;
+            if (idx[i] == ~0ull) continue;
+            __builtin_prefetch(occ_ + (idx[i] >> 6));
+            __builtin_prefetch(counts_ + (idx[i] >> 6) / RankIndex::kBlockWords);
+        }
+        for (int i = 0; i < m; ++i) {
+            rec[i] = idx[i] != ~0ull && rank_.test(idx[i]) ? records_ + rank_.rank(idx[i]) * kRecordBytes
+                                                            : nullptr;
+            if (rec[i]) __builtin_prefetch(rec[i]);
+        }
+        for (int i = 0; i < m; ++i) {
+            found[base + i] = rec[i] && field(rec[i], kAlpha) != 0;
+            if (found[base + i]) decode(rec[i], out[base + i]);
+        }
+    }
 }
 
 std::string CoverageTable::details() const {

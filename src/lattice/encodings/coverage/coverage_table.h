@@ -22,6 +22,8 @@ public:
 
     bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const override;
     bool coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const override;
+    void coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n, CoverageHit* out,
+                       bool* found) const override;
     std::string encoding() const override { return "coverage"; }
     std::string details() const override;
     std::uint64_t entries() const override { return entries_; }
@@ -35,6 +37,8 @@ private:
     std::uint32_t points_ = 0;
     std::uint64_t occupied_ = 0;
     RankIndex rank_;
+    const std::uint64_t* occ_ = nullptr;
+    const std::uint32_t* counts_ = nullptr;
     const std::uint8_t* records_ = nullptr;
     std::uint64_t entries_;
     std::size_t size_;
@@ -43,6 +47,7 @@ private:
     double alpha_sum_ = 0;
 
     const std::uint8_t* record(std::uint32_t a, std::uint32_t b) const;
+    static void decode(const std::uint8_t* r, CoverageHit& hit);
 };
 
 }  // namespace lat
