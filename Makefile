@@ -3,7 +3,9 @@
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
-DEMO_SCENE ?= examples/torus-bite.json
+# The demo is the product's point: fur grown over a scanned mesh, traced through lattices.
+DEMO_SCENE ?= examples/furry-bunny.json
+DEMO_FLAGS ?= --mode lattice
 DEMO_OUT ?= out/demo.png
 
 # Sanitizer build (`make test-sanitize`): its own directory; SANITIZE_TESTS passes ctest a
@@ -17,7 +19,7 @@ FUZZ_HARNESSES := $(patsubst fuzz/%_fuzz.cpp,%,$(wildcard fuzz/*_fuzz.cpp))
 
 # g++ brings libasan and libubsan (through libgcc-12-dev).
 PACKAGES := cmake make g++ pkg-config libembree-dev libtbb-dev libpng-dev nlohmann-json3-dev \
-            libcli11-dev libopenexr-dev libgtest-dev libgmock-dev libbenchmark-dev python3
+            libcli11-dev libopenexr-dev libassimp-dev libgtest-dev libgmock-dev libbenchmark-dev python3
 # Only `make bench` plots (bench/plot_complexity.py): a target-specific value, inherited by its
 # prerequisites (build -> configure -> deps), so `make test` and `make demo` do not install it.
 bench: PACKAGES += python3-matplotlib
@@ -62,7 +64,7 @@ build: configure
 
 demo: build
 	@mkdir -p $(dir $(DEMO_OUT))
-	@$(BUILD_DIR)/bin/lattice render $(DEMO_SCENE) -o $(DEMO_OUT)
+	@$(BUILD_DIR)/bin/lattice render $(DEMO_SCENE) $(DEMO_FLAGS) -o $(DEMO_OUT)
 	@echo "demo image: $(abspath $(DEMO_OUT))"
 
 test: build

@@ -72,8 +72,8 @@ def unit4():
 
 
 def placed(obj, zscale, z, rotate_deg=0):
-    # Only scales along z, turns by multiples of 90 degrees about z and translates: the
-    # renderer bounds a transformed torus by its transformed box, which these keep tight.
+    # Only scales along z, turns by multiples of 90 degrees about z and translates (the
+    # renderer bounds a placed torus by its exact extent, so any transform would do).
     ops = [{"scale": [1, 1, zscale]}]
     if rotate_deg:
         ops.append({"rotate": {"axis": [0, 0, 1], "angle_deg": rotate_deg}})

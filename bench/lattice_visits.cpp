@@ -80,7 +80,13 @@ public:
     void primitive_spheres(std::size_t i, std::vector<lat::BoundingSphere>& out) const override {
         s_->primitive_spheres(i, out);
     }
-    void cull_boxes(std::vector<lat::Bounds3>& out) const override { s_->cull_boxes(out); }
+    std::size_t cull_count() const override { return s_->cull_count(); }
+    lat::Bounds3 cull_bounds(std::size_t i, const lat::Transform& xf) const override {
+        return s_->cull_bounds(i, xf);
+    }
+    bool cull_meets(std::size_t i, const lat::Ray& r) const override {
+        return s_->cull_meets(i, r);
+    }
     std::uint32_t tag(const lat::Crossing& c, std::uint32_t fallback) const override {
         return s_->tag(c, fallback);
     }

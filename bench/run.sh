@@ -17,11 +17,13 @@ echo "== encodings (through the lattice command)"
 python3 "$here/encodings.py" "$build/bin/lattice" "$out" > "$out/encodings.md"
 echo "== complexity (exact against lattice mode as the primitive grows; docs/complexity.md)"
 python3 "$here/complexity.py" "$build/bin/lattice" "$out" --work "$build/complexity" > "$out/complexity.md"
+echo "== scatter (fur on a mesh, 100,000 instances)"
+python3 "$here/scatter.py" "$build/bin/lattice" "$out" > "$out/scatter.md"
 # matplotlib is Debian's python3-matplotlib: plot with Debian's python3 even when another one
 # (pyenv, a virtualenv) comes first in PATH.
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 "$py" "$here/plot_complexity.py" "$out/complexity.json" "$here/../docs/images/complexity.png"
-{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md"; } > "$out/summary.md"
+{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/scatter.md"; } > "$out/summary.md"
 echo
 cat "$out/summary.md"
 echo "results: $out"

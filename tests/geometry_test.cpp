@@ -1,11 +1,13 @@
 // Leaf shapes against closed-form answers: spheres, flat-ended cylinders, chains, half-spaces.
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
 
 #include "geometry/capped_cylinder.h"
 #include "geometry/chain.h"
 #include "geometry/halfspace.h"
+#include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
 #include "math/transform.h"
 
@@ -142,6 +144,99 @@ TEST(Transform, InverseAndNormals) {
     const Vec3 n{0, 0, 1}, tangent{1, 1, 0};
     EXPECT_NEAR(dot(t.normal(n), t.vector(tangent)), 0, 1e-14);
     EXPECT_FALSE(Transform::from_affine({Mat3::diagonal({1, 0, 1}), {}}).has_value());
+}
+
+
+// Capsules cull lattices: meets_line must agree with the distance from the line to points
+// along the segment, and a chain's capsules must hold its parts.
+TEST(Capsule, MeetsLineAgreesWithSampledDistance) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-3, 3);
+    int met = 0, missed = 0;
+    for (int k = 0; k < 2000; ++k) {
+        const Capsule c{{u(rng), u(rng), u(rng)}, k % 5 == 0 ? Vec3{} : Vec3{u(rng), u(rng), u(rng)},
+                        0.2 + 0.3 * std::abs(u(rng))};
+        // Lines aimed near the capsule, so that about half of them meet it.
+        const Vec3 o{u(rng) * 10, u(rng) * 10, u(rng) * 10};
+        const Vec3 aim = lerp(c.a, c.b, (u(rng) + 3) / 6) + Vec3{u(rng), u(rng), u(rng)} * 0.3;
+        const Vec3 d = aim - o;
+        double best = kInfinity;
+        for (int s = 0; s <= 4000; ++s) {
+            const Vec3 p = lerp(c.a, c.b, s / 4000.0), w = p - o;
+            best = std::min(best, length_squared(w - d * (dot(w, d) / dot(d, d))));
+        }
+        const double dist = std::sqrt(best);
+        if (std::abs(dist - c.r) < 1e-2) continue;  // too close to call by sampling
+        EXPECT_EQ(c.meets_line(o, d), dist < c.r) << k;
+        (dist < c.r ? met : missed)++;
+    }
+    EXPECT_GT(met, 100);
+    EXPECT_GT(missed, 100);
+}
+
+TEST(Capsule, ChainCapsulesHoldTheirPartsAndJointSpheresAreContained) {
+    const std::vector<ChainSphere> spheres{{{0, 0, 0}, 0.5}, {{1, 2, 3}, 0.5}, {{2, 2, 5}, 0.4}};
+    const std::vector<ChainCylinder> cylinders{{0, 1, 0.5}, {1, 2, 0.4}};
+    const ChainShape chain(spheres, cylinders);
+    std::vector<std::unique_ptr<Shape>> parts;  // the chain's parts, in its order
+    for (const ChainSphere& s : spheres) parts.push_back(std::make_unique<SphereShape>(s.center, s.radius));
+    for (const ChainCylinder& c : cylinders)
+        parts.push_back(std::make_unique<CappedCylinderShape>(
+            spheres[static_cast<std::size_t>(c.from)].center,
+            spheres[static_cast<std::size_t>(c.to)].center, c.radius));
+    ASSERT_EQ(parts.size(), chain.primitive_count());
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 6);
+    for (std::size_t i = 0; i < chain.primitive_count(); ++i) {
+        Capsule c;
+        ASSERT_TRUE(chain.primitive_capsule(i, c));
+        int inside = 0;
+        for (int k = 0; k < 20000; ++k) {
+            const Vec3 p{u(rng), u(rng), u(rng)};
+            if (!parts[i]->inside(p)) continue;
+            ++inside;
+            EXPECT_LE(c.distance_squared(p), c.r * c.r * (1 + 1e-12)) << i;
+        }
+        EXPECT_GT(inside, 5) << i;
+    }
+    Capsule joint, cyl, thin;
+    chain.primitive_capsule(1, joint);  // the sphere at (1, 2, 3), radius 0.5
+    chain.primitive_capsule(3, cyl);    // the cylinder from sphere 0 to sphere 1, radius 0.5
+    chain.primitive_capsule(4, thin);   // radius 0.4: cannot hold the 0.5 sphere
+    EXPECT_TRUE(cyl.contains(joint));
+    EXPECT_FALSE(thin.contains(joint));
+    EXPECT_TRUE(joint.contains(joint));
+}
+
+// A placed torus is bounded by its exact extent (ring + ball support), under rotations and
+// non-uniform scales: it holds every surface point and is touched by them on every side.
+TEST(Torus, PlacedBoundsAreExact) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int k = 0; k < 20; ++k) {
+        const PlacedShape t = make_torus({u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng) + 1.5},
+                                         3.0, 0.35);
+        const Transform user = Transform::translate({u(rng), u(rng), u(rng)}) *
+                               Transform::rotate({u(rng), u(rng), 1.0}, 3 * u(rng)) *
+                               Transform::scale({1.2 + u(rng), 1.2 + u(rng), 1.2 + u(rng)});
+        const Transform xf = user * t.placement;
+        const Bounds3 b = t.shape->placed_bounds(xf);
+        Bounds3 seen;
+        for (int i = 0; i < 400; ++i)
+            for (int j = 0; j < 100; ++j) {
+                const double a = 2 * M_PI * i / 400, v = 2 * M_PI * j / 100;
+                const double ring = 3.0 + 0.35 * std::cos(v);
+                const Vec3 p = xf.point({ring * std::cos(a), ring * std::sin(a), 0.35 * std::sin(v)});
+                seen = merge(seen, Bounds3{p, p});
+            }
+        const double scale = max_component(b.extent());
+        for (std::size_t axis = 0; axis < 3; ++axis) {
+            EXPECT_LE(b.lo[axis], seen.lo[axis] + 1e-9) << k;
+            EXPECT_GE(b.hi[axis], seen.hi[axis] - 1e-9) << k;
+            EXPECT_NEAR(b.lo[axis], seen.lo[axis], 2e-3 * scale) << k;
+            EXPECT_NEAR(b.hi[axis], seen.hi[axis], 2e-3 * scale) << k;
+        }
+    }
 }
 
 }  // namespace

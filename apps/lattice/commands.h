@@ -20,5 +20,6 @@ Command add_rasterize_command(CLI::App& parent);
 Command add_table1_command(CLI::App& parent);
 Command add_compare_command(CLI::App& parent);
 Command add_inspect_command(CLI::App& parent);
+Command add_scatter_command(CLI::App& parent);
 
 }  // namespace lat::cli

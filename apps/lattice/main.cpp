@@ -1,4 +1,4 @@
-// `lattice`: one binary, several subcommands (render, rasterize, table1, compare, inspect).
+// `lattice`: one binary, several subcommands (render, rasterize, table1, compare, inspect, scatter).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
     commands.push_back(lat::cli::add_table1_command(app));
     commands.push_back(lat::cli::add_compare_command(app));
     commands.push_back(lat::cli::add_inspect_command(app));
+    commands.push_back(lat::cli::add_scatter_command(app));
 
     try {
         app.parse(argc, argv);

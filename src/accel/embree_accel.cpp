@@ -37,18 +37,18 @@ struct QueryContext {
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;
-    // Objects culled by several boxes that this query has already tested: a second box of the
-    // same object can add nothing (its answer for a shorter range is no closer). A small ring;
-    // an object that falls out of it is merely tested again.
+    // Objects culled by several parts that this query has already tested: a second part of
+    // the same object can add nothing (its answer for a shorter range is no closer). A small
+    // ring; an object that falls out of it is merely tested again.
     std::uint32_t tested[8];
     unsigned n_tested = 0;
-    bool first_test(std::uint32_t obj) {
+    bool tested_already(std::uint32_t obj) const {
         const unsigned n = std::min(n_tested, 8u);
         for (unsigned i = 0; i < n; ++i)
-            if (tested[i] == obj) return false;
-        tested[n_tested++ % 8] = obj;
-        return true;
+            if (tested[i] == obj) return true;
+        return false;
     }
+    void mark_tested(std::uint32_t obj) { tested[n_tested++ % 8] = obj; }
 };
 // Callbacks cast Embree's context pointer back to ours.
 static_assert(std::is_standard_layout_v<QueryContext> && offsetof(QueryContext, rtc) == 0);
@@ -118,11 +118,13 @@ struct EmbreeAccel::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<AccelObject> objects;
-    // The top-level user geometry of single-part objects: one primitive per cull box.
+    // The top-level user geometry of single-part objects: one primitive per cull part
+    // (Shape::cull_count).
     struct DirectPrim {
         std::uint32_t object;
-        bool shared;     // one of several boxes of its object
-        Bounds3 bounds;  // world space
+        std::uint32_t cull;  // the object's cull part
+        bool shared;         // one of several cull parts of its object
+        Bounds3 bounds;      // world space
     };
     std::vector<DirectPrim> direct;
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
@@ -160,6 +162,16 @@ struct EmbreeAccel::Impl {
         return ctx->cached_local;
     }
 
+    // Whether a direct primitive's object is to be tested: it was not tested already for this
+    // query, and the line meets the cull part.
+    bool first_visit(QueryContext* ctx, unsigned prim, const Shape& shape, const Ray& local) const {
+        const DirectPrim& d = direct[prim];
+        if (!d.shared) return true;
+        if (ctx->tested_already(d.object) || !shape.cull_meets(d.cull, local)) return false;
+        ctx->mark_tested(d.object);
+        return true;
+    }
+
     void record(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Crossing& c,
                 unsigned geom, unsigned prim, unsigned inst) const {
         ctx->found = true;
@@ -195,10 +207,10 @@ struct EmbreeAccel::Impl {
         const Impl* self = ctx->accel;
         const unsigned inst = args->context->instID[0];
         const Target t = self->template target<K>(args->primID, inst);
-        if constexpr (K == Kind::kDirect)
-            if (self->direct[args->primID].shared && !ctx->first_test(t.object)) return;
         const Shape& shape = *self->objects[t.object].shape;
         const Ray& local = self->local_ray(ctx, t.object);
+        if constexpr (K == Kind::kDirect)
+            if (!self->first_visit(ctx, args->primID, shape, local)) return;
         const double tmax = ctx->found ? ctx->hit->t : ctx->tmax;
         const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
         Crossing c;
@@ -221,10 +233,10 @@ struct EmbreeAccel::Impl {
         auto* ctx = reinterpret_cast<QueryContext*>(args->context);
         const Impl* self = ctx->accel;
         const Target t = self->template target<K>(args->primID, args->context->instID[0]);
-        if constexpr (K == Kind::kDirect)
-            if (self->direct[args->primID].shared && !ctx->first_test(t.object)) return;
         const Shape& shape = *self->objects[t.object].shape;
         const Ray& local = self->local_ray(ctx, t.object);
+        if constexpr (K == Kind::kDirect)
+            if (!self->first_visit(ctx, args->primID, shape, local)) return;
         const double tmin = self->occlusion_tmin(ctx, t.object, local);
         const bool hit = K == Kind::kDirect
                              ? shape.occluded(local, tmin, ctx->tmax)
@@ -302,7 +314,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
 
     for (std::uint32_t i = 0; i < m.objects.size(); ++i) {
         const AccelObject& o = m.objects[i];
-        const Bounds3 wb = o.xf->bounds(o.shape->bounds());
+        const Bounds3 wb = o.shape->placed_bounds(*o.xf);
         if (wb.empty()) continue;
         if (!embree_can_hold(wb)) {
             m.unbounded.push_back(i);
@@ -325,12 +337,13 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             rtcReleaseGeometry(g);
             if (m.inst_object.size() <= id) m.inst_object.resize(id + 1, 0);
             m.inst_object[id] = i;
+        } else if (o.shape->cull_count() == 1) {
+            m.direct.push_back({i, 0, false, wb});
         } else {
-            std::vector<Bounds3> boxes;
-            o.shape->cull_boxes(boxes);
-            std::erase_if(boxes, [](const Bounds3& b) { return b.empty(); });
-            for (const Bounds3& b : boxes)
-                m.direct.push_back({i, boxes.size() > 1, boxes.size() > 1 ? o.xf->bounds(b) : wb});
+            for (std::uint32_t c = 0; c < o.shape->cull_count(); ++c) {
+                const Bounds3 b = o.shape->cull_bounds(c, *o.xf);
+                if (!b.empty()) m.direct.push_back({i, c, true, b});
+            }
         }
     }
     if (!m.direct.empty())

@@ -72,7 +72,7 @@ void combine_spans(const SpanList& a, const SpanList& b, CsgOp op, SpanList& out
 }
 
 int CsgShape::add_leaf(CsgLeaf leaf) {
-    const Bounds3 b = leaf.xf.bounds(leaf.shape->bounds());
+    const Bounds3 b = leaf.shape->placed_bounds(leaf.xf);
     leaves_.push_back({std::move(leaf), b});
     return -static_cast<int>(leaves_.size());
 }
@@ -107,6 +107,21 @@ Bounds3 CsgShape::compute_bounds(int ref) {
         else if (n.op == CsgOp::kIntersection) b = lat::intersect(b, c);
     }
     n.bounds = b;
+    return b;
+}
+
+Bounds3 CsgShape::placed_bounds(int ref, const Transform& xf) const {
+    if (is_leaf_ref(ref)) {
+        const CsgLeaf& leaf = leaves_[leaf_of(ref)].leaf;
+        return leaf.shape->placed_bounds(xf * leaf.xf);
+    }
+    const Node& n = nodes_[static_cast<std::size_t>(ref)];
+    Bounds3 b = placed_bounds(n.children[0], xf);
+    for (std::size_t k = 1; k < n.children.size(); ++k) {
+        if (n.op == CsgOp::kDifference) break;  // within the first child's
+        const Bounds3 c = placed_bounds(n.children[k], xf);
+        b = n.op == CsgOp::kUnion ? merge(b, c) : lat::intersect(b, c);
+    }
     return b;
 }
 

@@ -16,6 +16,29 @@ double horner(const double g[5], double u) {
 AlgebraicShape::AlgebraicShape(const Poly3& f, const Bounds3& bounds, Vec3 center)
     : f_(f), bounds_(bounds), center_(center), degree_(f.degree()) {}
 
+AlgebraicShape::AlgebraicShape(const Poly3& f, const Bounds3& bounds, Vec3 center,
+                               RingExtent extent)
+    : AlgebraicShape(f, bounds, center) {
+    has_extent_ = true;
+    extent_ = extent;
+}
+
+// The solid lies in circle + ball, so its image under x -> M x + t lies in M circle + M ball,
+// whose support along world axis k is the sum of theirs: with m the k-th row of M,
+// ring |m projected onto the z = 0 plane| + ball |m|. (A torus of major radius R, minor r
+// about unit axis n under a rotation: R sqrt(1 - n_k^2) + r, its exact extent.)
+Bounds3 AlgebraicShape::placed_bounds(const Transform& xf) const {
+    if (!has_extent_) return Shape::placed_bounds(xf);
+    const Affine& a = xf.forward();
+    Vec3 e;
+    for (std::size_t k = 0; k < 3; ++k) {
+        const Vec3& m = a.m.r[k];
+        e[k] = extent_.ring * std::sqrt(m.x * m.x + m.y * m.y) + extent_.ball * length(m);
+    }
+    const Vec3 c = xf.point({0, 0, 0});
+    return lat::intersect({c - e, c + e}, Shape::placed_bounds(xf));
+}
+
 bool AlgebraicShape::line_roots(const Ray& r, LineRoots& out) const {
     out.count = 0;
     const double len = length(r.d);

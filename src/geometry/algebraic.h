@@ -14,10 +14,19 @@ public:
     // accuracy for far-away rays).
     AlgebraicShape(const Poly3& f, const Bounds3& bounds, Vec3 center);
 
+    // A torus-like extent: every point of the solid lies within `ball` of the circle of radius
+    // `ring` about the origin in the plane z = 0 (a torus: major and minor radius; a sphere:
+    // ring 0). It makes placed_bounds exact under any transform.
+    struct RingExtent {
+        double ring = 0, ball = 0;
+    };
+    AlgebraicShape(const Poly3& f, const Bounds3& bounds, Vec3 center, RingExtent extent);
+
     const Poly3& polynomial() const { return f_; }
     int degree() const { return degree_; }
 
     Bounds3 bounds() const override { return bounds_; }
+    Bounds3 placed_bounds(const Transform& xf) const override;
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
@@ -38,6 +47,8 @@ private:
     Bounds3 bounds_;
     Vec3 center_;
     int degree_;
+    bool has_extent_ = false;
+    RingExtent extent_;
 };
 
 }  // namespace lat

@@ -75,6 +75,17 @@ Vec3 ChainShape::normal(const Ray& r, const Crossing& c) const {
     return part(c.part >> 2).normal(r, {c.t, c.part & 3u, 0});
 }
 
+bool ChainShape::primitive_capsule(std::size_t i, Capsule& out) const {
+    if (i < spheres_.size()) {
+        out = {spheres_[i].center, spheres_[i].center, spheres_[i].radius};
+    } else {
+        const ChainCylinder& c = cylinders_[i - spheres_.size()];
+        out = {spheres_[static_cast<std::size_t>(c.from)].center,
+               spheres_[static_cast<std::size_t>(c.to)].center, c.radius};
+    }
+    return true;
+}
+
 bool ChainShape::inside(Vec3 p) const {
     for (std::size_t i = 0; i < primitive_count(); ++i)
         if (part(i).inside(p)) return true;

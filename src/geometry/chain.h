@@ -54,6 +54,8 @@ public:
     }
     void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
     void primitive_spans(std::size_t i, const Ray& r, SpanList& out) const override;
+    // Spheres are capsules; so is the flat-ended cylinder's rim, within r of its axis segment.
+    bool primitive_capsule(std::size_t i, Capsule& out) const override;
     bool occluded_primitive(std::size_t i, const Ray& r, double tmin, double tmax) const override {
         return part(i).occluded(r, tmin, tmax);
     }

@@ -85,7 +85,9 @@ PlacedShape make_torus(Vec3 center, Vec3 axis, double R, double r) {
     f.at(0, 0, 2) = 2 * k;
     f.at(0, 0, 0) = k * k;
     const double e = R + r;
-    return algebraic(f, {{-e, -e, -r}, {e, e, r}}, frame_transform(center, axis));
+    const Bounds3 box{{-e, -e, -r}, {e, e, r}};
+    return {std::make_shared<AlgebraicShape>(f, box, Vec3{}, AlgebraicShape::RingExtent{R, r}),
+            frame_transform(center, axis)};
 }
 
 PlacedShape make_algebraic(const Poly3& f, const Bounds3& bounds) {

@@ -5,6 +5,14 @@
 
 namespace lat {
 
+Bounds3 Capsule::placed_bounds(const Transform& xf) const {
+    const Affine& m = xf.forward();
+    Vec3 e;
+    for (std::size_t i = 0; i < 3; ++i) e[i] = r * length(m.m.r[i]);
+    const Vec3 pa = xf.point(a), pb = xf.point(b);
+    return {min(pa, pb) - e, max(pa, pb) + e};
+}
+
 bool first_crossing(const SpanList& spans, double tmin, double tmax, Crossing& hit) {
     for (const Span& s : spans) {
         if (s.in.t >= tmax) return false;

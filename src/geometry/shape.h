@@ -1,6 +1,7 @@
 #pragma once
 // The solid-shape interface: every leaf of the scene (quartic, sphere, sphere/cylinder chain,
 // lattice instance) and every CSG tree implements it in its own coordinates.
+#include <algorithm>
 #include <cstdint>
 #include <string_view>
 #include <vector>
@@ -18,6 +19,43 @@ inline constexpr double kTouchTolerance = 1e-9;
 struct BoundingSphere {
     Vec3 center;
     double radius;
+};
+
+// The points within distance r of the segment [a, b] (a sphere when a = b).
+struct Capsule {
+    Vec3 a, b;
+    double r;
+
+    // Whether the line o + t d (d non-zero) comes within r of the segment. With w = o - a
+    // and u = b - a projected across the line (pw, pu), the squared distance from the line to
+    // a + s u is |s pu - pw|^2, minimised over s in [0, 1]; the interior case is compared
+    // multiplied through by |pu|^2, so the one division is 1 / |d|^2 (lattice culling calls
+    // this for every ray that meets a capsule's box).
+    bool meets_line(Vec3 o, Vec3 d) const {
+        const double inv_dd = 1.0 / dot(d, d);
+        const Vec3 w = o - a, u = b - a;
+        const Vec3 pw = w - d * (dot(w, d) * inv_dd), pu = u - d * (dot(u, d) * inv_dd);
+        const double uu = dot(pu, pu), wu = dot(pw, pu), ww = dot(pw, pw), rr = r * r;
+        if (wu <= 0) return ww <= rr;                      // nearest at a
+        if (wu >= uu) return uu - 2 * wu + ww <= rr;       // nearest at b
+        return ww * uu - wu * wu <= rr * uu;               // nearest inside
+    }
+    // Whether c lies inside: both ends of its segment within r - c.r of this segment (the
+    // distance to a segment is convex along c's segment).
+    bool contains(const Capsule& c) const {
+        const double slack = r - c.r;
+        return slack >= 0 && distance_squared(c.a) <= slack * slack &&
+               distance_squared(c.b) <= slack * slack;
+    }
+    double distance_squared(Vec3 p) const {
+        const Vec3 u = b - a, w = p - a;
+        const double uu = dot(u, u);
+        const double s = uu > 0 ? std::clamp(dot(w, u) / uu, 0.0, 1.0) : 0.0;
+        return length_squared(w - u * s);
+    }
+    // Its box under xf: the box of the placed segment grown by the placed ball's half-extents
+    // (r times the length of each row of the linear part), exact for the swept ellipsoid.
+    Bounds3 placed_bounds(const Transform& xf) const;
 };
 
 // A hit's place on its surface and the outward unit normal there.
@@ -119,11 +157,22 @@ public:
         out.push_back({b.center(), 0.5 * length(b.extent())});
     }
 
-    // Boxes (shape coordinates) that the accelerator culls with: a ray gets a crossing from
-    // this shape only at a point inside one of them (and a shadow ray is occluded only if it
-    // passes through one). By default the bounds; a lattice gives a few boxes hugging its
-    // primitive, much tighter than its lattice box.
-    virtual void cull_boxes(std::vector<Bounds3>& out) const { out.push_back(bounds()); }
+    // A capsule holding primitive i, when the shape knows one (chains do): lattices cull with
+    // them, grown by how far their answers can stray.
+    virtual bool primitive_capsule(std::size_t, Capsule&) const { return false; }
+
+    // Culling parts: regions the accelerator prunes rays with, for shapes it answers as a whole
+    // (a lattice gives parts hugging its primitive, much tighter than its lattice box). A ray
+    // gets a crossing from this shape only if its line meets one of them, and a shadow ray is
+    // occluded only if it does. By default one part, the bounds.
+    virtual std::size_t cull_count() const { return 1; }
+    // The bounds of cull part i placed by xf.
+    virtual Bounds3 cull_bounds(std::size_t, const Transform& xf) const {
+        return placed_bounds(xf);
+    }
+    // Whether the line of r (shape coordinates) can meet cull part i, for a line that meets its
+    // bounds: a cheap test that saves the shape's own.
+    virtual bool cull_meets(std::size_t, const Ray&) const { return true; }
 
     // CSG trees carry a material tag per leaf; other shapes answer with the fallback.
     virtual std::uint32_t tag(const Crossing&, std::uint32_t fallback) const { return fallback; }

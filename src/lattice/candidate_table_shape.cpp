@@ -8,13 +8,9 @@ CandidateTableShape::CandidateTableShape(std::shared_ptr<const LatticeTable> tab
                                          const TableContext& ctx)
     : table_(std::move(table)),
       primitive_(ctx.primitive),
-      frame_(ctx, 0.0),
+      frame_(ctx, 0.0),  // answers are the primitive's own crossings
       boxes_(*ctx.primitive, frame_.box()) {
     assert(primitive_ && table_->kind() == LatticeTable::Kind::kCandidates);
-}
-
-void CandidateTableShape::cull_boxes(std::vector<Bounds3>& out) const {
-    out.insert(out.end(), frame_.cull_boxes().begin(), frame_.cull_boxes().end());
 }
 
 bool CandidateTableShape::candidates(const Ray& r, CandidateList& list) const {

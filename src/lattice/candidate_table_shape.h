@@ -23,7 +23,11 @@ public:
         return primitive_->normal(r, c);
     }
     bool inside(Vec3 p) const override { return primitive_->inside(p); }
-    void cull_boxes(std::vector<Bounds3>& out) const override;
+    std::size_t cull_count() const override { return frame_.cull_count(); }
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf) const override {
+        return frame_.cull_bounds(i, xf);
+    }
+    bool cull_meets(std::size_t i, const Ray& r) const override { return frame_.cull_meets(i, r); }
 
 private:
     std::shared_ptr<const LatticeTable> table_;

@@ -29,21 +29,17 @@ const RayFootprint& ray_footprint() { return t_footprint; }
 
 FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
                                            double table_error)
-    : filter_(filter), point_(levels.back().table, levels.back().ctx, table_error) {
+    // The point-sampled finest level reaches as far as make_lattice_shape's lattices do.
+    : filter_(filter),
+      point_(levels.back().table, levels.back().ctx,
+             levels.back().ctx.cell * kSnapReach + table_error) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
     for (std::size_t i = 0; i < levels.size(); ++i) {
         const FilterLevel& l = levels[i];
-        // Only the coarsest level's frame culls (its reach is the largest); LatticeFrame grows
-        // its boxes by kSnapReach cells plus the error it is given.
-        const double grow = i == 0 ? (reach_cells(filter) - kSnapReach) * l.ctx.cell + table_error
-                                   : kInfinity;
-        levels_.push_back({l.table, LatticeFrame(l.ctx, grow), BoundaryGrid(l.ctx.cells)});
+        // Only the coarsest level's frame culls (its reach is the largest).
+        const double reach = i == 0 ? reach_cells(filter) * l.ctx.cell + table_error : kInfinity;
+        levels_.push_back({l.table, LatticeFrame(l.ctx, reach), BoundaryGrid(l.ctx.cells)});
     }
-}
-
-void FilteredLatticeShape::cull_boxes(std::vector<Bounds3>& out) const {
-    const auto& boxes = levels_.front().frame.cull_boxes();
-    out.insert(out.end(), boxes.begin(), boxes.end());
 }
 
 void FilteredLatticeShape::add_pair(const Level& l, const GridPoint& a, const GridPoint& b, double w,

@@ -62,7 +62,14 @@ public:
     void spans(const Ray& r, SpanList& out) const override { point_.spans(r, out); }
     Vec3 normal(const Ray&, const Crossing& c) const override { return c.stored.n; }
     bool inside(Vec3 p) const override { return point_.inside(p); }
-    void cull_boxes(std::vector<Bounds3>& out) const override;
+    // Culled by the coarsest level's frame, whose reach is the largest.
+    std::size_t cull_count() const override { return levels_.front().frame.cull_count(); }
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf) const override {
+        return levels_.front().frame.cull_bounds(i, xf);
+    }
+    bool cull_meets(std::size_t i, const Ray& r) const override {
+        return levels_.front().frame.cull_meets(i, r);
+    }
     double surface_tolerance() const override { return 2.0 * levels_.front().frame.cell(); }
 
 private:

@@ -5,12 +5,8 @@
 namespace lat {
 
 HitTableShape::HitTableShape(std::shared_ptr<const LatticeTable> table, const TableContext& ctx,
-                             double hit_error)
-    : table_(std::move(table)), frame_(ctx, hit_error) {}
-
-void HitTableShape::cull_boxes(std::vector<Bounds3>& out) const {
-    out.insert(out.end(), frame_.cull_boxes().begin(), frame_.cull_boxes().end());
-}
+                             double reach)
+    : table_(std::move(table)), frame_(ctx, reach) {}
 
 bool HitTableShape::line_hits(const Ray& r, LineHits& lh, double need_last_below) const {
     LatticeFrame::Snap s;

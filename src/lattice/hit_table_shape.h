@@ -13,7 +13,7 @@ namespace lat {
 class HitTableShape final : public Shape {
 public:
     HitTableShape(std::shared_ptr<const LatticeTable> table, const TableContext& ctx,
-                  double hit_error);
+                  double reach);
 
     Bounds3 bounds() const override { return frame_.box(); }
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
@@ -22,7 +22,11 @@ public:
     // Crossings of this shape always carry their stored point and normal.
     Vec3 normal(const Ray&, const Crossing& c) const override { return c.stored.n; }
     bool inside(Vec3 p) const override;
-    void cull_boxes(std::vector<Bounds3>& out) const override;
+    std::size_t cull_count() const override { return frame_.cull_count(); }
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf) const override {
+        return frame_.cull_bounds(i, xf);
+    }
+    bool cull_meets(std::size_t i, const Ray& r) const override { return frame_.cull_meets(i, r); }
     // Rays leaving a point found through this lattice skip crossings within this distance of
     // it: the table's own error, which would otherwise shade the surface by itself (acne).
     double surface_tolerance() const override { return 2.0 * frame_.cell(); }

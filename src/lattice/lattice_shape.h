@@ -15,18 +15,24 @@
 
 namespace lat {
 
-// The box, its boundary grid, the snapping of rays to grid point pairs, and the boxes a
-// lattice is culled with: what both lattice shapes share.
+// The box, its boundary grid, the snapping of rays to grid point pairs, and the parts a
+// lattice is culled with (Shape::cull_count): what both lattice shapes share.
 class LatticeFrame {
 public:
-    // ctx.primitive, when set, lets the cull boxes hug the primitive; hit_error: how far a
-    // stored hit can lie from the primitive (Encoding::error_bound), infinity when unknown,
-    // which culls with the lattice box alone.
-    LatticeFrame(const TableContext& ctx, double hit_error);
+    // reach: how far from the primitive (primitive units) the ray's point at an answer can lie,
+    // infinity when unknown, which culls with the lattice box alone. ctx.primitive, when set,
+    // lets the cull parts hug the primitive.
+    LatticeFrame(const TableContext& ctx, double reach);
 
     const Bounds3& box() const { return box_; }
-    const std::vector<Bounds3>& cull_boxes() const { return cull_; }
     double cell() const { return cell_; }
+
+    // See Shape::cull_count, cull_bounds and cull_meets.
+    std::size_t cull_count() const { return cull_.size(); }
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf) const;
+    bool cull_meets(std::size_t i, const Ray& r) const {
+        return capsules_.empty() || capsules_[i].meets_line(r.o, r.d);
+    }
 
     // The ray's line in lattice units, and its snapped entry and exit points.
     struct Snap {
@@ -40,10 +46,14 @@ public:
 private:
     BoundaryGrid grid_;
     double cell_, inv_cell_;
-    Bounds3 box_;                // primitive units
-    std::vector<Bounds3> cull_;  // see make_cull_boxes
+    Bounds3 box_;  // primitive units
+    // Culling, primitive units: capsules around the primitive's parts grown by the reach, when
+    // it has them, with their boxes clipped to the lattice box; else boxes alone.
+    std::vector<Capsule> capsules_;
+    std::vector<Bounds3> cull_;
 
-    void make_cull_boxes(const Shape* primitive, double hit_error);
+    void make_cull_boxes(const Shape* primitive, double reach);
+    bool make_cull_capsules(const Shape* primitive, double reach);
 };
 
 // Lattice visits (snaps of a ray to a grid point pair: one per call of a lattice shape's
@@ -52,7 +62,8 @@ private:
 std::uint64_t lattice_visits_this_thread();
 
 // The shape for a table of either kind; ctx.primitive must be set (candidate tables intersect
-// it; both cull by it) and outlive the shape.
+// it; both cull by it) and outlive the shape. hit_error: how far a stored hit can lie from the
+// primitive (Encoding::error_bound), infinity when unknown.
 std::shared_ptr<const Shape> make_lattice_shape(std::shared_ptr<const LatticeTable> table,
                                                 const TableContext& ctx, double hit_error);
 

@@ -1,8 +1,11 @@
 #include "scene/object_parser.h"
 
 #include <cmath>
+#include <filesystem>
 
 #include "geometry/named_shapes.h"
+#include "io/mesh_file.h"
+#include "util/error.h"
 #include "geometry/polynomial_parser.h"
 #include "scene/scene_loader.h"
 
@@ -11,7 +14,7 @@ namespace {
 
 const char* const kTypes =
     "sphere, ellipsoid, halfspace, cylinder, cone, paraboloid, hyperboloid1, hyperboloid2, "
-    "torus, quartic, instance, csg";
+    "torus, quartic, mesh, instance, csg, scatter";
 
 Poly3 parse_quartic_polynomial(const JsonValue& v) {
     const bool text = v.has("polynomial"), coefs = v.has("coefficients");
@@ -79,7 +82,7 @@ std::uint32_t ObjectParser::material(const JsonValue& v) const {
 
 ObjectParser::Leaf ObjectParser::parse_leaf(const JsonValue& v, const std::string& type) const {
     auto keys = [&](std::initializer_list<const char*> extra) {
-        std::vector<const char*> all{"type", "material", "transform"};
+        std::vector<const char*> all{"type", "name", "material", "transform"};
         all.insert(all.end(), extra.begin(), extra.end());
         v.allow_keys(all, (type[0] == 'e' || type[0] == 'i' ? "an " : "a ") + type);
     };
@@ -136,6 +139,10 @@ ObjectParser::Leaf ObjectParser::parse_leaf(const JsonValue& v, const std::strin
         keys({"polynomial", "constants", "coefficients"});
         return placed(make_algebraic(parse_quartic_polynomial(v), Bounds3::infinite()));
     }
+    if (type == "mesh") {
+        keys({"file"});
+        return {mesh(v.at("file")), Transform{}, -1};
+    }
     if (type == "instance") {
         keys({"primitive"});
         const JsonValue p = v.at("primitive");
@@ -161,7 +168,7 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
     if (auto t = v.find("transform")) xf = to_root * parse_transform(*t);
 
     if (type == "csg") {
-        v.allow_keys({"type", "op", "children", "material", "transform"});
+        v.allow_keys({"type", "name", "op", "children", "material", "transform"});
         if (!override_material)
             if (auto m = v.find("material")) override_material = material(*m);
         const JsonValue opv = v.at("op");
@@ -181,9 +188,14 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
         return csg.add_node(cop, std::move(refs));
     }
 
+    if (type == "scatter") v.at("type").fail("a scatter cannot be a csg leaf (it is many objects)");
     if (type == "instance" && override_material == kNoMaterial)
         v.at("type").fail("a primitive cannot contain instances");
     Leaf leaf = parse_leaf(v, type);
+    if (const auto* m = dynamic_cast<const TriangleMeshShape*>(leaf.shape.get()); m && !m->closed())
+        v.at("file").fail(
+            "an open mesh cannot be a csg leaf: it bounds no solid (a closed mesh has every edge "
+            "shared by exactly two triangles, wound the same way)");
     std::uint32_t mat;
     if (override_material) {
         mat = *override_material;
@@ -196,6 +208,23 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
     const Transform placed = xf * leaf.placement;
     require_finite_transform(placed, v);
     return csg.add_leaf({leaf.shape, placed, mat, leaf.primitive});
+}
+
+std::shared_ptr<const TriangleMeshShape> ObjectParser::mesh(const JsonValue& file) const {
+    const std::filesystem::path name(file.string());
+    const std::string path = name.is_absolute() || file.file().empty()
+                                 ? name.string()
+                                 : (std::filesystem::path(file.file()).parent_path() / name).string();
+    if (auto it = meshes_.find(path); it != meshes_.end()) return it->second;
+    try {
+        MeshData m = read_mesh_file(path);
+        auto shape = std::make_shared<const TriangleMeshShape>(
+            std::move(m.positions), std::move(m.triangles), std::move(m.normals));
+        meshes_[path] = shape;
+        return shape;
+    } catch (const InputError& e) {
+        file.fail(e.what());
+    }
 }
 
 std::shared_ptr<const Shape> ObjectParser::parse_shape(const JsonValue& v) const {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "csg/csg_shape.h"
+#include "geometry/triangle_mesh.h"
 #include "scene/json_reader.h"
 #include "scene/scene.h"
 
@@ -24,10 +25,17 @@ public:
     // The solid alone, materials ignored (for primitives given as an object; instances of
     // them take the instance's material).
     std::shared_ptr<const Shape> parse_shape(const JsonValue& v) const;
+    // The index of the material named by v.
+    std::uint32_t material_index(const JsonValue& v) const { return material(v); }
+    // The mesh named by a "file" field, relative to the scene file's directory.
+    std::shared_ptr<const TriangleMeshShape> mesh(const JsonValue& file) const;
 
 private:
     const std::map<std::string, std::uint32_t>& materials_;
     const std::vector<Primitive>& primitives_;
+
+    // Meshes by resolved path, read once per scene however often they are used.
+    mutable std::map<std::string, std::shared_ptr<const TriangleMeshShape>> meshes_;
 
     std::uint32_t material(const JsonValue& v) const;
     // A leaf's geometry in its own frame, with the placement that its parameters imply.

@@ -38,6 +38,13 @@ struct SceneObject {
     std::string where;                   // e.g. "objects[12]", for messages
 };
 
+// A scatter object of the file, expanded into objects [first, first + count).
+struct ScatterGroup {
+    std::string name;        // its "name", or empty
+    std::size_t json_index;  // in the file's "objects"
+    std::size_t first = 0, count = 0;
+};
+
 struct Scene {
     std::string file;
     std::string format;
@@ -49,6 +56,7 @@ struct Scene {
     std::vector<Material> materials;
     std::vector<Primitive> primitives;
     std::vector<SceneObject> objects;
+    std::vector<ScatterGroup> scatters;
 };
 
 }  // namespace lat

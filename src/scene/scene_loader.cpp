@@ -4,6 +4,7 @@
 #include <map>
 
 #include "scene/object_parser.h"
+#include "scene/scatter.h"
 #include "util/error.h"
 #include "util/file.h"
 #include "util/hash.h"
@@ -132,6 +133,69 @@ Primitive parse_primitive(const JsonValue& v, const std::string& name, const Obj
     return p;
 }
 
+namespace {
+
+std::optional<std::string> name_of(const JsonValue& v) {
+    if (!v.is_object()) return std::nullopt;
+    if (auto n = v.find("name")) return n->string();
+    return std::nullopt;
+}
+
+// The surface a scatter covers: an object given inline (drawn too), or another object of the
+// list named by "name" or by index.
+JsonValue scatter_target(const JsonValue& sc, const JsonValue& objects,
+                         const std::map<std::string, std::size_t>& names,
+                         const ObjectParser& parser, Scene& s) {
+    const JsonValue on = sc.at("on");
+    if (on.is_object()) {
+        if (on.has("type") && on.at("type").is_string() && on.at("type").string() == "scatter")
+            on.fail("a scatter cannot cover another scatter");
+        s.objects.push_back(parser.parse(on));
+        return on;
+    }
+    if (on.is_string()) {
+        auto it = names.find(on.string());
+        if (it == names.end()) on.fail("no object is named '" + on.string() + "'");
+        return objects[it->second];
+    }
+    const int i = on.integer();
+    if (i < 0 || static_cast<std::size_t>(i) >= objects.size())
+        on.fail("object index " + std::to_string(i) + " does not exist (there are " +
+                std::to_string(objects.size()) + " objects, numbered from 0)");
+    const JsonValue target = objects[static_cast<std::size_t>(i)];
+    if (target.at("type").string() == "scatter") on.fail("a scatter cannot cover another scatter");
+    return target;
+}
+
+// Objects first, then scatters (which may name objects anywhere in the list) expanded into
+// instances after them.
+void load_objects(const JsonValue& objects, const ObjectParser& parser, Scene& s) {
+    std::map<std::string, std::size_t> names;
+    std::vector<std::size_t> scatters;
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        const JsonValue o = objects[i];
+        if (auto n = name_of(o)) {
+            if (!names.emplace(*n, i).second) o.at("name").fail("another object is named '" + *n + "'");
+        }
+        if (o.is_object() && o.has("type") && o.at("type").is_string() &&
+            o.at("type").string() == "scatter") {
+            scatters.push_back(i);
+            continue;
+        }
+        s.objects.push_back(parser.parse(o));
+    }
+    for (const std::size_t i : scatters) {
+        const JsonValue sc = objects[i];
+        const JsonValue on = scatter_target(sc, objects, names, parser, s);
+        ScatterGroup g{name_of(sc).value_or(""), i, s.objects.size(), 0};
+        expand_scatter(sc, on, parser, s.primitives, s.objects);
+        g.count = s.objects.size() - g.first;
+        s.scatters.push_back(g);
+    }
+}
+
+}  // namespace
+
 Scene load_scene_text(const std::string& text, const std::string& file) {
     const nlohmann::json doc = parse_json_text(text, file);
     const JsonValue root(doc, "", file);
@@ -173,8 +237,7 @@ Scene load_scene_text(const std::string& text, const std::string& file) {
         for (const std::string& name : prims->keys())
             s.primitives.push_back(parse_primitive(prims->at(name), name, &parser));
     }
-    const JsonValue objects = root.at("objects");
-    for (std::size_t i = 0; i < objects.size(); ++i) s.objects.push_back(parser.parse(objects[i]));
+    load_objects(root.at("objects"), parser, s);
     return s;
 }
 

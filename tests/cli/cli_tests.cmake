@@ -74,7 +74,7 @@ set_tests_properties(cli.threads_identical PROPERTIES FIXTURES_REQUIRED "threads
 # Lattice tables: bad cache directories, corrupt, truncated and mismatched tables, sizes that
 # cannot fit, and the cache itself.
 foreach(case corrupt truncated other_primitive missing_dir not_a_dir too_big unknown_primitive
-             candidates_any_parts sigma_inv_range unknown_encoding point_limit outside_box
+             candidates_any_parts sigma_inv_range unknown_encoding point_limit outside_box tilted_tori_fit
              render_then_reuse filter filter_errors)
   add_test(NAME cli.lattice_${case}
     COMMAND ${CMAKE_COMMAND} -DLATTICE=$<TARGET_FILE:lattice> -DEXAMPLES=${PROJECT_SOURCE_DIR}/examples -DDATA=${CMAKE_CURRENT_SOURCE_DIR}/data
@@ -90,3 +90,25 @@ if(Python3_Interpreter_FOUND)
             -DGEN=${PROJECT_SOURCE_DIR}/bench/complexity_scenes.py -DWORK=${CLI_OUT}/complexity
             -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/complexity_scenes.cmake)
 endif()
+
+# Meshes and scatters (issue 12): bad files and bad parameters, one located line, exit 2.
+lattice_cli_error(mesh_missing ${BAD}/mesh-missing.json "mesh-missing.json: objects\\[1\\]\\.file: .*no-such-mesh.obj: cannot open mesh file: No such file or directory")
+lattice_cli_error(mesh_no_triangles ${BAD}/mesh-no-triangles.json "objects\\[1\\]\\.file: .*no-triangles.obj: the mesh has no triangles")
+lattice_cli_error(mesh_huge_claim ${BAD}/mesh-huge-claim.json "objects\\[1\\]\\.file: .*huge-claim.ply: the PLY header claims 99999999 vertex elements")
+lattice_cli_error(mesh_nan_obj ${BAD}/mesh-nan-obj.json "objects\\[1\\]\\.file: .*nan-vertex.obj: line 3: 'nan' is not a finite number")
+lattice_cli_error(mesh_nan_ply ${BAD}/mesh-nan-ply.json "objects\\[1\\]\\.file: .*nan-vertex.ply: line 11: 'nan' is not a finite number")
+lattice_cli_error(mesh_bad_index ${BAD}/mesh-bad-index.json "objects\\[1\\]\\.file: .*bad-index.obj: cannot read mesh: OBJ: vertex index out of range")
+lattice_cli_error(mesh_random_bytes ${BAD}/mesh-random-bytes.json "objects\\[1\\]\\.file: .*random-bytes.ply: cannot read mesh")
+lattice_cli_error(mesh_open_in_csg ${BAD}/mesh-open-in-csg.json "objects\\[0\\]\\.children\\[1\\]\\.file: an open mesh cannot be a csg leaf")
+lattice_cli_error(scatter_huge_count ${BAD}/scatter-huge-count.json "objects\\[0\\]\\.count: 1000000000 instances is over the limit of 2000000")
+lattice_cli_error(scatter_no_box ${BAD}/scatter-no-box.json "objects\\[0\\]: missing field 'box': a cone is unbounded")
+lattice_cli_error(scatter_bad_scale ${BAD}/scatter-bad-scale.json "objects\\[0\\]\\.scale: min is over max")
+foreach(mode exact lattice)
+  add_test(NAME cli.scatter_mesh_renders_${mode}
+    COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;-q;--mode;${mode};--lattice-dir;${CLI_OUT};${BAD}/scatter-mesh-good.json;-o;${CLI_OUT}/scatter-${mode}.png"
+            -DEXIT=0 -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+endforeach()
+add_test(NAME cli.scatter_command_unknown_name
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;scatter;${BAD}/scatter-mesh-good.json;--object;fur;-o;${CLI_OUT}/placed.json"
+          -DEXIT=2 "-DPATTERN=scatter-mesh-good.json: objects: no scatter is named 'fur'"
+          -DNO_FILE=${CLI_OUT}/placed.json -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)

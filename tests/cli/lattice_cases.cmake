@@ -106,6 +106,10 @@ elseif(CASE STREQUAL "point_limit")
 elseif(CASE STREQUAL "outside_box")
   run(2 "outside-box\\.json: primitives\\.blob: primitive 'blob' reaches outside its lattice box \\[0, 1\\] x \\[0, 1\\] x \\[0, 1\\]"
       ${LATTICE} rasterize -q ${LIMITS}/outside-box.json --primitive blob -o ${WORK}/t.lht)
+elseif(CASE STREQUAL "tilted_tori_fit")
+  # Tori tilted in every direction, major 3 + minor 0.35 about the centre of an 8^3 box: their
+  # exact extents fit, where the box around each transformed torus box did not.
+  run(0 "" ${LATTICE} rasterize -q ${LIMITS}/tilted-tori.json --primitive rings -o ${WORK}/t.lht)
 elseif(CASE STREQUAL "render_then_reuse")
   # A lattice render builds its table once, then finds it in the cache.
   run(0 "1 table .*1 built" ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/a.png)

@@ -1,0 +1,64 @@
+#pragma once
+// A triangle mesh as a shape: traced exactly in double precision (Moller-Trumbore), shaded
+// smoothly with vertex normals (the file's, or area-weighted averages of the faces around each
+// vertex). Each triangle is one primitive, so the accelerator holds them one by one. A closed
+// mesh (every edge shared by exactly two triangles, consistently oriented) is also a solid for
+// CSG, inside by ray parity; an open one is only a surface.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "geometry/mesh_bvh.h"
+#include "geometry/shape.h"
+
+namespace lat {
+
+// Moller-Trumbore: the ray parameter t and barycentrics (u, v) of the crossing with triangle
+// (a, b, c), the point being (1-u-v) a + u b + v c. Edges count (with a tolerance of 1e-12 in
+// barycentrics), so that a ray through a shared edge is never lost between two triangles.
+bool intersect_triangle(const Ray& r, Vec3 a, Vec3 b, Vec3 c, double& t, double& u, double& v);
+
+class TriangleMeshShape final : public Shape {
+public:
+    using Triangle = std::array<std::uint32_t, 3>;
+    // Inputs must be valid (finite, indices in range: io/mesh_file.h checks files); `normals`
+    // per vertex, or empty to compute them.
+    TriangleMeshShape(std::vector<Vec3> positions, std::vector<Triangle> triangles,
+                      std::vector<Vec3> normals = {});
+
+    bool closed() const { return closed_; }
+    const std::vector<Vec3>& positions() const { return positions_; }
+    const std::vector<Triangle>& triangles() const { return triangles_; }
+    // The unit face normal (outward for a closed mesh) and the smooth normal at (u, v).
+    Vec3 face_normal(std::size_t tri) const;
+    Vec3 shading_normal(std::size_t tri, double u, double v) const;
+
+    Bounds3 bounds() const override { return bounds_; }
+    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
+    bool occluded(const Ray& r, double tmin, double tmax) const override;
+    void spans(const Ray& r, SpanList& out) const override;
+    Vec3 normal(const Ray& r, const Crossing& c) const override;
+    bool inside(Vec3 p) const override;
+    bool names_surface(const Crossing& c) const override { return c.part < triangles_.size(); }
+
+    std::size_t primitive_count() const override { return triangles_.size(); }
+    Bounds3 primitive_bounds(std::size_t i) const override;
+    Bounds3 primitive_bounds(std::size_t i, const Transform& xf) const override;
+    bool intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
+                             Crossing& hit) const override;
+    bool occluded_primitive(std::size_t i, const Ray& r, double tmin, double tmax) const override;
+
+private:
+    std::vector<Vec3> positions_;
+    std::vector<Triangle> triangles_;
+    std::vector<Vec3> normals_;  // unit, per vertex
+    Bounds3 bounds_;
+    MeshBvh bvh_;
+    bool closed_ = false;
+    bool flip_ = false;  // closed and wound inwards: face normals are turned to point out
+
+    void compute_normals();
+    void check_closed();
+};
+
+}  // namespace lat

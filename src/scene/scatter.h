@@ -1,0 +1,25 @@
+#pragma once
+// "scatter" objects: many instances of a primitive placed over the surface of another object
+// (sphere, ellipsoid, any named quadric within a box, torus, half-space patch, triangle mesh),
+// area-uniformly or as Poisson-disk (blue) noise, deterministically for a seed. The loader
+// expands each scatter into ordinary instance objects, so both render modes trace them as any
+// other instance. docs/scene-format.md describes the fields.
+#include <cstddef>
+#include <vector>
+
+#include "scene/json_reader.h"
+#include "scene/object_parser.h"
+#include "scene/scene.h"
+
+namespace lat {
+
+// Far more instances than a render wants (100,000 load and build in about a second); each
+// takes some 250 bytes, so the limit keeps one scatter within half a gigabyte.
+constexpr std::size_t kMaxScatterCount = 2'000'000;
+
+// Expands the scatter `v` over the surface object `on` (its JSON, already parsed once as an
+// object of the scene), appending its instances to `out`.
+void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser& parser,
+                    const std::vector<Primitive>& primitives, std::vector<SceneObject>& out);
+
+}  // namespace lat
