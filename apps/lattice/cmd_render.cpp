@@ -1,6 +1,7 @@
 // lattice render SCENE.json -o OUT.png [--threads N] [--spp N] [--stats FILE.json] [--mode M]
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -25,6 +26,12 @@ std::map<std::string, RenderMode> mode_names() {
     return m;
 }
 const std::map<std::string, RenderMode> kModes = mode_names();
+const std::map<std::string, bool> kOnOff{{"on", true}, {"off", false}};
+const std::map<std::string, LatticeFilter> kFilters = [] {
+    std::map<std::string, LatticeFilter> m;
+    for (const auto& [name, value] : kLatticeFilterNames) m.emplace(name, value);
+    return m;
+}();
 const std::map<std::string, Instancing> kInstancing{
     {"auto", Instancing::kAuto}, {"always", Instancing::kAlways}, {"never", Instancing::kNever}};
 
@@ -40,6 +47,8 @@ struct RenderArgs {
     std::string instancing = "auto";
     TextureOptions texture;
     int shadow_map_size = ParticleOptions{}.shadow_map_size;
+    std::string filter = "none";
+    std::string lod = "on";
     bool quiet = false;
 
     bool lattice_mode() const { return kModes.at(mode) == RenderMode::kLattice; }
@@ -101,6 +110,8 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeRes
     if (a.lattice_mode()) {
         j["sigma_inv"] = a.spec.sigma_inv;
         j["encoding"] = a.spec.encoding;
+        j["filter"] = a.filter;
+        j["lod"] = a.lod;
         j["tables_ms"] = r.prepare_ms;
         j["tables_built"] = lattices.built;
         j["table_bytes"] = lattices.table_bytes;
@@ -139,6 +150,8 @@ int run_render(const RenderArgs& a) {
     settings.progress = progress;
     settings.lattice_dir = a.lattice_dir;
     settings.spec = a.spec;
+    settings.filtering.filter = kFilters.at(a.filter);
+    settings.filtering.lod = kOnOff.at(a.lod);
     settings.accel.instancing = kInstancing.at(a.instancing);
     settings.texture = a.texture;
     settings.shadow_map_size = a.shadow_map_size;
@@ -184,12 +197,26 @@ Command add_render_command(CLI::App& parent) {
                       "Directory of cached lattice tables (default: $LATTICE_CACHE_DIR, "
                       "$XDG_CACHE_HOME/lattice or ~/.cache/lattice)");
     add_table_options(*c.app, args->spec);
+    c.app->add_option("--filter", args->filter,
+                      "lattice mode: none (point-sampled tables, as rasterized), box (each pair's "
+                      "coverage) or smooth (coverage blended over the neighbouring pairs); a filter "
+                      "uses the coverage encoding")
+        ->check(CLI::IsMember(kFilters));
+    c.app->add_option("--lod", args->lod,
+                      "lattice mode with a filter: levels of detail, sigma^-1 = K, 2K, 4K as "
+                      "the pixels' footprints need (on), or only K (off)")
+        ->check(CLI::IsMember(kOnOff));
     c.app->add_option("--instancing", args->instancing,
                       "Multi-part objects as Embree instances (always), flattened into one "
                       "hierarchy (never), or flattened unless that would be huge (auto)")
         ->check(CLI::IsMember(kInstancing));
     c.app->add_flag("-q,--quiet", args->quiet, "No progress bar or summary line");
-    c.run = [args] { return run_render(*args); };
+    c.run = [args, app = c.app] {
+        // A filter needs coverage: unless an encoding was asked for, it takes the one with it.
+        if (kFilters.at(args->filter) != LatticeFilter::kNone && app->get_option("--encoding")->count() == 0)
+            args->spec.encoding = "coverage";
+        return run_render(*args);
+    };
     return c;
 }
 

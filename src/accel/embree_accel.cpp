@@ -29,6 +29,11 @@ struct QueryContext {
     AccelHit* hit;
     bool found = false;
     std::uint32_t self = EmbreeAccel::kNoObject;  // occlusion: the object the ray leaves
+    // intersect_layers: where crossings of partial coverage go (they do not end the ray), and
+    // for transmittance queries, the product of their 1 - coverage and the value below which
+    // it counts as blocked (the product does not depend on the order they are met in).
+    std::vector<AccelHit>* partial = nullptr;
+    double transmitted = 1, blocked_below = 0;
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;
@@ -207,13 +212,19 @@ struct EmbreeAccel::Impl {
         if constexpr (K == Kind::kDirect)
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
         const double tmax = ctx->found ? ctx->hit->t : ctx->tmax;
+        const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
         Crossing c;
         const bool hit = K == Kind::kDirect
-                             ? shape.intersect(local, ctx->tmin, tmax, c)
-                             : shape.intersect_primitive(t.part, local, ctx->tmin, tmax, c);
-        if (hit)
-            self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), t.object, c, args->geomID,
-                         args->primID, K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
+                             ? shape.intersect(local, tmin, tmax, c)
+                             : shape.intersect_primitive(t.part, local, tmin, tmax, c);
+        if (!hit) return;
+        if (ctx->partial && c.coverage < 1.0f) {  // kept, and the ray goes on
+            ctx->partial->push_back({c.t, t.object, c});
+            ctx->transmitted *= 1.0 - double(c.coverage);
+            if (ctx->transmitted >= ctx->blocked_below) return;
+        }
+        self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), t.object, c, args->geomID,
+                     args->primID, K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
     }
 
     template <Kind K>
@@ -373,6 +384,47 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
             hit = {c.t, i, c};
         }
     }
+    return ctx.found;
+}
+
+bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
+                                   AccelHit& hit, std::vector<AccelHit>& partial,
+                                   double blocked_below) const {
+    partial.clear();
+    const bool traceable = embree_can_trace(r, tmin, tmax);
+    if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
+    const Impl& m = *impl_;
+    QueryContext ctx(m, r, tmin, tmax, hit);
+    ctx.self = self;
+    ctx.partial = &partial;
+    ctx.blocked_below = blocked_below;
+    if (traceable) {
+        alignas(16) RTCRayHit rh;
+        set_rtc_ray(rh.ray, r, tmin, tmax);
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(m.scene, &ctx.rtc, &rh);
+    }
+    for (const std::uint32_t i : m.unbounded) {
+        const AccelObject& o = m.objects[i];
+        const Ray local = o.xf->is_identity() ? r : o.xf->inverse_ray(r);
+        Crossing c;
+        if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), ctx.found ? hit.t : tmax, c))
+            continue;
+        if (c.coverage < 1.0f) {
+            partial.push_back({c.t, i, c});
+        } else {
+            ctx.found = true;
+            hit = {c.t, i, c};
+        }
+    }
+    // Partial crossings met before a closer opaque one was found lie behind it.
+    if (ctx.found)
+        std::erase_if(partial, [&](const AccelHit& p) { return p.t >= hit.t; });
+    // In ray order (ties by object): the same for any traversal order.
+    std::sort(partial.begin(), partial.end(), [](const AccelHit& a, const AccelHit& b) {
+        return a.t != b.t ? a.t < b.t : a.object < b.object;
+    });
     return ctx.found;
 }
 

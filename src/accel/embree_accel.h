@@ -50,6 +50,14 @@ public:
     // `self` also skips that object's crossings within its surface_tolerance().
     static constexpr std::uint32_t kNoObject = 0xFFFFFFFFu;
     bool occluded(const Ray& r, double tmin, double tmax, std::uint32_t self = kNoObject) const;
+    // One traversal for rays that see through partial crossings (Crossing::coverage < 1, from
+    // prefiltered lattices): `hit`, as intersect() finds it, is the closest opaque crossing, and
+    // `partial` every partial crossing before it, in ray order. `self` as for occluded().
+    // blocked_below > 0 (shadow rays): once the partial crossings met let less than that
+    // through, the last one is taken as opaque and the traversal ends (`hit` is then no closest
+    // crossing; only "blocked" is meant).
+    bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self, AccelHit& hit,
+                          std::vector<AccelHit>& partial, double blocked_below = 0) const;
 
     struct Impl;
 

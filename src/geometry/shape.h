@@ -80,6 +80,10 @@ struct Crossing {
     std::uint32_t part = 0;
     std::uint32_t leaf = 0;
     bool has_stored = false;
+    // The share of the rays around this one that meet the surface here (prefiltered lattices,
+    // issue 10: a partial hit lets the rest of the ray go on behind it); 1 for every exact shape.
+    // (In the padding after has_stored: a Crossing is no larger for it.)
+    float coverage = 1.0f;
     SurfacePoint stored;  // when has_stored: in the coordinates of the shape that found it
 
     std::uint32_t leaf_index() const { return leaf & ~kFlipBit; }

@@ -37,6 +37,9 @@ struct Encoding {
     std::uint64_t max_points = 0;  // boundary points it can key
     double bytes_per_hit = 0;      // at the build's peak, for planning memory before a build
     bool needs_hits = true;        // built from rasterized hits (else from the primitive itself)
+    // Stores each pair's coverage besides its hit (LatticeTable::coverage): the tables that
+    // filtered rendering (--filter) can use.
+    bool coverage = false;
 
     // The payload. `hits` are the rasterized hits when needs_hits (else empty); ctx.primitive
     // is set. Must not depend on the thread count.

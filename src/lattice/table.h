@@ -86,6 +86,14 @@ struct CandidateList {
     const std::uint32_t* parts = nullptr;
 };
 
+// A prefiltered table's answer for a pair (issue 10, lattice/coverage.h): the share of the rays
+// snapping to it that meet the primitive, and their mean hit.
+struct CoverageHit {
+    double alpha = 0;  // in (0, 1]
+    double t = 0;      // the mean hit point, projected on the segment p_a -> p_b
+    Vec3 normal;       // their mean unit normal
+};
+
 class LatticeTable {
 public:
     virtual ~LatticeTable() = default;
@@ -101,6 +109,15 @@ public:
     virtual bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const = 0;
     // Candidate tables: the parts for the pair (a, b); false when there are none.
     virtual bool candidates(std::uint32_t, std::uint32_t, CandidateList&) const { return false; }
+    // Prefiltered tables (Encoding::coverage): the pair's coverage; false when the pair's rays
+    // (nearly) all miss.
+    virtual bool coverage(std::uint32_t, std::uint32_t, CoverageHit&) const { return false; }
+    // The coverage of n pairs (a[i], b[i]) at once, found[i] saying whether each has one: lets
+    // a table overlap the memory accesses of the pairs a smooth filter blends.
+    virtual void coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
+                               CoverageHit* out, bool* found) const {
+        for (int i = 0; i < n; ++i) found[i] = coverage(a[i], b[i], out[i]);
+    }
 
     virtual std::string encoding() const = 0;
     // Encoding-specific facts for `lattice inspect` (widths, counts), one line; may be empty.

@@ -1,7 +1,9 @@
 #include "render/render_modes.h"
 
 #include <array>
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "geometry/chain.h"
 #include "render/scene_parts.h"
@@ -65,7 +67,12 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             if (mode == RenderMode::kLattice) {
                 const TableCache cache(settings.lattice_dir.empty() ? default_cache_dir() : settings.lattice_dir,
                                        !settings.lattice_dir.empty());
-                r.lattices = scene_lattices(scene, cache, settings.spec, settings.progress);
+                LatticeFiltering filtering = settings.filtering;
+                // A pixel's angle, narrowed by the samples that share it.
+                filtering.spread = 2 * std::tan(scene.camera.fov_y_deg * M_PI / 360.0) /
+                                   scene.camera.height / std::sqrt(double(std::max(1, settings.spp)));
+                r.lattices = scene_lattices(scene, cache, settings.spec, settings.progress, filtering);
+                opt.layered = filtering.filter != LatticeFilter::kNone;
                 instance_shape = [&r](int prim) { return r.lattices.shapes[static_cast<std::size_t>(prim)]; };
                 r.bytes_added += r.lattices.table_bytes;
             }

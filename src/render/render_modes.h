@@ -35,6 +35,7 @@ struct ModeSettings {
     bool progress = false;
     std::string lattice_dir;  // empty: default_cache_dir()
     TableSpec spec;           // lattice mode
+    LatticeFiltering filtering;  // lattice mode; spread is set from the camera and spp
     AccelOptions accel;
     TextureOptions texture;
     int shadow_map_size = ParticleOptions{}.shadow_map_size;

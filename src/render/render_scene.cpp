@@ -26,11 +26,29 @@ RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_sha
 bool RenderScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const {
     AccelHit h;
     if (!accel_->intersect(r, tmin, tmax, h)) return false;
+    surface_hit(r, h, hit);
+    return true;
+}
+
+bool RenderScene::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
+                                   SurfaceHit& hit, std::vector<SurfaceHit>& partial,
+                                   double blocked_below) const {
+    AccelHit h;
+    thread_local std::vector<AccelHit> layers;
+    const bool found = accel_->intersect_layers(r, tmin, tmax, self, h, layers, blocked_below);
+    if (found) surface_hit(r, h, hit);
+    partial.resize(layers.size());
+    for (std::size_t i = 0; i < layers.size(); ++i) surface_hit(r, layers[i], partial[i]);
+    return found;
+}
+
+void RenderScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const {
     const SceneObject& o = scene_.objects[h.object];
     const Shape& shape = *shapes_[h.object];
     hit.t = h.t;
     hit.object = h.object;
     hit.material = shape.tag(h.crossing, o.material);
+    hit.alpha = h.crossing.coverage;
     if (o.xf.is_identity()) {
         const SurfacePoint s = shape.surface(r, h.crossing);
         hit.p = s.p;
@@ -40,7 +58,6 @@ bool RenderScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& 
         hit.p = o.xf.point(s.p);
         hit.n = normalize(o.xf.normal(s.n));
     }
-    return true;
 }
 
 }  // namespace lat

@@ -16,6 +16,7 @@ struct SurfaceHit {
     Vec3 n;  // outward unit normal, world space
     std::uint32_t material = 0;
     std::uint32_t object = 0;
+    double alpha = 1;  // coverage: below 1 only for prefiltered lattices (render/layers.h)
 };
 
 class RenderScene {
@@ -27,6 +28,12 @@ public:
                          const AccelOptions& accel = {});
 
     bool intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const;
+    // Through partial hits (render/layers.h): the closest opaque hit, if any, and every partial
+    // hit before it, in ray order. `self` as for occluded.
+    // blocked_below: see EmbreeAccel::intersect_layers.
+    bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
+                          SurfaceHit& hit, std::vector<SurfaceHit>& partial,
+                          double blocked_below = 0) const;
     // `self`: the object whose surface the ray leaves (see EmbreeAccel::occluded).
     bool occluded(const Ray& r, double tmin, double tmax,
                   std::uint32_t self = EmbreeAccel::kNoObject) const {
@@ -34,12 +41,16 @@ public:
     }
 
     const Scene& scene() const { return scene_; }
+    // The shape traced for an object (its lattice, in lattice mode).
+    const Shape& shape(std::uint32_t object) const { return *shapes_[object]; }
 
 private:
     const Scene& scene_;
     std::vector<std::shared_ptr<const Shape>> shapes_;  // per object, as traced
     std::vector<AccelObject> accel_objects_;
     std::unique_ptr<EmbreeAccel> accel_;
+
+    void surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const;
 };
 
 }  // namespace lat

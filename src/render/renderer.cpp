@@ -10,6 +10,7 @@
 
 #include "lattice/lattice_shape.h"
 #include "render/camera.h"
+#include "render/layers.h"
 #include "render/shading.h"
 #include "util/error.h"
 #include "util/interrupt.h"
@@ -60,6 +61,8 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     int sx_n, sy_n;
     stratify(std::max(1, opt.spp), sx_n, sy_n);
     const int spp = sx_n * sy_n;
+    // A sample's footprint per unit distance: the pixel's angle, shared by its samples.
+    const double spread = 2 * std::tan(s.camera.fov_y_deg * M_PI / 360.0) / h / std::sqrt(double(spp));
 
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
     std::atomic<std::uint64_t> primary{0}, shadow{0}, visits{0};
@@ -90,7 +93,9 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
                         ++rays;
                         SurfaceHit hit;
                         Vec3 c = s.background;
-                        if (rs.intersect(ray, 0.0, kInfinity, hit))
+                        if (opt.layered)
+                            c = trace_layers(rs, ray, spread, counters);
+                        else if (rs.intersect(ray, 0.0, kInfinity, hit))
                             c = opt.shader ? opt.shader(ray, hit, counters) : shade(rs, ray, hit, counters);
                         sum += c;
                         sum_clamped += Vec3{std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0),

@@ -17,6 +17,8 @@ using SurfaceShader = std::function<Vec3(const Ray&, const SurfaceHit&, ShadeCou
 
 struct RenderOptions {
     int spp = 1;  // stratified samples per pixel; 1 is the pixel centre
+    // Trace rays front to back through partial hits (prefiltered lattices, render/layers.h).
+    bool layered = false;
     bool progress = false;
     SurfaceShader shader;  // empty: shade()
 };

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "lattice/cache/table_cache.h"
+#include "lattice/filtered_shape.h"
 #include "scene/scene.h"
 
 namespace lat {
@@ -19,7 +20,19 @@ struct SceneLattices {
     std::vector<std::string> paths;
 };
 
+// How lattices are filtered (issue 10): the filter, and whether levels of detail are built. With
+// lod, each primitive gets the levels sigma^-1 = K 2^j whose cells match the footprints of the
+// camera's pixels (spread: a pixel's angle) somewhere on its instances, at most kMaxLodLevels.
+struct LatticeFiltering {
+    LatticeFilter filter = LatticeFilter::kNone;
+    bool lod = false;
+    double spread = 0;
+};
+// Three levels, K to 4K: the next (8K) of the paper's hair would take 28 GB to build.
+inline constexpr int kMaxLodLevels = 3;
+
+// With filtering, spec's encoding must store coverage (Encoding::coverage; else InputError).
 SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const TableSpec& spec,
-                             bool progress);
+                             bool progress, const LatticeFiltering& filtering = {});
 
 }  // namespace lat

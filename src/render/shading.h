@@ -26,6 +26,10 @@ inline Vec3 phong_term(const Material& m, Vec3 color, Vec3 n, Vec3 l, Vec3 v, Ve
 
 // Radiance (linear, unclamped) seen along `ray` at `hit`.
 Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters);
+// The same with shadow rays that pass partly through prefiltered lattices (render/layers.h);
+// `width`: the footprint of the shaded point (world units), which picks the lattices' levels.
+Vec3 shade_transmitted(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, double width,
+                       ShadeCounters& counters);
 
 // Start of shadow rays: far enough from the surface to skip its own crossing, which double
 // precision places within ~1e-12 relative of the true one, and small against any feature.

@@ -75,7 +75,7 @@ set_tests_properties(cli.threads_identical PROPERTIES FIXTURES_REQUIRED "threads
 # cannot fit, and the cache itself.
 foreach(case corrupt truncated other_primitive missing_dir not_a_dir too_big unknown_primitive
              candidates_any_parts sigma_inv_range unknown_encoding point_limit outside_box tilted_tori_fit
-             render_then_reuse)
+             render_then_reuse filter filter_errors)
   add_test(NAME cli.lattice_${case}
     COMMAND ${CMAKE_COMMAND} -DLATTICE=$<TARGET_FILE:lattice> -DEXAMPLES=${PROJECT_SOURCE_DIR}/examples -DDATA=${CMAKE_CURRENT_SOURCE_DIR}/data
             -DWORK=${CLI_OUT}/lattice-${case} -DCASE=${case}

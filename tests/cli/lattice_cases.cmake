@@ -65,8 +65,40 @@ elseif(CASE STREQUAL "sigma_inv_range")
   endforeach()
   run(2 "--sigma-inv: sigma\\^-1 = 0 is out of range"
       ${LATTICE} render -q ${P3} --mode lattice --sigma-inv 0 --lattice-dir ${WORK} -o ${WORK}/x.png)
+elseif(CASE STREQUAL "filter")
+  # Filtered lattices: the coverage table is built and used; --filter none is the plain lattice.
+  run(0 "" ${LATTICE} render -q ${P3} --mode lattice --filter smooth --lod off --lattice-dir ${WORK}
+      -o ${WORK}/smooth.png --stats ${WORK}/s.json)
+  file(READ ${WORK}/s.json stats)
+  if(NOT stats MATCHES "\"filter\": *\"smooth\"" OR NOT stats MATCHES "\"encoding\": *\"coverage\"")
+    message(FATAL_ERROR "stats do not name the filter and its encoding:\n${stats}")
+  endif()
+  file(GLOB tables ${WORK}/hair-s1-coverage-*.lht)
+  if(NOT tables)
+    message(FATAL_ERROR "no coverage table in the cache")
+  endif()
+  run(0 "" ${LATTICE} render -q ${P3} --mode lattice --filter none --lattice-dir ${WORK} -o ${WORK}/none.png)
+  run(0 "" ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/plain.png)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/none.png ${WORK}/plain.png RESULT_VARIABLE differ)
+  if(differ)
+    message(FATAL_ERROR "--filter none differs from the plain lattice image")
+  endif()
+  execute_process(COMMAND ${LATTICE} inspect ${tables} --no-certify OUTPUT_VARIABLE out RESULT_VARIABLE code)
+  if(NOT code EQUAL 0 OR NOT out MATCHES "partly covered")
+    message(FATAL_ERROR "inspect does not report coverage:\n${out}")
+  endif()
+elseif(CASE STREQUAL "filter_errors")
+  run(2 "--filter: smoothest not in \\{box,none,smooth\\}"
+      ${LATTICE} render -q ${P3} --mode lattice --filter smoothest --lattice-dir ${WORK} -o ${WORK}/x.png)
+  run(2 "--lod: maybe not in"
+      ${LATTICE} render -q ${P3} --mode lattice --filter box --lod maybe --lattice-dir ${WORK} -o ${WORK}/x.png)
+  run(2 "^lattice: error: --filter: filtered lattices need a table encoding that stores coverage \\(--encoding coverage\\), not 'hash14'\n$"
+      ${LATTICE} render -q ${P3} --mode lattice --filter box --encoding hash14 --lattice-dir ${WORK} -o ${WORK}/x.png)
+  if(EXISTS ${WORK}/x.png)
+    message(FATAL_ERROR "an image was written")
+  endif()
 elseif(CASE STREQUAL "unknown_encoding")
-  run(2 "--encoding: unknown table encoding 'nope' \\(known: hash14, dense, candidates, perfect5, perfect6, perfect7, learned\\)"
+  run(2 "--encoding: unknown table encoding 'nope' \\(known: hash14, dense, candidates, perfect5, perfect6, perfect7, learned, coverage\\)"
       ${LATTICE} rasterize -q ${P3} --primitive hair --encoding nope -o ${WORK}/t.lht)
 elseif(CASE STREQUAL "point_limit")
   run(2 "primitives\\.hair: the hash14 encoding keys at most 65535 boundary points; a lattice of 84 x 84 x 240 cells \\(sigma\\^-1 = 12\\) has 94754"

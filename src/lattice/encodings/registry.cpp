@@ -7,12 +7,12 @@
 namespace lat {
 
 extern const Encoding kHash14Encoding, kDenseEncoding, kCandidatesEncoding, kPerfect5Encoding,
-    kPerfect6Encoding, kPerfect7Encoding, kLearnedEncoding;
+    kPerfect6Encoding, kPerfect7Encoding, kLearnedEncoding, kCoverageEncoding;
 
 std::span<const Encoding* const> encodings() {
     static const Encoding* const all[] = {
         &kHash14Encoding,   &kDenseEncoding,    &kCandidatesEncoding, &kPerfect5Encoding,
-        &kPerfect6Encoding, &kPerfect7Encoding, &kLearnedEncoding,
+        &kPerfect6Encoding, &kPerfect7Encoding, &kLearnedEncoding, &kCoverageEncoding,
     };
     return all;
 }

@@ -1,0 +1,32 @@
+#include <cmath>
+
+#include "lattice/encoding.h"
+#include "lattice/encodings/coverage/coverage_table.h"
+
+namespace lat {
+
+extern const Encoding kCoverageEncoding;
+const Encoding kCoverageEncoding{
+    .name = "coverage",
+    .summary = "prefiltered: per ordered pair its hit and its coverage (share of the rays "
+               "snapping to it that meet the primitive, their mean hit), for --filter",
+    // Ordered pairs are indexed densely: N^2 occupancy bits, 512 MB at this many points.
+    .max_points = 0xFFFFull,
+    // While building: the rasterized hit (20 bytes), about 1.5 coverage samples of 20 bytes, and
+    // the record (14 bytes), per stored hit.
+    .bytes_per_hit = 64.0,
+    .needs_hits = true,
+    .coverage = true,
+    .build = &CoverageTable::build,
+    .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
+               const TableContext& ctx) -> std::unique_ptr<LatticeTable> {
+        return std::make_unique<CoverageTable>(payload, size, entries, ctx);
+    },
+    // The hits of the pairs' own segments are kept as hash14 keeps them: t in 1/65534 of a
+    // segment no longer than the box's diagonal.
+    .error_bound = [](const TableContext& ctx, const EncodeOptions&) {
+        return std::hypot(ctx.cells[0], ctx.cells[1], ctx.cells[2]) * ctx.cell / 65534.0;
+    },
+};
+
+}  // namespace lat

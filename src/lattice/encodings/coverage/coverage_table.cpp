@@ -1,0 +1,223 @@
+#include "lattice/encodings/coverage/coverage_table.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+#include "lattice/coverage.h"
+#include "lattice/octahedral.h"
+
+namespace lat {
+namespace {
+
+constexpr std::uint64_t kMagic = 0x3152'4556'4F43ull;  // "COVER1"
+constexpr std::size_t kRecordBytes = CoverageTable::kFields * 2;
+constexpr double kTScale = 65534.0;
+constexpr double kAlphaScale = 65535.0;
+
+struct Header {
+    std::uint64_t magic;
+    std::uint32_t points, rays;  // boundary points; sub-rays per pair
+    std::uint64_t occupied;      // records
+    std::uint64_t center_hits;   // records whose own segment hits (the table's entries)
+    std::uint64_t reserved[4];
+};
+static_assert(sizeof(Header) == 64);
+
+std::uint64_t padded8(std::uint64_t bytes) { return (bytes + 7) / 8 * 8; }
+
+struct Sections {
+    std::uint64_t nwords, occ, counts, records, total;
+};
+
+Sections sections(std::uint64_t points, std::uint64_t occupied) {
+    Sections s{};
+    s.nwords = words_for_bits(points * points);
+    s.occ = sizeof(Header);
+    s.counts = s.occ + s.nwords * 8;
+    s.records = s.counts + padded8(RankIndex::count_entries(s.nwords) * 4);
+    s.total = s.records + padded8(occupied * kRecordBytes);
+    return s;
+}
+
+std::uint16_t field(const std::uint8_t* rec, int f) {
+    std::uint16_t v;
+    std::memcpy(&v, rec + 2 * f, 2);
+    return v;
+}
+
+std::uint16_t quantise_t(double t) {
+    return static_cast<std::uint16_t>(std::lround(std::clamp(t, 0.0, 1.0) * kTScale));
+}
+
+// One record in the making: the pair's own hit and its coverage, merged by pair.
+struct Entry {
+    std::uint64_t pair;
+    std::array<std::uint16_t, CoverageTable::kFields> f;
+};
+
+}  // namespace
+
+ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, const EncodeOptions&) {
+    const BoundaryGrid grid(ctx.cells);
+    const std::uint64_t n = grid.count();
+    std::vector<Entry> entries;
+    entries.reserve(hits.size());
+    for (const auto& chunk : hits.chunks)
+        for (const RawHit& h : chunk)
+            entries.push_back({h.a * n + h.b, {quantise_t(h.t), h.nu, h.nv, 0, 0, 0, 0}});
+    std::sort(entries.begin(), entries.end(),
+              [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
+    const std::size_t centers = entries.size();
+    // Coverage samples come sorted by pair: merge them into the hits, adding the pairs whose
+    // own segment misses.
+    std::size_t next = 0;
+    for (const CoverageSample& c : rasterize_coverage(ctx, false)) {
+        const std::uint64_t pair = c.a * n + c.b;
+        while (next < centers && entries[next].pair < pair) ++next;
+        Entry* e = nullptr;
+        if (next < centers && entries[next].pair == pair) {
+            e = &entries[next];
+        } else {
+            entries.push_back({pair, {kNoHit, 0, 0, 0, 0, 0, 0}});
+            e = &entries.back();
+        }
+        e->f[kMeanT] = quantise_t(c.t);
+        e->f[kMeanNu] = c.nu, e->f[kMeanNv] = c.nv;
+        e->f[kAlpha] = static_cast<std::uint16_t>(std::lround(double(c.alpha) * kAlphaScale));
+    }
+    std::inplace_merge(entries.begin(), entries.begin() + static_cast<std::ptrdiff_t>(centers),
+                       entries.end(), [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
+
+    const Sections s = sections(n, entries.size());
+    ByteBuffer out(s.total);
+    std::memset(out.data(), 0, s.total);
+    const Header h{kMagic, static_cast<std::uint32_t>(n), kCoverageRays, entries.size(), centers, {}};
+    std::memcpy(out.data(), &h, sizeof h);
+    auto* occ = reinterpret_cast<std::uint64_t*>(out.data() + s.occ);
+    std::uint8_t* rec = out.data() + s.records;
+    for (const Entry& e : entries) {
+        occ[e.pair >> 6] |= std::uint64_t{1} << (e.pair & 63);
+        std::memcpy(rec, e.f.data(), kRecordBytes);
+        rec += kRecordBytes;
+    }
+    RankIndex::build(occ, s.nwords, reinterpret_cast<std::uint32_t*>(out.data() + s.counts));
+    return out;
+}
+
+CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
+                             const TableContext& ctx)
+    : entries_(entries), size_(size) {
+    auto fail = [](const char* why) {
+        throw std::runtime_error(std::string("coverage payload: ") + why);
+    };
+    if (size < sizeof(Header)) fail("shorter than its header");
+    Header h;
+    std::memcpy(&h, payload, sizeof h);
+    if (h.magic != kMagic) fail("bad tag");
+    const BoundaryGrid grid(ctx.cells);
+    if (h.points != grid.count()) fail("boundary point count differs from the lattice's");
+    if (h.rays != kCoverageRays) fail("sampled with a different number of sub-rays");
+    if (h.center_hits != entries || h.occupied < entries || h.occupied > (std::uint64_t{1} << 40))
+        fail("record counts inconsistent with the header");
+    const Sections s = sections(h.points, h.occupied);
+    if (s.total != size) fail("size does not match its counts");
+    const auto* occ = reinterpret_cast<const std::uint64_t*>(payload + s.occ);
+    const auto* counts = reinterpret_cast<const std::uint32_t*>(payload + s.counts);
+    if (!RankIndex::valid(occ, s.nwords, counts)) fail("rank directory does not match");
+    if (counts[(s.nwords + RankIndex::kBlockWords - 1) / RankIndex::kBlockWords] != h.occupied)
+        fail("occupancy does not match the record count");
+    // Pairs beyond N^2 in the last word would index records of no pair.
+    if (h.points && (static_cast<std::uint64_t>(h.points) * h.points) % 64 &&
+        (occ[s.nwords - 1] >> ((static_cast<std::uint64_t>(h.points) * h.points) % 64)))
+        fail("occupancy bits past the last pair");
+    points_ = h.points;
+    occupied_ = h.occupied;
+    rank_ = RankIndex(occ, counts);
+    occ_ = occ;
+    counts_ = counts;
+    records_ = payload + s.records;
+    std::uint64_t centers = 0;
+    for (std::uint64_t i = 0; i < occupied_; ++i) {
+        const std::uint8_t* r = records_ + i * kRecordBytes;
+        const std::uint16_t t = field(r, kT), alpha = field(r, kAlpha);
+        if ((t != kNoHit && t > kTScale) || field(r, kMeanT) > kTScale || (t == kNoHit && alpha == 0))
+            fail("a record out of range");
+        centers += t != kNoHit;
+        partial_ += alpha > 0 && alpha < kAlphaScale;
+        alpha_sum_ += alpha / kAlphaScale;
+    }
+    if (centers != entries) fail("hit count does not match the header");
+}
+
+const std::uint8_t* CoverageTable::record(std::uint32_t a, std::uint32_t b) const {
+    if (a >= points_ || b >= points_) return nullptr;
+    const std::uint64_t i = static_cast<std::uint64_t>(a) * points_ + b;
+    if (!rank_.test(i)) return nullptr;
+    return records_ + rank_.rank(i) * kRecordBytes;
+}
+
+bool CoverageTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
+    const std::uint8_t* r = record(a, b);
+    if (!r || field(r, kT) == kNoHit) return false;
+    hit.t = field(r, kT) / kTScale;
+    hit.normal = oct_decode({field(r, kNu), field(r, kNv)}, kRawNormalBits);
+    return true;
+}
+
+void CoverageTable::decode(const std::uint8_t* r, CoverageHit& hit) {
+    hit.alpha = field(r, kAlpha) / kAlphaScale;
+    hit.t = field(r, kMeanT) / kTScale;
+    hit.normal = oct_decode({field(r, kMeanNu), field(r, kMeanNv)}, kRawNormalBits);
+}
+
+bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const {
+    const std::uint8_t* r = record(a, b);
+    if (!r || field(r, kAlpha) == 0) return false;
+    decode(r, hit);
+    return true;
+}
+
+void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
+                                  CoverageHit* out, bool* found) const {
+    // Three passes, each prefetching what the next reads, so that the cache misses of the pairs
+    // (occupancy word, rank count, record: three a pair in a table of hundreds of MB) overlap
+    // instead of following one another.
+    constexpr int kMax = 16;
+    std::uint64_t idx[kMax];
+    const std::uint8_t* rec[kMax];
+    for (int base = 0; base < n; base += kMax) {
+        const int m = std::min(kMax, n - base);
+        for (int i = 0; i < m; ++i) {
+            const std::uint32_t x = a[base + i], y = b[base + i];
+            idx[i] = x < points_ && y < points_ ? static_cast<std::uint64_t>(x) * points_ + y : ~0ull;
+            if (idx[i] == ~0ull) continue;
+            __builtin_prefetch(occ_ + (idx[i] >> 6));
+            __builtin_prefetch(counts_ + (idx[i] >> 6) / RankIndex::kBlockWords);
+        }
+        for (int i = 0; i < m; ++i) {
+            rec[i] = idx[i] != ~0ull && rank_.test(idx[i]) ? records_ + rank_.rank(idx[i]) * kRecordBytes
+                                                            : nullptr;
+            if (rec[i]) __builtin_prefetch(rec[i]);
+        }
+        for (int i = 0; i < m; ++i) {
+            found[base + i] = rec[i] && field(rec[i], kAlpha) != 0;
+            if (found[base + i]) decode(rec[i], out[base + i]);
+        }
+    }
+}
+
+std::string CoverageTable::details() const {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "%llu records, %d sub-rays a pair; coverage: %llu pairs partly covered "
+                  "(0 < alpha < 1), %.0f pairs' worth in all, %.3f records per hit",
+                  static_cast<unsigned long long>(occupied_), kCoverageRays,
+                  static_cast<unsigned long long>(partial_), alpha_sum_,
+                  entries_ ? double(occupied_) / double(entries_) : 0.0);
+    return buf;
+}
+
+}  // namespace lat

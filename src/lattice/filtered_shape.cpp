@@ -1,0 +1,152 @@
+#include "lattice/filtered_shape.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace lat {
+namespace {
+
+thread_local RayFootprint t_footprint;
+
+
+// How far (in cells of a level) a ray answered through a level can pass from the primitive: a
+// pair blended in has its ends within sqrt(2) cells of the ray's (smooth: a neighbouring grid
+// point in both face directions; box: kSnapReach), and a sub-ray of that pair that meets the
+// primitive lies within kSnapReach of the pair's segment.
+double reach_cells(LatticeFilter f) {
+    return (f == LatticeFilter::kSmooth ? std::sqrt(2.0) : kSnapReach) + kSnapReach;
+}
+
+}  // namespace
+
+void set_ray_footprint(const RayFootprint& f) { t_footprint = f; }
+
+double lod_level(double cell0, double width) {
+    return std::log2(cell0 / (width * kCellPerFootprint));
+}
+const RayFootprint& ray_footprint() { return t_footprint; }
+
+FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
+                                           double table_error)
+    // The point-sampled finest level reaches as far as make_lattice_shape's lattices do.
+    : filter_(filter),
+      point_(levels.back().table, levels.back().ctx,
+             levels.back().ctx.cell * kSnapReach + table_error) {
+    assert(!levels.empty() && filter != LatticeFilter::kNone);
+    for (std::size_t i = 0; i < levels.size(); ++i) {
+        const FilterLevel& l = levels[i];
+        // Only the coarsest level's frame culls (its reach is the largest).
+        const double reach = i == 0 ? reach_cells(filter) * l.ctx.cell + table_error : kInfinity;
+        levels_.push_back({l.table, LatticeFrame(l.ctx, reach), BoundaryGrid(l.ctx.cells)});
+    }
+}
+
+void FilteredLatticeShape::add_pair(const Level& l, const GridPoint& a, const GridPoint& b, double w,
+                                    Sheet& s) const {
+    const std::uint32_t ia = l.grid.id(a), ib = l.grid.id(b);
+    CoverageHit h;
+    if (ia == ib || !l.table->coverage(ia, ib, h)) return;
+    s.add(w, h, lerp(to_vec(a), to_vec(b), h.t) * l.frame.cell());
+}
+
+void FilteredLatticeShape::sheet(const Level& l, const Ray& r, double weight, bool smooth,
+                                 Sheet& s) const {
+    LatticeFrame::Snap sn;
+    if (!l.frame.snap(r, sn)) return;
+    if (!smooth) {
+        add_pair(l, sn.pa, sn.pb, weight, s);
+        return;
+    }
+    // The real entry and exit points, on the faces snap chose (the axes that clip first and
+    // last, found by the same loop), in face coordinates u, v (the next two axes).
+    const auto& n = l.grid.cells();
+    double t0 = -kInfinity, t1 = kInfinity;
+    int ax[2] = {0, 0};
+    for (int k = 0; k < 3; ++k) {
+        const auto uk = static_cast<std::size_t>(k);
+        if (sn.d[uk] == 0) continue;
+        double tn = -sn.o[uk] / sn.d[uk], tf = (n[uk] - sn.o[uk]) / sn.d[uk];
+        if (tn > tf) std::swap(tn, tf);
+        if (tn > t0) t0 = tn, ax[0] = k;
+        if (tf < t1) t1 = tf, ax[1] = k;
+    }
+    const Vec3 x[2] = {sn.o + sn.d * t0, sn.o + sn.d * t1};
+    const GridPoint g[2] = {sn.pa, sn.pb};
+    // The 4-D coordinates (u, v of the entry, u, v of the exit), their cell and fractions.
+    std::array<int, 4> base{}, axis_of{};
+    std::array<double, 4> frac{};
+    for (int e = 0; e < 2; ++e)
+        for (int j = 0; j < 2; ++j) {
+            const int a = (ax[e] + 1 + j) % 3;
+            const auto ua = static_cast<std::size_t>(a);
+            const double v = std::clamp(x[e][ua], 0.0, double(n[ua]));
+            const int b = std::min(static_cast<int>(std::floor(v)), std::max(0, n[ua] - 1));
+            base[static_cast<std::size_t>(2 * e + j)] = b;
+            frac[static_cast<std::size_t>(2 * e + j)] = std::clamp(v - b, 0.0, 1.0);
+            axis_of[static_cast<std::size_t>(2 * e + j)] = a;
+        }
+    std::array<int, 4> order{0, 1, 2, 3};
+    std::sort(order.begin(), order.end(), [&](int i, int j) {
+        return frac[static_cast<std::size_t>(i)] > frac[static_cast<std::size_t>(j)];
+    });
+    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn); the
+    // corners' pairs are looked up together.
+    GridPoint c[2] = {g[0], g[1]};
+    for (int k = 0; k < 4; ++k) c[k / 2][axis_of[static_cast<std::size_t>(k)]] = base[static_cast<std::size_t>(k)];
+    std::uint32_t ia[5], ib[5];
+    GridPoint ca[5], cb[5];
+    double w[5];
+    int m = 0;
+    double prev = 1;
+    for (int step = 0; step <= 4; ++step) {
+        const double f = step < 4 ? frac[static_cast<std::size_t>(order[static_cast<std::size_t>(step)])] : 0;
+        if (prev - f > 0) {
+            ia[m] = l.grid.id(c[0]), ib[m] = l.grid.id(c[1]);
+            if (ia[m] != ib[m]) ca[m] = c[0], cb[m] = c[1], w[m] = weight * (prev - f), ++m;
+        }
+        prev = f;
+        if (step < 4) {
+            const int k = order[static_cast<std::size_t>(step)];
+            ++c[k / 2][axis_of[static_cast<std::size_t>(k)]];
+        }
+    }
+    CoverageHit h[5];
+    bool found[5];
+    l.table->coverage_many(ia, ib, m, h, found);
+    for (int i = 0; i < m; ++i)
+        if (found[i]) s.add(w[i], h[i], lerp(to_vec(ca[i]), to_vec(cb[i]), h[i].t) * l.frame.cell());
+}
+
+bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    // The level whose cell is the footprint wide, at the box's centre along the ray.
+    const double dd = dot(r.d, r.d);
+    const RayFootprint& fp = t_footprint;
+    const double tc = dot(bounds().center() - r.o, r.d) / dd;
+    const double width = (fp.width0 + fp.spread * std::max(0.0, tc)) * std::sqrt(dd);
+    const double top = double(levels_.size() - 1);
+    const double level =
+        width > 0 ? std::clamp(lod_level(levels_.front().frame.cell(), width), 0.0, top) : top;
+    const auto lo = static_cast<std::size_t>(std::floor(level));
+    const double w_hi = level - double(lo);
+    const bool smooth = filter_ == LatticeFilter::kSmooth;
+    Sheet s;
+    sheet(levels_[lo], r, 1 - w_hi, smooth, s);
+    if (w_hi > 0) sheet(levels_[lo + 1], r, w_hi, smooth, s);
+    if (s.alpha <= 1e-6) return false;
+    const Vec3 p = s.p / s.alpha;
+    const double t = dot(p - r.o, r.d) / dd;
+    if (!(t > tmin && t < tmax)) return false;
+    const double ln = length(s.n);
+    hit = Crossing(t, 0, SurfacePoint{p, ln > 0 ? s.n / ln : -r.d / std::sqrt(dd)});
+    // Blends of full pairs round to just under 1: they are opaque (and end the ray's traversal).
+    hit.coverage = s.alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(s.alpha);
+    return true;
+}
+
+bool FilteredLatticeShape::occluded(const Ray& r, double tmin, double tmax) const {
+    Crossing c;
+    return intersect(r, tmin, tmax, c) && c.coverage >= 0.5f;
+}
+
+}  // namespace lat

@@ -1,0 +1,29 @@
+#pragma once
+// Tracing through prefiltered lattices (issue 10): a lattice answers a ray with a sheet of
+// coverage alpha < 1 (SurfaceHit::alpha), so a ray is traced front to back: each surface met
+// adds alpha of its shade, weighted by what is still uncovered, and the ray goes on behind it.
+// Shadow rays likewise get the transmittance prod (1 - alpha) of what they cross instead of a
+// yes/no. Exact shapes have alpha = 1, so a scene without lattices shades as shade() does.
+#include "render/render_scene.h"
+#include "render/shading.h"
+
+namespace lat {
+
+// Partial surfaces shaded along a camera ray, at most: the last one is taken as opaque. A
+// pixel's share left behind eight hairs of coverage 1/2 is 1/256, under an 8-bit step; deeper
+// stacks of partial sheets are rare (the edges of overlapping hairs). One traversal finds them
+// all (EmbreeAccel::intersect_layers).
+inline constexpr int kMaxLayers = 8;
+// Below this share left uncovered, the rest of a ray is not traced.
+inline constexpr double kMinTransmittance = 1.0 / 1024;
+
+// Radiance along a camera ray; `spread`: the width of its footprint per unit of distance (the
+// pixel's angle), which picks the lattices' levels of detail (lattice/filtered_shape.h).
+Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCounters& counters);
+
+// The share of light that gets through from tmin to tmax along r (unit direction) leaving a
+// surface of object `self`, whose crossings within its surface tolerance are skipped.
+double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tmax,
+                     std::uint32_t self);
+
+}  // namespace lat
