@@ -96,6 +96,18 @@ bool ray_is_finite(const Ray& r, double tmin, double tmax) {
     return is_finite(r.o) && is_finite(r.d) && std::isfinite(tmin) && !std::isnan(tmax);
 }
 
+void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax);
+
+// Embree's closest-hit traversal; the callbacks record what they find in ctx.
+template <class Context>
+void trace_closest(RTCScene scene, Context& ctx, const Ray& r, double tmin, double tmax) {
+    alignas(16) RTCRayHit rh;
+    set_rtc_ray(rh.ray, r, tmin, tmax);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, &ctx.rtc, &rh);
+}
+
 void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax) {
     ray.org_x = static_cast<float>(r.o.x);
     ray.org_y = static_cast<float>(r.o.y);
@@ -367,13 +379,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, hit);
 
-    if (traceable) {
-        alignas(16) RTCRayHit rh;
-        set_rtc_ray(rh.ray, r, tmin, tmax);
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(m.scene, &ctx.rtc, &rh);
-    }
+    if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax);
 
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
@@ -398,13 +404,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     ctx.self = self;
     ctx.partial = &partial;
     ctx.blocked_below = blocked_below;
-    if (traceable) {
-        alignas(16) RTCRayHit rh;
-        set_rtc_ray(rh.ray, r, tmin, tmax);
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(m.scene, &ctx.rtc, &rh);
-    }
+    if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax);
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
         const Ray local = o.xf->is_identity() ? r : o.xf->inverse_ray(r);
