@@ -9,6 +9,7 @@
 #include <random>
 
 #include "geometry/chain.h"
+#include "hook_primitive.h"
 #include "lattice/coverage.h"
 #include "lattice/encoding.h"
 #include "lattice/lattice_shape.h"
@@ -21,13 +22,8 @@
 namespace lat {
 namespace {
 
-// The hook of the paper's Figure 1, sigma = 1, at sigma^-1 = 2 (as the registry tests use it).
-const ChainShape& hook() {
-    static const ChainShape s({{{1, 1, 1}, 0.5}, {{1, 1, 3}, 0.5}, {{3, 1, 3}, 0.5}, {{3, 1, 2}, 0.5}},
-                              {{0, 1, 0.5}, {1, 2, 0.5}, {2, 3, 0.5}});
-    return s;
-}
-const TableContext kContext{{8, 4, 8}, 0.5, 1.0, &hook()};
+using test::hook;
+const TableContext& kContext = test::kHookContext;
 
 // Of rays parallel to the segment a b, shifted uniformly over the face cell of a, those the
 // renderer snaps to (a, b), the share whose chord through the box meets the primitive (the whole

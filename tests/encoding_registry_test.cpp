@@ -10,6 +10,7 @@
 #include <set>
 
 #include "geometry/chain.h"
+#include "hook_primitive.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/certify.h"
 #include "lattice/encoding.h"
@@ -21,13 +22,8 @@
 namespace lat {
 namespace {
 
-// The hook of the paper's Figure 1 at sigma^-1 = 2, with sigma = 1.
-const ChainShape& hook() {
-    static const ChainShape s({{{1, 1, 1}, 0.5}, {{1, 1, 3}, 0.5}, {{3, 1, 3}, 0.5}, {{3, 1, 2}, 0.5}},
-                              {{0, 1, 0.5}, {1, 2, 0.5}, {2, 3, 0.5}});
-    return s;
-}
-const TableContext kContext{{8, 4, 8}, 0.5, 1.0, &hook()};
+using test::hook;
+const TableContext& kContext = test::kHookContext;
 
 struct Built {
     RasterizeResult raster;

@@ -136,15 +136,7 @@ std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool pro
     // segment when the faces differ, by a little more: one cell is kept as the margin), so a
     // part it meets has its bounding sphere, grown by that, in the cone from p_i: the culling of
     // the rasterizer with grown spheres, grouped by part in ascending order.
-    std::vector<PartSphere> cull;
-    for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
-        std::vector<BoundingSphere> bs;
-        shape.primitive_spheres(i, bs);
-        for (const BoundingSphere& s : bs)
-            cull.push_back({s.center / ctx.cell,
-                            (s.radius / ctx.cell + 1.0) * (1 + 1e-9) + 1e-9,
-                            static_cast<std::uint32_t>(i)});
-    }
+    const std::vector<PartSphere> cull = part_spheres(shape, ctx.cell, 1.0, 1e-9);
     std::array<FaceLayout, 6> faces;
     for (int f = 0; f < 6; ++f) faces[static_cast<std::size_t>(f)] = layout_face(grid, f);
 

@@ -51,4 +51,17 @@ void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& 
     v1 = static_cast<int>(std::floor(std::min(vmax + eps, double(v1))));
 }
 
+std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double grow, double rel_pad) {
+    std::vector<PartSphere> out;
+    std::vector<BoundingSphere> bs;
+    for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
+        bs.clear();
+        shape.primitive_spheres(i, bs);
+        for (const BoundingSphere& b : bs)
+            out.push_back({b.center / cell, (b.radius / cell + grow) * (1 + rel_pad) + 1e-9,
+                           static_cast<std::uint32_t>(i)});
+    }
+    return out;
+}
+
 }  // namespace lat

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "geometry/shape.h"
 #include "lattice/boundary_grid.h"
 #include "math/bounds.h"
 
@@ -27,6 +28,12 @@ struct PartSphere {
     double r;
     std::uint32_t part;
 };
+
+// The culling spheres of every part of `shape` (Shape::primitive_spheres), in lattice units
+// (cell: the primitive units of one), grown by `grow` cells and padded against rounding by
+// `rel_pad` of the radius and 1e-9; grouped by part in ascending order, so a list built from
+// them is sorted by part.
+std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double grow, double rel_pad);
 
 // The face-grid rectangle that can hold exits of segments from p that meet the box b: the
 // central projection of b's corners onto the face plane; the whole face when unbounded.

@@ -70,15 +70,8 @@ public:
     Tracer(const Shape& shape, const TableContext& lg) : grid_(lg.cells), h_(lg.cell) {
         for (int f = 0; f < 6; ++f) faces_[static_cast<std::size_t>(f)] = layout_face(grid_, f);
         count_sums();
-        // The parts as bounding spheres in lattice units, grouped by part, padded beyond the
-        // parts' touch tolerance so culling never drops a touching hit.
-        for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
-            std::vector<BoundingSphere> bs;
-            shape.primitive_spheres(i, bs);
-            for (const BoundingSphere& b : bs)
-                spheres_.push_back({b.center / h_, b.radius / h_ * (1 + 1e-6) + 1e-9,
-                                    static_cast<std::uint32_t>(i)});
-        }
+        // Padded beyond the parts' touch tolerance so culling never drops a touching hit.
+        spheres_ = part_spheres(shape, h_, 0.0, 1e-6);
     }
 
     const BoundaryGrid& grid() const { return grid_; }

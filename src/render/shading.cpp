@@ -20,21 +20,10 @@ Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, Sh
     if (dot(n, v) < 0) n = -n;  // face the viewer
 
     Vec3 c = m.ka * m.color * s.ambient;
-    const double eps = shadow_epsilon(hit.p);
-    for (const PointLight& light : s.lights) {
-        const Vec3 to_light = light.position - hit.p;
-        const double dist = length(to_light);
-        if (dist == 0) continue;
-        const Vec3 l = to_light / dist;
-        double seen = 1;
-        if (s.shadows) {
-            ++counters.shadow_rays;
-            seen = visible(Ray{hit.p, l}, eps, dist * (1 - 1e-12), dist);
-            if (seen <= 0) continue;
-        }
+    for_each_light(rs, hit.p, counters, visible, [&](const PointLight& light, Vec3 l, double seen) {
         const Vec3 lit = phong_term(m, m.color, n, l, v, light.intensity);
         c += seen == 1 ? lit : lit * seen;
-    }
+    });
     return c;
 }
 

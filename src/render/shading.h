@@ -35,4 +35,28 @@ Vec3 shade_transmitted(const RenderScene& rs, const Ray& ray, const SurfaceHit& 
 // precision places within ~1e-12 relative of the true one, and small against any feature.
 double shadow_epsilon(Vec3 p);
 
+// The lights that reach p, each with its shadow ray cast (when the scene has shadows):
+// visible(shadow ray, tmin, tmax, distance) gives the share of the light that arrives, and
+// lit(light, unit direction to it, share) is called when that is above 0. The one home of the
+// light loop: shade() and the texture mode's baked surfaces both go through it.
+template <class Visible, class Lit>
+void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Visible&& visible,
+                    Lit&& lit) {
+    const Scene& s = rs.scene();
+    const double eps = shadow_epsilon(p);
+    for (const PointLight& light : s.lights) {
+        const Vec3 to_light = light.position - p;
+        const double dist = length(to_light);
+        if (dist == 0) continue;
+        const Vec3 l = to_light / dist;
+        double seen = 1;
+        if (s.shadows) {
+            ++counters.shadow_rays;
+            seen = visible(Ray{p, l}, eps, dist * (1 - 1e-12), dist);
+            if (seen <= 0) continue;
+        }
+        lit(light, l, seen);
+    }
+}
+
 }  // namespace lat

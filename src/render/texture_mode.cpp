@@ -189,19 +189,13 @@ RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const R
         Vec3 nf = normalize(base.xf.normal(t.normal));
         if (dot(nf, v) < 0) nf = -nf;
         Vec3 bare = m.ka * m.color * scene.ambient, furred = fur.ka * t.colour * scene.ambient;
-        const double eps = shadow_epsilon(hit.p);
-        for (const PointLight& light : scene.lights) {
-            const Vec3 to_light = light.position - hit.p;
-            const double dist = length(to_light);
-            if (dist == 0) continue;
-            const Vec3 l = to_light / dist;
-            if (scene.shadows) {
-                ++counters.shadow_rays;
-                if (rs.occluded({hit.p, l}, eps, dist * (1 - 1e-12), hit.object)) continue;
-            }
+        auto visible = [&](const Ray& r, double tmin, double tmax, double) {
+            return rs.occluded(r, tmin, tmax, hit.object) ? 0.0 : 1.0;
+        };
+        for_each_light(rs, hit.p, counters, visible, [&](const PointLight& light, Vec3 l, double) {
             bare += phong_term(m, m.color, n, l, v, light.intensity);
             furred += phong_term(fur, t.colour, nf, l, v, light.intensity);
-        }
+        });
         return (1 - t.coverage) * bare + t.coverage * furred;
     };
     return render_image(rs, o);

@@ -143,14 +143,7 @@ std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& 
     const std::vector<Part> parts = parts_of(shape, ctx.cell);
     // Culling spheres, grown by the reach, grouped by part in ascending order: each face point's
     // list is then built sorted, and a part already in it is its last entry.
-    std::vector<PartSphere> cull;
-    for (std::size_t i = 0; i < parts.size(); ++i) {
-        std::vector<BoundingSphere> bs;
-        shape.primitive_spheres(i, bs);
-        for (const BoundingSphere& b : bs)
-            cull.push_back({b.center / ctx.cell, (b.radius / ctx.cell + kSnapReach) * (1 + 1e-9) + 1e-9,
-                            static_cast<std::uint32_t>(i)});
-    }
+    const std::vector<PartSphere> cull = part_spheres(shape, ctx.cell, kSnapReach, 1e-9);
     std::array<FaceLayout, 6> faces;
     for (int f = 0; f < 6; ++f) faces[static_cast<std::size_t>(f)] = layout_face(grid, f);
 
