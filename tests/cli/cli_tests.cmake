@@ -143,4 +143,10 @@ add_test(NAME cli.table2_texture_base_unmappable
 file(MAKE_DIRECTORY ${CLI_OUT}/t2-cache)
 add_test(NAME cli.table2_runs
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/good.json;-o;${CLI_OUT}/t2;--truth-spp;4;--spp;2;--encodings;hash14,dense;--lattice-dir;${CLI_OUT}/t2-cache;--texture-size;64"
-          -DEXIT=0 "-DPATTERN=table2: lattice-dense" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+          -DEXIT=0 "-DPATTERN=table2: lattice-dense" "-DSTDOUT_PATTERN=\\| lattice-coverage-smooth \\| 1 \\|.*Crops \\(`crops.png`\\)"
+          -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+# compare prints SSIM (issue 13), here of two of table2's images.
+add_test(NAME cli.compare_prints_ssim
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;compare;${CLI_OUT}/t2/truth.png;${CLI_OUT}/t2/texture.png"
+          -DEXIT=0 "-DSTDOUT_PATTERN=ssim: 0\\.[0-9][0-9][0-9][0-9]" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+set_tests_properties(cli.compare_prints_ssim PROPERTIES DEPENDS cli.table2_runs)
