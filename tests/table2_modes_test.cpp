@@ -36,6 +36,23 @@ double covered_pixels(const RenderOutput& out) {
     return sum;
 }
 
+// The mode's image at 4 spp (64-texel-wide maps) is the same bytes on one thread and on two.
+void expect_same_image_on_1_and_2_threads(const Scene& s, RenderMode mode) {
+    ModeSettings ms;
+    ms.spp = 4;
+    ms.texture.width = 64;
+    RenderOutput one, two;
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+        one = render_in_mode(s, mode, ms).out;
+    }
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+        two = render_in_mode(s, mode, ms).out;
+    }
+    EXPECT_EQ(one.display.rgb, two.display.rgb);
+}
+
 TEST(ParticleMode, SplatCoverageMatchesTheExactSilhouetteArea) {
     const Scene s = load_scene_text(capsule_scene(96), "capsule.json");
     const ParticleSet set = make_particles(s);
@@ -57,18 +74,7 @@ TEST(ParticleMode, SplatCoverageMatchesTheExactSilhouetteArea) {
 
 TEST(ParticleMode, ImagesAreIdenticalForAnyThreadCount) {
     const Scene s = load_scene_text(capsule_scene(48), "capsule.json");
-    ModeSettings ms;
-    ms.spp = 4;
-    RenderOutput one, two;
-    {
-        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-        one = render_in_mode(s, RenderMode::kParticles, ms).out;
-    }
-    {
-        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
-        two = render_in_mode(s, RenderMode::kParticles, ms).out;
-    }
-    EXPECT_EQ(one.display.rgb, two.display.rgb);
+    expect_same_image_on_1_and_2_threads(s, RenderMode::kParticles);
 }
 
 // A ball of radius 0.3 centred 1.15 above the origin, rooted at its bottom, over `base` (an
@@ -184,19 +190,7 @@ TEST(TextureMode, MeshAtlasFindsTheTexelOfItsOwnPoints) {
 TEST(TextureMode, MeshImagesAreIdenticalForAnyThreadCount) {
     const test::TempDir dir;
     const Scene s = load_scene(ball_over_mesh(dir));
-    ModeSettings ms;
-    ms.spp = 4;
-    ms.texture.width = 64;
-    RenderOutput one, two;
-    {
-        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-        one = render_in_mode(s, RenderMode::kTexture, ms).out;
-    }
-    {
-        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
-        two = render_in_mode(s, RenderMode::kTexture, ms).out;
-    }
-    EXPECT_EQ(one.display.rgb, two.display.rgb);
+    expect_same_image_on_1_and_2_threads(s, RenderMode::kTexture);
 }
 
 TEST(TextureMode, NeedsASurfaceUnderTheRoots) {
@@ -212,19 +206,7 @@ TEST(TextureMode, NeedsASurfaceUnderTheRoots) {
 
 TEST(TextureMode, ImagesAreIdenticalForAnyThreadCount) {
     const Scene s = load_scene_text(kBallScene, "ball.json");
-    ModeSettings ms;
-    ms.spp = 4;
-    ms.texture.width = 64;
-    RenderOutput one, two;
-    {
-        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-        one = render_in_mode(s, RenderMode::kTexture, ms).out;
-    }
-    {
-        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
-        two = render_in_mode(s, RenderMode::kTexture, ms).out;
-    }
-    EXPECT_EQ(one.display.rgb, two.display.rgb);
+    expect_same_image_on_1_and_2_threads(s, RenderMode::kTexture);
 }
 
 }  // namespace
