@@ -90,7 +90,8 @@ std::string ball_scene(const std::string& base) {
               {"type": "instance", "primitive": "ball", "material": "fur",
                "transform": [{"translate": [0, 0, 1.15]}]}]})";
 }
-const std::string kBallScene = ball_scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "skin"})");
+const std::string kBallScene =
+    ball_scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "skin"})");
 
 TEST(TextureMode, BakedBallMatchesItsExactProjection) {
     const Scene s = load_scene_text(kBallScene, "ball.json");

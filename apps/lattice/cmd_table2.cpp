@@ -226,8 +226,10 @@ Command add_table2_command(CLI::App& parent) {
     c.app->add_option("--filter-spp", args->filter_spp,
                       "Samples per pixel of the filtered lattice (filtering stands in for supersampling)")
         ->check(CLI::Range(1, 65536));
-    c.app->add_option("--crop-size", args->crop_size, "Side of the magnified crops, pixels")->check(CLI::Range(8, 4096));
-    c.app->add_option("--crop-scale", args->crop_scale, "Magnification of the crops")->check(CLI::Range(1, 16));
+    c.app->add_option("--crop-size", args->crop_size, "Side of the magnified crops, pixels")
+        ->check(CLI::Range(8, 4096));
+    c.app->add_option("--crop-scale", args->crop_scale, "Magnification of the crops")
+        ->check(CLI::Range(1, 16));
     c.run = [args] { return run_table2(*args); };
     return c;
 }

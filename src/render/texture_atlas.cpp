@@ -20,7 +20,8 @@ const TriangleMeshShape* as_mesh(const SceneObject& o) {
 
 class SphereAtlas final : public TextureAtlas {
 public:
-    SphereAtlas(const SphereShape& s, int width) : s_(s), w_(std::max(2, width)), h_(std::max(1, w_ / 2)) {}
+    SphereAtlas(const SphereShape& s, int width)
+        : s_(s), w_(std::max(2, width)), h_(std::max(1, w_ / 2)) {}
 
     std::size_t texel_count() const override { return static_cast<std::size_t>(w_) * h_; }
     std::uint64_t layout_bytes() const override { return 0; }
@@ -32,7 +33,8 @@ public:
     }
     double texel_area(std::size_t t) const override {
         const auto j = static_cast<double>(t / w_);
-        return s_.radius() * s_.radius() * (2 * M_PI / w_) * (std::cos(M_PI * j / h_) - std::cos(M_PI * (j + 1) / h_));
+        const double band = std::cos(M_PI * j / h_) - std::cos(M_PI * (j + 1) / h_);
+        return s_.radius() * s_.radius() * (2 * M_PI / w_) * band;
     }
     TexelWeights lookup(Vec3 p, std::uint32_t) const override {
         double u, v;
@@ -45,12 +47,10 @@ public:
             for (int di = 0; di <= 1; ++di) {
                 const int i = ((i0 + di) % w_ + w_) % w_, j = std::min(h_ - 1, j0 + dj);
                 tw.texel[static_cast<std::size_t>(tw.count)] = static_cast<std::size_t>(j) * w_ + i;
-                tw.weight[static_cast<std::size_t>(tw.count++)] = (di ? fx : 1 - fx) * (dj ? fy : 1 - fy);
+                tw.weight[static_cast<std::size_t>(tw.count++)] =
+                    (di ? fx : 1 - fx) * (dj ? fy : 1 - fy);
             }
         return tw;
-    }
-    std::string describe() const override {
-        return "equirectangular " + std::to_string(w_) + " x " + std::to_string(h_);
     }
 
 private:
@@ -67,7 +67,8 @@ public:
         std::vector<double> world_area(tris.size());
         double total = 0;
         for (std::size_t k = 0; k < tris.size(); ++k) {
-            const Vec3 a = xf.point(vertex(k, 0)), b = xf.point(vertex(k, 1)), c = xf.point(vertex(k, 2));
+            const Vec3 a = xf.point(vertex(k, 0)), b = xf.point(vertex(k, 1)),
+                       c = xf.point(vertex(k, 2));
             world_area[k] = 0.5 * length(cross(b - a, c - a));
             total += world_area[k];
         }
@@ -84,7 +85,9 @@ public:
     }
 
     std::size_t texel_count() const override { return first_.back(); }
-    std::uint64_t layout_bytes() const override { return n_.size() * (sizeof(std::uint32_t) + sizeof(std::size_t)); }
+    std::uint64_t layout_bytes() const override {
+        return n_.size() * (sizeof(std::uint32_t) + sizeof(std::size_t));
+    }
     bool texel_point(std::size_t t, double a, double b, SurfacePoint& out) const override {
         std::size_t k, i, j;
         locate(t, k, i, j);
@@ -97,7 +100,9 @@ public:
     double texel_area(std::size_t t) const override {
         std::size_t k, i, j;
         locate(t, k, i, j);
-        const double cell = length(cross(vertex(k, 1) - vertex(k, 0), vertex(k, 2) - vertex(k, 0))) / (double(n_[k]) * n_[k]);
+        const double parallelogram =
+            length(cross(vertex(k, 1) - vertex(k, 0), vertex(k, 2) - vertex(k, 0)));
+        const double cell = parallelogram / (double(n_[k]) * n_[k]);
         return i + j + 1 == n_[k] ? cell / 2 : cell;
     }
     TexelWeights lookup(Vec3 p, std::uint32_t part) const override {
@@ -105,9 +110,10 @@ public:
         const std::size_t k = part;
         // Barycentrics of p (on the triangle, up to rounding).
         const Vec3 a = vertex(k, 0), e0 = vertex(k, 1) - a, e1 = vertex(k, 2) - a, w = p - a;
-        const double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1), d20 = dot(w, e0), d21 = dot(w, e1);
-        const double den = d00 * d11 - d01 * d01;
-        const double u = den > 0 ? (d11 * d20 - d01 * d21) / den : 0, v = den > 0 ? (d00 * d21 - d01 * d20) / den : 0;
+        const double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1);
+        const double d20 = dot(w, e0), d21 = dot(w, e1), den = d00 * d11 - d01 * d01;
+        const double u = den > 0 ? (d11 * d20 - d01 * d21) / den : 0;
+        const double v = den > 0 ? (d00 * d21 - d01 * d20) / den : 0;
         const int n = static_cast<int>(n_[k]);
         const double x = u * n - 0.5, y = v * n - 0.5;
         const int i0 = static_cast<int>(std::floor(x)), j0 = static_cast<int>(std::floor(y));
@@ -132,9 +138,6 @@ public:
         for (int c = 0; c < tw.count; ++c) tw.weight[static_cast<std::size_t>(c)] /= sum;
         return tw;
     }
-    std::string describe() const override {
-        return "per-triangle grids, " + std::to_string(n_.size()) + " triangles";
-    }
 
 private:
     const TriangleMeshShape& m_;
@@ -144,10 +147,13 @@ private:
     Vec3 vertex(std::size_t k, std::size_t c) const { return m_.positions()[m_.triangles()[k][c]]; }
     std::size_t index(std::size_t k, int i, int j) const {
         const std::size_t n = n_[k], jj = static_cast<std::size_t>(j);
-        return first_[k] + jj * (2 * n - jj + 1) / 2 + static_cast<std::size_t>(i);  // after rows 0..j-1
+        return first_[k] + jj * (2 * n - jj + 1) / 2 +
+               static_cast<std::size_t>(i);  // after rows 0..j-1
     }
     void locate(std::size_t t, std::size_t& k, std::size_t& i, std::size_t& j) const {
-        k = static_cast<std::size_t>(std::upper_bound(first_.begin(), first_.end(), t) - first_.begin()) - 1;
+        k = static_cast<std::size_t>(std::upper_bound(first_.begin(), first_.end(), t) -
+                                     first_.begin()) -
+            1;
         std::size_t r = t - first_[k], n = n_[k];
         for (j = 0; r >= n - j; ++j) r -= n - j;
         i = r;
@@ -166,7 +172,9 @@ Vec3 uv_to_direction(double u, double v) {
     return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
 }
 
-bool has_texture_atlas(const SceneObject& base) { return as_sphere(base) || as_mesh(base); }
+bool has_texture_atlas(const SceneObject& base) {
+    return as_sphere(base) || as_mesh(base);
+}
 
 std::unique_ptr<TextureAtlas> make_texture_atlas(const SceneObject& base, int width) {
     if (const SphereShape* s = as_sphere(base)) return std::make_unique<SphereAtlas>(*s, width);

@@ -19,7 +19,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <string>
 
 #include "geometry/shape.h"
 #include "scene/scene.h"
@@ -46,8 +45,6 @@ public:
     // The texels around point p of the surface, on part `part` of the shape (a mesh's
     // triangle), weights summing to 1.
     virtual TexelWeights lookup(Vec3 p, std::uint32_t part) const = 0;
-    // E.g. "equirectangular 1024 x 512" or "per-triangle grids, 14,696 triangles".
-    virtual std::string describe() const = 0;
 };
 
 // Whether the texture mode has a layout for this object's shape.

@@ -130,7 +130,8 @@ TextureMaps bake_texture(const Scene& scene, const TextureOptions& opt) {
     const double above = reach * 1.01;
     constexpr std::size_t kGrain = 4096;
     ProgressBar bar("bake", (texels + kGrain - 1) / kGrain, opt.progress);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, texels, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+    using Range = tbb::blocked_range<std::size_t>;
+    tbb::parallel_for(Range(0, texels, kGrain), [&](const Range& r) {
         for (std::size_t t = r.begin(); t != r.end(); ++t) {
             Vec3 colour, normal;
             int hits = 0, samples = 0;
@@ -143,7 +144,8 @@ TextureMaps bake_texture(const Scene& scene, const TextureOptions& opt) {
                     // Only the fur between the sample and the base where it folds back over it.
                     double top = above;
                     Crossing fold;
-                    if (base.shape->intersect(base.xf.inverse_ray({p, up}), 1e-4 * above, above, fold)) top = fold.t;
+                    if (base.shape->intersect(base.xf.inverse_ray({p, up}), 1e-4 * above, above, fold))
+                        top = fold.t;
                     SurfaceHit hit;
                     if (!rs.intersect({p + up * top, -up}, 0.0, top, hit)) continue;
                     ++hits;
