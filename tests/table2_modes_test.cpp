@@ -130,7 +130,8 @@ TEST(TextureMode, BakedBallMatchesItsExactProjection) {
 // side that the base inference must pass over.
 std::string ball_over_mesh(const test::TempDir& dir) {
     test::spit(dir.file("square.obj"), "v -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nf 1 2 3\nf 1 3 4\n");
-    test::spit(dir.file("mesh.json"), ball_scene(R"({"type": "mesh", "file": "square.obj", "material": "skin"})"));
+    test::spit(dir.file("mesh.json"),
+               ball_scene(R"({"type": "mesh", "file": "square.obj", "material": "skin"})"));
     return dir.file("mesh.json");
 }
 
@@ -201,6 +202,24 @@ TEST(TextureMode, NeedsASurfaceUnderTheRoots) {
         FAIL();
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("capsule.json: objects[0]: texture mode"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(TextureMode, RefusesFurStandingApartFromTheBase) {
+    // Two balls over the sphere at the origin, one over the sphere at x = 10 (objects[3]).
+    const Scene s = load_scene_text(
+        ball_scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "skin"},
+            {"type": "instance", "primitive": "ball", "material": "fur", "transform": [{"translate": [0, 0.1, 1.15]}]},
+            {"type": "instance", "primitive": "ball", "material": "fur", "transform": [{"translate": [10, 0, 1.15]}]})"),
+        "two.json");
+    try {
+        texture_base(s);
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("two.json: objects[3]: texture mode maps every instance onto the one "
+                                             "surface most of them grow from, objects[1]"),
+                  std::string::npos)
             << e.what();
     }
 }

@@ -95,6 +95,15 @@ std::size_t texture_base(const Scene& scene) {
         throw InputError(located_message(scene.file, scene.objects[base].where,
                                          "the instances grow from this object, and texture mode maps onto "
                                          "spheres, ellipsoids and triangle meshes only"));
+    // All of them: fur standing elsewhere would be baked as seen from this surface, wrongly.
+    for (const std::size_t k : inst) {
+        const SceneObject& o = scene.objects[k];
+        if (root_distance(scene, scene.objects[base], o) > instance_size(scene, o))
+            throw InputError(located_message(
+                scene.file, o.where,
+                "texture mode maps every instance onto the one surface most of them grow from, " +
+                    scene.objects[base].where + ", and this one stands apart from it"));
+    }
     return base;
 }
 

@@ -10,7 +10,8 @@
 //   up to 1,024 instances spread over the list). Scatter roots lie on their surface, so a
 //   scatter's "on" object is found at distance zero. Spheres, ellipsoids and triangle meshes
 //   can be mapped (render/texture_atlas.h: an equirectangular map, or per-triangle texel grids
-//   for meshes, which have no parametrisation); any other base is refused.
+//   for meshes, which have no parametrisation); any other base is refused, and so is fur
+//   standing apart from the base (one base a scene).
 // - Baking: each texel is sampled on an s x s grid; at each sample a ray comes down the
 //   surface normal from above the highest reach of the fur (an instance's size plus its root's
 //   distance from the base), or from the base itself where it folds back over the sample
@@ -60,8 +61,8 @@ struct TextureOptions {
 };
 
 // The base surface (index in scene.objects) of the scene's instances, as described above;
-// throws InputError when no object lies under the instances' roots, or the one that does
-// cannot be mapped.
+// throws InputError when no object lies under the instances' roots, when the one that does
+// cannot be mapped, or when an instance stands apart from it (farther than its own size).
 std::size_t texture_base(const Scene& scene);
 
 // Throws as texture_base. A scene without instances gets empty maps.
