@@ -124,7 +124,7 @@ add_test(NAME cli.particles_need_a_chain
           -DNO_FILE=${CLI_OUT}/par.png -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 foreach(mode texture particles)
   add_test(NAME cli.${mode}_mode_renders
-    COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;-q;--mode;${mode};--spp;4;${BAD}/good.json;-o;${CLI_OUT}/${mode}.png"
+    COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;-q;--mode;${mode};--spp;4;${BAD}/furred-sphere.json;-o;${CLI_OUT}/${mode}.png"
             -DEXIT=0 -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 endforeach()
 add_test(NAME cli.texture_size_range
@@ -142,7 +142,7 @@ add_test(NAME cli.table2_texture_base_unmappable
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 file(MAKE_DIRECTORY ${CLI_OUT}/t2-cache)
 add_test(NAME cli.table2_runs
-  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/good.json;-o;${CLI_OUT}/t2;--truth-spp;4;--spp;2;--encodings;hash14,dense;--lattice-dir;${CLI_OUT}/t2-cache;--texture-size;64"
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/furred-sphere.json;-o;${CLI_OUT}/t2;--truth-spp;4;--spp;2;--encodings;hash14,dense;--lattice-dir;${CLI_OUT}/t2-cache;--texture-size;64"
           -DEXIT=0 "-DPATTERN=table2: lattice-dense" "-DSTDOUT_PATTERN=\\| lattice-coverage-smooth \\| 1 \\|.*Crops \\(`crops.png`\\)"
           -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 # compare prints SSIM (issue 13), here of two of table2's images.
