@@ -63,6 +63,7 @@ private:
     void make_cull_parts(const Shape* primitive, double reach);
     static void drop_covered(std::vector<Piece>& pieces);
     void group(const std::vector<Piece>& pieces, bool capsules);
+    void split_in_halves();
 };
 
 // Lattice visits (snaps of a ray to a grid point pair: one per call of a lattice shape's
