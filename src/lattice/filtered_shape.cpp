@@ -27,6 +27,11 @@ double lod_level(double cell0, double width) {
 }
 const RayFootprint& ray_footprint() { return t_footprint; }
 
+double lod_blend(double f, double band) {
+    if (band <= 0) return f < 0.5 ? 0.0 : 1.0;
+    return std::clamp((f - 0.5) / band + 0.5, 0.0, 1.0);
+}
+
 FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
                                            double table_error)
     // The point-sampled finest level reaches as far as make_lattice_shape's lattices do.
@@ -42,20 +47,12 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     }
 }
 
-void FilteredLatticeShape::add_pair(const Level& l, const GridPoint& a, const GridPoint& b, double w,
-                                    Sheet& s) const {
-    const std::uint32_t ia = l.grid.id(a), ib = l.grid.id(b);
-    CoverageHit h;
-    if (ia == ib || !l.table->coverage(ia, ib, h)) return;
-    s.add(w, h, lerp(to_vec(a), to_vec(b), h.t) * l.frame.cell());
-}
-
-void FilteredLatticeShape::sheet(const Level& l, const Ray& r, double weight, bool smooth,
-                                 Sheet& s) const {
+void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bool smooth,
+                                 Blend& out) const {
     LatticeFrame::Snap sn;
     if (!l.frame.snap(r, sn)) return;
     if (!smooth) {
-        add_pair(l, sn.pa, sn.pb, weight, s);
+        out.add(l.grid, sn.pa, sn.pb, weight);
         return;
     }
     // The real entry and exit points, on the faces snap chose (the axes that clip first and
@@ -90,32 +87,27 @@ void FilteredLatticeShape::sheet(const Level& l, const Ray& r, double weight, bo
     std::sort(order.begin(), order.end(), [&](int i, int j) {
         return frac[static_cast<std::size_t>(i)] > frac[static_cast<std::size_t>(j)];
     });
-    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn); the
-    // corners' pairs are looked up together.
+    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn).
     GridPoint c[2] = {g[0], g[1]};
     for (int k = 0; k < 4; ++k) c[k / 2][axis_of[static_cast<std::size_t>(k)]] = base[static_cast<std::size_t>(k)];
-    std::uint32_t ia[5], ib[5];
-    GridPoint ca[5], cb[5];
-    double w[5];
-    int m = 0;
     double prev = 1;
     for (int step = 0; step <= 4; ++step) {
         const double f = step < 4 ? frac[static_cast<std::size_t>(order[static_cast<std::size_t>(step)])] : 0;
-        if (prev - f > 0) {
-            ia[m] = l.grid.id(c[0]), ib[m] = l.grid.id(c[1]);
-            if (ia[m] != ib[m]) ca[m] = c[0], cb[m] = c[1], w[m] = weight * (prev - f), ++m;
-        }
+        if (prev - f > 0) out.add(l.grid, c[0], c[1], weight * (prev - f));
         prev = f;
         if (step < 4) {
             const int k = order[static_cast<std::size_t>(step)];
             ++c[k / 2][axis_of[static_cast<std::size_t>(k)]];
         }
     }
-    CoverageHit h[5];
-    bool found[5];
-    l.table->coverage_many(ia, ib, m, h, found);
-    for (int i = 0; i < m; ++i)
-        if (found[i]) s.add(w[i], h[i], lerp(to_vec(ca[i]), to_vec(cb[i]), h[i].t) * l.frame.cell());
+}
+
+void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, Sheet& s) const {
+    CoverageHit h[Blend::kMaxPairs];
+    bool found[Blend::kMaxPairs];
+    l.table->coverage_many(b.ia, b.ib, b.n, h, found);
+    for (int i = 0; i < b.n; ++i)
+        if (found[i]) s.add(b.w[i], h[i], lerp(to_vec(b.ca[i]), to_vec(b.cb[i]), h[i].t) * l.frame.cell());
 }
 
 bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
@@ -128,11 +120,18 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
     const double level =
         width > 0 ? std::clamp(lod_level(levels_.front().frame.cell(), width), 0.0, top) : top;
     const auto lo = static_cast<std::size_t>(std::floor(level));
-    const double w_hi = level - double(lo);
+    const double w_hi = lod_blend(level - double(lo), kLodBlendBand);
     const bool smooth = filter_ == LatticeFilter::kSmooth;
+    // Both levels' pairs are found first and their lookups started together, so that the
+    // cache misses of the two tables overlap.
+    const std::size_t count = w_hi > 0 ? 2 : 1;
+    Blend b[2];
+    for (std::size_t i = 0; i < count; ++i) {
+        blend(levels_[lo + i], r, i == 0 ? 1 - w_hi : w_hi, smooth, b[i]);
+        levels_[lo + i].table->prefetch_coverage(b[i].ia, b[i].ib, b[i].n);
+    }
     Sheet s;
-    sheet(levels_[lo], r, 1 - w_hi, smooth, s);
-    if (w_hi > 0) sheet(levels_[lo + 1], r, w_hi, smooth, s);
+    for (std::size_t i = 0; i < count; ++i) add_blend(levels_[lo + i], b[i], s);
     if (s.alpha <= 1e-6) return false;
     const Vec3 p = s.p / s.alpha;
     const double t = dot(p - r.o, r.d) / dd;

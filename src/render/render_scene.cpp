@@ -32,10 +32,10 @@ bool RenderScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& 
 
 bool RenderScene::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                                    SurfaceHit& hit, std::vector<SurfaceHit>& partial,
-                                   double blocked_below) const {
+                                   const LayerStop& stop) const {
     AccelHit h;
     thread_local std::vector<AccelHit> layers;
-    const bool found = accel_->intersect_layers(r, tmin, tmax, self, h, layers, blocked_below);
+    const bool found = accel_->intersect_layers(r, tmin, tmax, self, h, layers, stop);
     if (found) surface_hit(r, h, hit);
     partial.resize(layers.size());
     for (std::size_t i = 0; i < layers.size(); ++i) surface_hit(r, layers[i], partial[i]);

@@ -30,10 +30,10 @@ public:
     bool intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const;
     // Through partial hits (render/layers.h): the closest opaque hit, if any, and every partial
     // hit before it, in ray order. `self` as for occluded.
-    // blocked_below: see EmbreeAccel::intersect_layers.
+    // stop: see EmbreeAccel::intersect_layers.
     bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                           SurfaceHit& hit, std::vector<SurfaceHit>& partial,
-                          double blocked_below = 0) const;
+                          const LayerStop& stop = {}) const;
     // `self`: the object whose surface the ray leaves (see EmbreeAccel::occluded).
     bool occluded(const Ray& r, double tmin, double tmax,
                   std::uint32_t self = EmbreeAccel::kNoObject) const {

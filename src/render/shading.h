@@ -26,10 +26,6 @@ inline Vec3 phong_term(const Material& m, Vec3 color, Vec3 n, Vec3 l, Vec3 v, Ve
 
 // Radiance (linear, unclamped) seen along `ray` at `hit`.
 Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters);
-// The same with shadow rays that pass partly through prefiltered lattices (render/layers.h);
-// `width`: the footprint of the shaded point (world units), which picks the lattices' levels.
-Vec3 shade_transmitted(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, double width,
-                       ShadeCounters& counters);
 
 // Start of shadow rays: far enough from the surface to skip its own crossing, which double
 // precision places within ~1e-12 relative of the true one, and small against any feature.
@@ -57,6 +53,26 @@ void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Visi
         }
         lit(light, l, seen);
     }
+}
+
+// Phong with shadows; visible(shadow ray, tmin, tmax, distance) is the share of the light that
+// arrives: 0 or 1 for shade(), a transmittance through partial hits for layered rays
+// (render/layers.h).
+template <class Visible>
+Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters,
+                Visible&& visible) {
+    const Scene& s = rs.scene();
+    const Material& m = s.materials[hit.material];
+    const Vec3 v = normalize(-ray.d);
+    Vec3 n = hit.n;
+    if (dot(n, v) < 0) n = -n;  // face the viewer
+
+    Vec3 c = m.ka * m.color * s.ambient;
+    for_each_light(rs, hit.p, counters, visible, [&](const PointLight& light, Vec3 l, double seen) {
+        const Vec3 lit = phong_term(m, m.color, n, l, v, light.intensity);
+        c += seen == 1 ? lit : lit * seen;
+    });
+    return c;
 }
 
 }  // namespace lat
