@@ -137,7 +137,10 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
     const double t = dot(p - r.o, r.d) / dd;
     if (!(t > tmin && t < tmax)) return false;
     const double ln = length(s.n);
-    hit = Crossing(t, 0, SurfacePoint{p, ln > 0 ? s.n / ln : -r.d / std::sqrt(dd)});
+    // The normal is the coverage-weighted mean of the blended pairs' unit normals, left
+    // unnormalised: its length (below 1 where they diverge) tells the shading how much the
+    // normals under the footprint spread (SurfaceHit::normal_length).
+    hit = Crossing(t, 0, SurfacePoint{p, ln > 0 ? s.n / s.alpha : -r.d / std::sqrt(dd)});
     // Blends of full pairs round to just under 1: they are opaque (and end the ray's traversal).
     hit.coverage = s.alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(s.alpha);
     return true;

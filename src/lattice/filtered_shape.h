@@ -69,6 +69,7 @@ public:
     // sheet occludes when it covers at least half.
     bool occluded(const Ray& r, double tmin, double tmax) const override;
     void spans(const Ray& r, SpanList& out) const override { point_.spans(r, out); }
+    // The mean of unit normals: of length 1 or less (see intersect).
     Vec3 normal(const Ray&, const Crossing& c) const override { return c.stored.n; }
     bool inside(Vec3 p) const override { return point_.inside(p); }
     // Culled by the coarsest level's frame, whose reach is the largest.

@@ -49,12 +49,14 @@ void RenderScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) 
     hit.object = h.object;
     hit.material = shape.tag(h.crossing, o.material);
     hit.alpha = h.crossing.coverage;
+    const SurfacePoint s = shape.surface(o.xf.is_identity() ? r : o.xf.inverse_ray(r), h.crossing);
+    // Only a mean of normals (prefiltered lattices) is meant to be shorter than 1.
+    const double len = length(s.n);
+    hit.normal_length = len < 1 - 1e-6 ? len : 1.0;
     if (o.xf.is_identity()) {
-        const SurfacePoint s = shape.surface(r, h.crossing);
         hit.p = s.p;
-        hit.n = s.n;
+        hit.n = hit.normal_length < 1 && len > 0 ? s.n / len : s.n;
     } else {
-        const SurfacePoint s = shape.surface(o.xf.inverse_ray(r), h.crossing);
         hit.p = o.xf.point(s.p);
         hit.n = normalize(o.xf.normal(s.n));
     }

@@ -17,6 +17,10 @@ struct SurfaceHit {
     std::uint32_t material = 0;
     std::uint32_t object = 0;
     double alpha = 1;  // coverage: below 1 only for prefiltered lattices (render/layers.h)
+    // Prefiltered lattices answer with the mean of the unit normals under a ray's footprint:
+    // its length, below 1 where they diverge, widens the specular lobe (phong_term). 1 for
+    // every other surface.
+    double normal_length = 1;
 };
 
 class RenderScene {
