@@ -14,6 +14,16 @@
 namespace lat {
 namespace {
 
+float float_above(double t) {
+    const auto f = static_cast<float>(t);
+    return static_cast<double>(f) > t ? f : std::nextafter(f, INFINITY);
+}
+
+// Partial crossings in ray order, ties by object: the same for any traversal order.
+bool in_ray_order(const AccelHit& a, const AccelHit& b) {
+    return a.t != b.t ? a.t < b.t : a.object < b.object;
+}
+
 // Per-query state. Embree hands our callbacks the RTCIntersectContext; ours extends it with
 // the double-precision ray and the best hit so far (the documented way to pass query data).
 struct QueryContext {
@@ -29,11 +39,39 @@ struct QueryContext {
     AccelHit* hit;
     bool found = false;
     std::uint32_t self = EmbreeAccel::kNoObject;  // occlusion: the object the ray leaves
-    // intersect_layers: where crossings of partial coverage go (they do not end the ray), and
-    // for transmittance queries, the product of their 1 - coverage and the value below which
-    // it counts as blocked (the product does not depend on the order they are met in).
+    // intersect_layers: where crossings of partial coverage go (they do not end the ray), how
+    // far to look, and for shadow rays the product of their 1 - coverage (which does not depend
+    // on the order they are met in).
     std::vector<AccelHit>* partial = nullptr;
-    double transmitted = 1, blocked_below = 0;
+    LayerStop stop;
+    double transmitted = 1;
+    // A partial crossing met; whether it blocks a shadow ray. For camera rays the crossings are
+    // kept in ray order and cut where compositing will stop (LayerStop), and tmax and the
+    // traversal's tfar come down to the last one kept.
+    bool add_partial(const AccelHit& h, float& tfar) {
+        // An object answers a ray with one sheet; met again (it fell out of the ring of tested
+        // objects), it is not counted twice.
+        for (const AccelHit& p : *partial)
+            if (p.object == h.object) return false;
+        if (stop.blocked_below > 0) {
+            partial->push_back(h);
+            transmitted *= 1.0 - double(h.crossing.coverage);
+            return transmitted < stop.blocked_below;
+        }
+        partial->insert(std::upper_bound(partial->begin(), partial->end(), h, in_ray_order), h);
+        if (stop.max_layers <= 0) return false;
+        double left = 1;
+        for (std::size_t i = 0; i < partial->size(); ++i) {
+            left *= 1.0 - double((*partial)[i].crossing.coverage);
+            if (static_cast<int>(i) + 1 == stop.max_layers || left <= stop.min_left) {
+                partial->resize(i + 1);
+                tmax = std::min(tmax, partial->back().t);
+                tfar = std::min(tfar, float_above(tmax));
+                break;
+            }
+        }
+        return false;
+    }
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;
@@ -66,11 +104,6 @@ RTCBounds to_rtc_bounds(const Bounds3& b) {
     r.upper_z = std::nextafter(static_cast<float>(b.hi.z + pad), INFINITY);
     r.align0 = r.align1 = 0;
     return r;
-}
-
-float float_above(double t) {
-    const auto f = static_cast<float>(t);
-    return static_cast<double>(f) > t ? f : std::nextafter(f, INFINITY);
 }
 
 // Embree asserts (and aborts) on a ray whose float origin or direction exceeds FLT_LARGE
@@ -223,20 +256,21 @@ struct EmbreeAccel::Impl {
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
-        const double tmax = ctx->found ? ctx->hit->t : ctx->tmax;
+        const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
         const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
         Crossing c;
         const bool hit = K == Kind::kDirect
                              ? shape.intersect(local, tmin, tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, tmax, c);
         if (!hit) return;
-        if (ctx->partial && c.coverage < 1.0f) {  // kept, and the ray goes on
-            ctx->partial->push_back({c.t, t.object, c});
-            ctx->transmitted *= 1.0 - double(c.coverage);
-            if (ctx->transmitted >= ctx->blocked_below) return;
-        }
-        self->record(ctx, reinterpret_cast<RTCRayHit*>(args->rayhit), t.object, c, args->geomID,
-                     args->primID, K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
+        auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+        // Partial crossings are kept, and the ray goes on (unless that blocks a shadow ray).
+        if (ctx->partial && c.coverage < 1.0f && !ctx->add_partial({c.t, t.object, c}, rh->ray.tfar))
+            return;
+        self->record(ctx, rh, t.object, c, args->geomID, args->primID,
+                     K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
+        // A blocked shadow ray needs no closer crossing: the traversal ends.
+        if (ctx->stop.blocked_below > 0) rh->ray.tfar = -INFINITY;
     }
 
     template <Kind K>
@@ -395,7 +429,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 
 bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                                    AccelHit& hit, std::vector<AccelHit>& partial,
-                                   double blocked_below) const {
+                                   const LayerStop& stop) const {
     partial.clear();
     const bool traceable = embree_can_trace(r, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
@@ -403,14 +437,16 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     QueryContext ctx(m, r, tmin, tmax, hit);
     ctx.self = self;
     ctx.partial = &partial;
-    ctx.blocked_below = blocked_below;
+    ctx.stop = stop;
     if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax);
+    const bool blocked = ctx.found && stop.blocked_below > 0;
     for (const std::uint32_t i : m.unbounded) {
+        if (blocked) break;
         const AccelObject& o = m.objects[i];
         const Ray local = o.xf->is_identity() ? r : o.xf->inverse_ray(r);
         Crossing c;
-        if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), ctx.found ? hit.t : tmax, c))
-            continue;
+        const double t1 = ctx.found ? std::min(hit.t, ctx.tmax) : ctx.tmax;
+        if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), t1, c)) continue;
         if (c.coverage < 1.0f) {
             partial.push_back({c.t, i, c});
         } else {
@@ -422,9 +458,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     if (ctx.found)
         std::erase_if(partial, [&](const AccelHit& p) { return p.t >= hit.t; });
     // In ray order (ties by object): the same for any traversal order.
-    std::sort(partial.begin(), partial.end(), [](const AccelHit& a, const AccelHit& b) {
-        return a.t != b.t ? a.t < b.t : a.object < b.object;
-    });
+    std::sort(partial.begin(), partial.end(), in_ray_order);
     return ctx.found;
 }
 

@@ -36,6 +36,19 @@ struct AccelHit {
     Crossing crossing;         // in the object's coordinates (same t)
 };
 
+// How far a traversal through partial crossings needs to go (intersect_layers).
+struct LayerStop {
+    // Shadow rays: once the partial crossings met let less than this through, or an opaque
+    // one is met, the ray is blocked and the traversal ends at once (`hit` is then no
+    // closest crossing; only "blocked" is meant). 0: not a shadow ray.
+    double blocked_below = 0;
+    // Camera rays, composited front to back: the first max_layers partial crossings, or
+    // those up to where the product of their (1 - coverage) falls to min_left or below,
+    // are all that is seen; the traversal looks no farther. max_layers 0: no limit.
+    int max_layers = 0;
+    double min_left = 0;
+};
+
 class EmbreeAccel {
 public:
     explicit EmbreeAccel(std::span<const AccelObject> objects, const AccelOptions& opt = {});
@@ -52,12 +65,10 @@ public:
     bool occluded(const Ray& r, double tmin, double tmax, std::uint32_t self = kNoObject) const;
     // One traversal for rays that see through partial crossings (Crossing::coverage < 1, from
     // prefiltered lattices): `hit`, as intersect() finds it, is the closest opaque crossing, and
-    // `partial` every partial crossing before it, in ray order. `self` as for occluded().
-    // blocked_below > 0 (shadow rays): once the partial crossings met let less than that
-    // through, the last one is taken as opaque and the traversal ends (`hit` is then no closest
-    // crossing; only "blocked" is meant).
+    // `partial` every partial crossing before it (up to where `stop` says), in ray order. `self`
+    // as for occluded().
     bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self, AccelHit& hit,
-                          std::vector<AccelHit>& partial, double blocked_below = 0) const;
+                          std::vector<AccelHit>& partial, const LayerStop& stop = {}) const;
 
     struct Impl;
 

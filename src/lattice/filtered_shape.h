@@ -40,6 +40,15 @@ inline constexpr double kCellPerFootprint = 0.85;
 // The level (real; 0 is the lattice of cell cell0, each next one halves it) for a footprint of
 // this width, in the same units.
 double lod_level(double cell0, double width);
+// Levels are blended only within a band of this width around the midpoint between two (as
+// "brilinear" texture filtering does): elsewhere a ray reads one level, half the lookups of a
+// blend. Plate 4 (512^2, 1 spp, against 256-spp exact): a band of 1 (linear blending across
+// the whole interval) 36.04 dB, 1/2 35.92 dB, 1/4 35.89 dB in 0.75 of its time, 0 (the
+// nearest level) 35.88 dB in 0.70; the loss is all in shadow rays. 1/4 keeps changes of level
+// across an image from showing as seams.
+inline constexpr double kLodBlendBand = 0.25;
+// The weight of the finer of two levels at fraction f (0 to 1) of the way to it.
+double lod_blend(double f, double band);
 
 // One level: a coverage table and its lattice.
 struct FilterLevel {
@@ -60,6 +69,7 @@ public:
     // sheet occludes when it covers at least half.
     bool occluded(const Ray& r, double tmin, double tmax) const override;
     void spans(const Ray& r, SpanList& out) const override { point_.spans(r, out); }
+    // The mean of unit normals: of length 1 or less (see intersect).
     Vec3 normal(const Ray&, const Crossing& c) const override { return c.stored.n; }
     bool inside(Vec3 p) const override { return point_.inside(p); }
     // Culled by the coarsest level's frame, whose reach is the largest.
@@ -88,12 +98,25 @@ private:
             n += h.normal * (w * h.alpha);
         }
     };
+    // The pairs of one level that a ray's sheet blends, and their weights.
+    struct Blend {
+        static constexpr int kMaxPairs = 5;
+        int n = 0;
+        std::uint32_t ia[kMaxPairs], ib[kMaxPairs];
+        GridPoint ca[kMaxPairs], cb[kMaxPairs];
+        double w[kMaxPairs];
+        void add(const BoundaryGrid& g, const GridPoint& a, const GridPoint& b, double weight) {
+            ia[n] = g.id(a), ib[n] = g.id(b);
+            if (ia[n] != ib[n]) ca[n] = a, cb[n] = b, w[n] = weight, ++n;
+        }
+    };
     std::vector<Level> levels_;
     LatticeFilter filter_;
     HitTableShape point_;  // the finest level, point-sampled
 
-    void sheet(const Level& l, const Ray& r, double weight, bool smooth, Sheet& s) const;
-    void add_pair(const Level& l, const GridPoint& a, const GridPoint& b, double w, Sheet& s) const;
+    void blend(const Level& l, const Ray& r, double weight, bool smooth, Blend& b) const;
+    // Looks the blend's pairs up and adds them to the sheet.
+    void add_blend(const Level& l, const Blend& b, Sheet& s) const;
 };
 
 }  // namespace lat

@@ -127,6 +127,9 @@ public:
                                CoverageHit* out, bool* found) const {
         for (int i = 0; i < n; ++i) found[i] = coverage(a[i], b[i], out[i]);
     }
+    // A hint that coverage_many will soon be asked for these pairs: the table may start
+    // fetching what locates them, so that the lookups of several tables overlap.
+    virtual void prefetch_coverage(const std::uint32_t*, const std::uint32_t*, int) const {}
 
     virtual std::string encoding() const = 0;
     // Encoding-specific facts for `lattice inspect` (widths, counts), one line; may be empty.

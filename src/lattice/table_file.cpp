@@ -15,6 +15,7 @@
 #include "lattice/boundary_grid.h"
 #include "lattice/encoding.h"
 #include "util/atomic_file.h"
+#include "util/big_buffer.h"
 #include "util/error.h"
 #include "util/hash.h"
 
@@ -131,14 +132,37 @@ TableHeader decode_header(const std::uint8_t* b, std::size_t file_size, const st
     return h;
 }
 
-// A read-only mapping of a whole file, shared by the table made over it.
+// A whole file in memory, shared by the table made over it: mapped read-only, or for large
+// tables read into anonymous memory with huge pages, since their lookups land at random over
+// hundreds of megabytes, and with 4 kB pages of a mapped file nearly every one would also miss
+// the TLB (Plate 4's filtered lattice, 350 MB of coverage tables: 13 % less render time).
 struct Mapping {
+    static constexpr std::size_t kCopyAbove = std::size_t{64} << 20;
     void* addr = nullptr;
     std::size_t size = 0;
+    ByteBuffer copy;
+    const std::uint8_t* bytes() const {
+        return copy.size() ? copy.data() : static_cast<const std::uint8_t*>(addr);
+    }
     ~Mapping() {
         if (addr && addr != MAP_FAILED) ::munmap(addr, size);
     }
 };
+
+// Reads the whole of fd into m.copy; false (errno set) on a read error or a short file.
+bool read_whole(int fd, Mapping& m) {
+    m.copy = ByteBuffer(m.size);
+    for (std::size_t done = 0; done < m.size;) {
+        const ssize_t n = ::pread(fd, m.copy.data() + done, m.size - done, static_cast<off_t>(done));
+        if (n <= 0) {
+            if (n < 0 && errno == EINTR) continue;
+            if (n == 0) errno = EIO;
+            return false;
+        }
+        done += static_cast<std::size_t>(n);
+    }
+    return true;
+}
 
 }  // namespace
 
@@ -200,11 +224,18 @@ LoadedTable load_table_file(const std::string& path, const TableHeader* expected
     }
     auto m = std::make_shared<Mapping>();
     m->size = static_cast<std::size_t>(st.st_size);
-    if (m->size > 0) m->addr = ::mmap(nullptr, m->size, PROT_READ, MAP_PRIVATE, fd, 0);
-    ::close(fd);
-    if (m->size > 0 && m->addr == MAP_FAILED)
-        throw InputError(path + ": cannot map lattice table: " + std::strerror(errno));
-    const auto* bytes = static_cast<const std::uint8_t*>(m->addr);
+    if (m->size >= Mapping::kCopyAbove) {
+        const bool ok = read_whole(fd, *m);
+        const int err = errno;
+        ::close(fd);
+        if (!ok) throw InputError(path + ": cannot read lattice table: " + std::strerror(err));
+    } else {
+        if (m->size > 0) m->addr = ::mmap(nullptr, m->size, PROT_READ, MAP_PRIVATE, fd, 0);
+        ::close(fd);
+        if (m->size > 0 && m->addr == MAP_FAILED)
+            throw InputError(path + ": cannot map lattice table: " + std::strerror(errno));
+    }
+    const std::uint8_t* bytes = m->bytes();
     std::uint64_t checksum = 0, meta_bytes = 0;
     LoadedTable out;
     out.header = decode_header(bytes, m->size, path, checksum, meta_bytes);

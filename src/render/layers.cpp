@@ -3,12 +3,26 @@
 #include "lattice/filtered_shape.h"
 
 namespace lat {
+namespace {
+
+// Radiance at a layer; `width`: its footprint (world units), which picks the lattices' levels
+// of detail for its shadow rays, narrowing to the point light.
+Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, double width,
+                 ShadeCounters& counters) {
+    return shade_with(rs, ray, hit, counters, [&](const Ray& r, double tmin, double tmax, double dist) {
+        set_ray_footprint({width, -width / dist});
+        return transmittance(rs, r, tmin, tmax, hit.object);
+    });
+}
+
+}  // namespace
 
 double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tmax,
                      std::uint32_t self) {
     thread_local std::vector<SurfaceHit> partial;
     SurfaceHit opaque;
-    if (rs.intersect_layers(r, tmin, tmax, self, opaque, partial, kMinTransmittance)) return 0;
+    if (rs.intersect_layers(r, tmin, tmax, self, opaque, partial, {.blocked_below = kMinTransmittance}))
+        return 0;
     double trans = 1;
     for (const SurfaceHit& h : partial) trans *= 1 - h.alpha;
     return trans <= kMinTransmittance ? 0 : trans;
@@ -18,7 +32,8 @@ Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCou
     thread_local std::vector<SurfaceHit> partial;
     set_ray_footprint({0, spread});
     SurfaceHit opaque;
-    const bool found = rs.intersect_layers(ray, 0.0, kInfinity, EmbreeAccel::kNoObject, opaque, partial);
+    const bool found = rs.intersect_layers(ray, 0.0, kInfinity, EmbreeAccel::kNoObject, opaque, partial,
+                                           {.max_layers = kMaxLayers, .min_left = kMinTransmittance});
     // Shading moves the footprint (shadow rays): the layers are all found first.
     const std::vector<SurfaceHit> layers = partial;
     Vec3 c;
@@ -26,11 +41,11 @@ Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCou
     for (std::size_t i = 0; i < layers.size(); ++i) {
         const SurfaceHit& h = layers[i];
         const double alpha = i + 1 == kMaxLayers ? 1.0 : h.alpha;
-        c += shade_transmitted(rs, ray, h, spread * h.t, counters) * (left * alpha);
+        c += shade_layer(rs, ray, h, spread * h.t, counters) * (left * alpha);
         left *= 1 - alpha;
         if (left <= kMinTransmittance) return c;
     }
-    return c + (found ? shade_transmitted(rs, ray, opaque, spread * opaque.t, counters)
+    return c + (found ? shade_layer(rs, ray, opaque, spread * opaque.t, counters)
                       : rs.scene().background) * left;
 }
 

@@ -32,10 +32,10 @@ bool RenderScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& 
 
 bool RenderScene::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                                    SurfaceHit& hit, std::vector<SurfaceHit>& partial,
-                                   double blocked_below) const {
+                                   const LayerStop& stop) const {
     AccelHit h;
     thread_local std::vector<AccelHit> layers;
-    const bool found = accel_->intersect_layers(r, tmin, tmax, self, h, layers, blocked_below);
+    const bool found = accel_->intersect_layers(r, tmin, tmax, self, h, layers, stop);
     if (found) surface_hit(r, h, hit);
     partial.resize(layers.size());
     for (std::size_t i = 0; i < layers.size(); ++i) surface_hit(r, layers[i], partial[i]);
@@ -50,12 +50,14 @@ void RenderScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) 
     hit.part = h.crossing.part;
     hit.material = shape.tag(h.crossing, o.material);
     hit.alpha = h.crossing.coverage;
+    const SurfacePoint s = shape.surface(o.xf.is_identity() ? r : o.xf.inverse_ray(r), h.crossing);
+    // Only a mean of normals (prefiltered lattices) is meant to be shorter than 1.
+    const double len = length(s.n);
+    hit.normal_length = len < 1 - 1e-6 ? len : 1.0;
     if (o.xf.is_identity()) {
-        const SurfacePoint s = shape.surface(r, h.crossing);
         hit.p = s.p;
-        hit.n = s.n;
+        hit.n = hit.normal_length < 1 && len > 0 ? s.n / len : s.n;
     } else {
-        const SurfacePoint s = shape.surface(o.xf.inverse_ray(r), h.crossing);
         hit.p = o.xf.point(s.p);
         hit.n = normalize(o.xf.normal(s.n));
     }

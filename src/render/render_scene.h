@@ -18,6 +18,10 @@ struct SurfaceHit {
     std::uint32_t object = 0;
     std::uint32_t part = 0;  // the shape's part that was hit (a mesh's triangle)
     double alpha = 1;  // coverage: below 1 only for prefiltered lattices (render/layers.h)
+    // Prefiltered lattices answer with the mean of the unit normals under a ray's footprint:
+    // its length, below 1 where they diverge, widens the specular lobe (phong_term). 1 for
+    // every other surface.
+    double normal_length = 1;
 };
 
 class RenderScene {
@@ -31,10 +35,10 @@ public:
     bool intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const;
     // Through partial hits (render/layers.h): the closest opaque hit, if any, and every partial
     // hit before it, in ray order. `self` as for occluded.
-    // blocked_below: see EmbreeAccel::intersect_layers.
+    // stop: see EmbreeAccel::intersect_layers.
     bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                           SurfaceHit& hit, std::vector<SurfaceHit>& partial,
-                          double blocked_below = 0) const;
+                          const LayerStop& stop = {}) const;
     // `self`: the object whose surface the ray leaves (see EmbreeAccel::occluded).
     bool occluded(const Ray& r, double tmin, double tmax,
                   std::uint32_t self = EmbreeAccel::kNoObject) const {

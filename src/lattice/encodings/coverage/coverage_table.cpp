@@ -190,13 +190,8 @@ void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b
     const std::uint8_t* rec[kMax];
     for (int base = 0; base < n; base += kMax) {
         const int m = std::min(kMax, n - base);
-        for (int i = 0; i < m; ++i) {
-            const std::uint32_t x = a[base + i], y = b[base + i];
-            idx[i] = x < points_ && y < points_ ? static_cast<std::uint64_t>(x) * points_ + y : ~0ull;
-            if (idx[i] == ~0ull) continue;
-            __builtin_prefetch(occ_ + (idx[i] >> 6));
-            __builtin_prefetch(counts_ + (idx[i] >> 6) / RankIndex::kBlockWords);
-        }
+        for (int i = 0; i < m; ++i) idx[i] = pair_index(a[base + i], b[base + i]);
+        prefetch_coverage(a + base, b + base, m);
         for (int i = 0; i < m; ++i) {
             rec[i] = idx[i] != ~0ull && rank_.test(idx[i]) ? records_ + rank_.rank(idx[i]) * kRecordBytes
                                                             : nullptr;
@@ -206,6 +201,15 @@ void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b
             found[base + i] = rec[i] && field(rec[i], kAlpha) != 0;
             if (found[base + i]) decode(rec[i], out[base + i]);
         }
+    }
+}
+
+void CoverageTable::prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const {
+    for (int i = 0; i < n; ++i) {
+        const std::uint64_t idx = pair_index(a[i], b[i]);
+        if (idx == ~0ull) continue;
+        __builtin_prefetch(occ_ + (idx >> 6));
+        __builtin_prefetch(counts_ + (idx >> 6) / RankIndex::kBlockWords);
     }
 }
 

@@ -24,6 +24,7 @@ public:
     bool coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const override;
     void coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n, CoverageHit* out,
                        bool* found) const override;
+    void prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const override;
     std::string encoding() const override { return "coverage"; }
     std::string details() const override;
     std::uint64_t entries() const override { return entries_; }
@@ -47,6 +48,10 @@ private:
     double alpha_sum_ = 0;
 
     const std::uint8_t* record(std::uint32_t a, std::uint32_t b) const;
+    // The dense index of pair (a, b), or ~0 when a point is out of range.
+    std::uint64_t pair_index(std::uint32_t a, std::uint32_t b) const {
+        return a < points_ && b < points_ ? static_cast<std::uint64_t>(a) * points_ + b : ~0ull;
+    }
     static void decode(const std::uint8_t* r, CoverageHit& hit);
 };
 
