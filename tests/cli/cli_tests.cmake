@@ -144,3 +144,17 @@ file(MAKE_DIRECTORY ${CLI_OUT}/t2-cache)
 add_test(NAME cli.table2_runs
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/good.json;-o;${CLI_OUT}/t2;--truth-spp;4;--spp;2;--encodings;hash14,dense;--lattice-dir;${CLI_OUT}/t2-cache;--texture-size;64"
           -DEXIT=0 "-DPATTERN=table2: lattice-dense" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+
+# Under mpirun (issue 14), when the build found MPI: 2 ranks against 1 process, and errors.
+if(LATTICE_WITH_MPI AND MPIEXEC_EXECUTABLE)
+  foreach(case render_exact render_lattice rasterize rank0_modes errors)
+    add_test(NAME cli.mpi_${case}
+      COMMAND ${CMAKE_COMMAND} -DLATTICE=$<TARGET_FILE:lattice> -DMPIEXEC=${MPIEXEC_EXECUTABLE}
+              -DEXAMPLES=${PROJECT_SOURCE_DIR}/examples -DDATA=${CMAKE_CURRENT_SOURCE_DIR}/data
+              -DWORK=${CLI_OUT}/mpi-${case} -DCASE=${case}
+              -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/mpi_cases.cmake)
+    # Open MPI refuses to run as root unless told (CI runs as root); two ranks on two cores.
+    set_tests_properties(cli.mpi_${case} PROPERTIES
+      ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1" PROCESSORS 2 TIMEOUT 300)
+  endforeach()
+endif()
