@@ -115,49 +115,53 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
     counts.visits.fetch_add(lattice_visits_this_thread() - visits0, std::memory_order_relaxed);
 }
 
-// The rows of the tiles [begin, end), as pieces of one of the image's pixel arrays.
-template <class T>
-void tile_rows(const TileContext& tc, std::span<const dist::Chunk> chunks,
-               const std::vector<T>& rgb, std::vector<std::span<const std::uint8_t>>& pieces) {
-    for (const auto& [begin, end] : chunks)
-        for (std::uint32_t tile = begin; tile != end; ++tile) {
+// Calls row(first, count) for each row of the chunks' tiles, in order: the index of its first
+// pixel in the image and its length in pixels.
+template <class F>
+void for_each_tile_row(const TileContext& tc, std::span<const dist::Chunk> chunks, F&& row) {
+    for (const dist::Chunk& c : chunks)
+        for (std::uint32_t tile = c.begin; tile != c.end; ++tile) {
             const int x0 = static_cast<int>(tile % static_cast<std::uint32_t>(tc.tiles_x)) * kTile;
             const int y0 = static_cast<int>(tile / static_cast<std::uint32_t>(tc.tiles_x)) * kTile;
-            const std::size_t n = static_cast<std::size_t>(std::min(tc.w, x0 + kTile) - x0) * 3;
-            for (int j = y0; j < std::min(tc.h, y0 + kTile); ++j) {
-                const T* row = rgb.data() + (static_cast<std::size_t>(j) * tc.w + x0) * 3;
-                pieces.emplace_back(reinterpret_cast<const std::uint8_t*>(row), n * sizeof(T));
-            }
+            const auto count = static_cast<std::size_t>(std::min(tc.w, x0 + kTile) - x0);
+            for (int j = y0; j < std::min(tc.h, y0 + kTile); ++j)
+                row(static_cast<std::size_t>(j) * static_cast<std::size_t>(tc.w) + static_cast<std::size_t>(x0), count);
         }
 }
 
 // Rank 0 receives every other rank's tiles: the chunk list, then the radiance and the display
 // rows of those tiles, in that order (15 bytes a pixel).
 void gather_tiles(const TileContext& tc, const dist::DealReport& mine) {
+    std::vector<float>& radiance = tc.out.radiance.rgb;
+    std::vector<std::uint8_t>& display = tc.out.display.rgb;
     const std::uint64_t nchunks = mine.chunks.size();
     std::vector<std::span<const std::uint8_t>> pieces{
         {reinterpret_cast<const std::uint8_t*>(&nchunks), sizeof nchunks},
-        {reinterpret_cast<const std::uint8_t*>(mine.chunks.data()), nchunks * sizeof(mine.chunks[0])}};
-    tile_rows(tc, mine.chunks, tc.out.radiance.rgb, pieces);
-    tile_rows(tc, mine.chunks, tc.out.display.rgb, pieces);
+        {reinterpret_cast<const std::uint8_t*>(mine.chunks.data()), nchunks * sizeof(dist::Chunk)}};
+    for_each_tile_row(tc, mine.chunks, [&](std::size_t first, std::size_t count) {
+        pieces.emplace_back(reinterpret_cast<const std::uint8_t*>(radiance.data() + first * 3),
+                            count * 3 * sizeof(float));
+    });
+    for_each_tile_row(tc, mine.chunks, [&](std::size_t first, std::size_t count) {
+        pieces.emplace_back(display.data() + first * 3, count * 3);
+    });
     const std::vector<ByteBuffer> all = dist::gather_to_root(pieces);
     for (std::size_t r = 1; r < all.size(); ++r) {
-        const ByteBuffer& b = all[r];
+        const std::uint8_t* from = all[r].data();
         std::uint64_t n = 0;
-        assert(b.size() >= sizeof n);
-        std::memcpy(&n, b.data(), sizeof n);
+        std::memcpy(&n, from, sizeof n);
         std::vector<dist::Chunk> chunks(n);
-        std::memcpy(chunks.data(), b.data() + sizeof n, n * sizeof(chunks[0]));
-        // Where this rank's rows go: the same walk over its tiles, into our image.
-        std::vector<std::span<const std::uint8_t>> into;
-        tile_rows(tc, chunks, tc.out.radiance.rgb, into);
-        tile_rows(tc, chunks, tc.out.display.rgb, into);
-        const std::uint8_t* from = b.data() + sizeof n + n * sizeof(chunks[0]);
-        for (const auto& row : into) {
-            std::memcpy(const_cast<std::uint8_t*>(row.data()), from, row.size());
-            from += row.size();
-        }
-        assert(from == b.data() + b.size());
+        std::memcpy(chunks.data(), from + sizeof n, n * sizeof(dist::Chunk));
+        from += sizeof n + n * sizeof(dist::Chunk);
+        for_each_tile_row(tc, chunks, [&](std::size_t first, std::size_t count) {
+            std::memcpy(radiance.data() + first * 3, from, count * 3 * sizeof(float));
+            from += count * 3 * sizeof(float);
+        });
+        for_each_tile_row(tc, chunks, [&](std::size_t first, std::size_t count) {
+            std::memcpy(display.data() + first * 3, from, count * 3);
+            from += count * 3;
+        });
+        assert(from == all[r].data() + all[r].size());
     }
 }
 
