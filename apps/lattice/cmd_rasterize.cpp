@@ -39,13 +39,13 @@ struct RankShare {
     int rank = 0;
     dist::HostName host;
     std::uint64_t segments = 0, hits = 0;
-    double seconds = 0;
+    double seconds = 0, cpu_seconds = 0;
     std::uint64_t peak_memory_bytes = 0;
 };
 
 nlohmann::json rank_shares(const RasterizeResult& r) {
     RankShare mine{dist::rank(), dist::HostName::here(), r.pairs_traced_here, r.hits_here, r.seconds,
-                   peak_rss_bytes()};
+                   cpu_seconds(), peak_rss_bytes()};
     nlohmann::json j = nlohmann::json::array();
     for (const RankShare& s : dist::gather_values(mine))
         j.push_back({{"rank", s.rank},
@@ -53,6 +53,7 @@ nlohmann::json rank_shares(const RasterizeResult& r) {
                      {"segments_traced", s.segments},
                      {"stored_hits", s.hits},
                      {"rasterize_seconds", s.seconds},
+                     {"cpu_seconds", s.cpu_seconds},
                      {"peak_memory_bytes", s.peak_memory_bytes}});
     return j;
 }
@@ -114,7 +115,13 @@ int run_rasterize(const RasterizeArgs& a) {
                             {"table_bytes", b.bytes},
                             {"bytes_per_hit", per_entry},
                             {"peak_memory_bytes", peak_rss_bytes()}};
-        if (!ranks.is_null()) j["ranks"] = ranks;
+        // The CPU time of the whole command (every rank's, summed): its cost on a busy machine.
+        j["cpu_seconds"] = cpu_seconds();
+        if (!ranks.is_null()) {
+            j["ranks"] = ranks;
+            j["cpu_seconds"] = 0.0;
+            for (const auto& rank : ranks) j["cpu_seconds"] = j["cpu_seconds"].get<double>() + rank["cpu_seconds"].get<double>();
+        }
         write_json_file(a.stats, j);
     }
     return 0;

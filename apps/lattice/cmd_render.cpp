@@ -128,6 +128,7 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeRes
         j["lattice_visits"] = st.lattice_visits;
     }
     j["render_ms"] = st.render_ms;
+    j["render_cpu_ms"] = st.cpu_ms;
     j["total_ms"] = t.written;
     j["primary_rays"] = st.primary_rays;
     j["shadow_rays"] = st.shadow_rays;
@@ -143,6 +144,7 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeRes
                                   {"chunks", rs.chunks},
                                   {"render_ms", rs.render_ms},
                                   {"wait_ms", rs.wait_ms},
+                                  {"cpu_ms", rs.cpu_ms},
                                   {"primary_rays", rs.primary_rays},
                                   {"shadow_rays", rs.shadow_rays},
                                   {"lattice_visits", rs.lattice_visits},

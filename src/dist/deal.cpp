@@ -133,7 +133,7 @@ class Dealer {
 public:
     Dealer(std::uint32_t n, const std::function<void(std::uint32_t)>& work, const DealOptions& opt)
         : n_(n), work_(work), opt_(opt), threads_(thread_count()),
-          queue_(static_cast<std::uint64_t>(threads_)) {
+          queue_(2 * static_cast<std::uint64_t>(threads_)) {
         report_.threads = threads_;
         std::vector<int> all(static_cast<std::size_t>(ranks()));
         transport::allgather(&threads_, sizeof threads_, all.data());
@@ -240,7 +240,8 @@ private:
         }
     }
 
-    // Other ranks: one request at a time, sent while the queue still holds a round of items.
+    // Other ranks: one request at a time, sent while the queue still holds two rounds of items
+    // (rank 0 may take up to a millisecond to answer).
     void ask() {
         bool asked = false, closed = false;
         std::uint64_t reported = 0;

@@ -14,7 +14,7 @@ namespace lat::dist {
 struct DealOptions {
     // Collective: spread the items over every rank of the job. Rank 0 deals them in chunks
     // that shrink as the items run out (guided self-scheduling), each rank asking for its next
-    // chunk while it still has one round of items left, so that no thread waits for the
+    // chunk while it still has two rounds of items left, so that no thread waits for the
     // network; each rank runs its chunks on all its threads. False (and in a single process):
     // one oneTBB loop over all items here.
     bool across_ranks = false;

@@ -37,11 +37,12 @@ void receive(int from, int tag, void* data, std::size_t bytes);
 // Whether a message with `tag` from any rank is waiting; `from` is then its sender.
 bool poll(int tag, int& from);
 
-// How long a waiting loop pauses after `idle` empty polls in a row: not at all at first
-// (answers that come in microseconds are not delayed), then 10 us doubling to 0.32 ms.
+// How long a waiting loop pauses after `idle` empty polls in a row: not at all for the first
+// few (an answer on its way is not delayed), then 50 us doubling to 0.8 ms. Each poll costs a
+// few microseconds of CPU, which a rank waiting while its threads render takes from them.
 inline long idle_pause_ns(int idle) {
-    if (idle < 64) return 0;
-    return 10'000L << (idle - 64 < 5 ? idle - 64 : 5);
+    if (idle < 4) return 0;
+    return 50'000L << (idle - 4 < 4 ? idle - 4 : 4);
 }
 // Sleeps idle_pause_ns(idle).
 void idle_wait(int idle);

@@ -176,6 +176,7 @@ void gather_rank_stats(const dist::DealReport& deal, RenderStats& st) {
     mine.chunks = static_cast<std::uint32_t>(deal.chunks.size());
     mine.render_ms = deal.seconds * 1e3;
     mine.wait_ms = deal.wait_seconds * 1e3;
+    mine.cpu_ms = st.cpu_ms;
     mine.primary_rays = st.primary_rays;
     mine.shadow_rays = st.shadow_rays;
     mine.lattice_visits = st.lattice_visits;
@@ -184,11 +185,13 @@ void gather_rank_stats(const dist::DealReport& deal, RenderStats& st) {
     if (st.ranks.empty()) return;
     st.primary_rays = st.shadow_rays = st.lattice_visits = 0;
     st.threads = 0;
+    st.cpu_ms = 0;
     for (const RankStats& r : st.ranks) {
         st.primary_rays += r.primary_rays;
         st.shadow_rays += r.shadow_rays;
         st.lattice_visits += r.lattice_visits;
         st.threads += r.threads;
+        st.cpu_ms += r.cpu_ms;
     }
 }
 
@@ -213,6 +216,7 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     ProgressBar bar("render", static_cast<std::uint64_t>(tiles_x) * tiles_y,
                     opt.progress && dist::is_root());
     const auto start = std::chrono::steady_clock::now();
+    const double cpu0 = cpu_seconds();
     dist::DealOptions deal_opt;
     deal_opt.across_ranks = across;
     deal_opt.progress = &bar;
@@ -225,10 +229,9 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     out.stats.shadow_rays = counts.shadow.load();
     out.stats.lattice_visits = counts.visits.load();
     out.stats.threads = deal.threads;
-    if (across) {
-        gather_tiles(tc, deal);
-        gather_rank_stats(deal, out.stats);
-    }
+    if (across) gather_tiles(tc, deal);
+    out.stats.cpu_ms = (cpu_seconds() - cpu0) * 1e3;
+    if (across) gather_rank_stats(deal, out.stats);
     out.stats.render_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return out;

@@ -36,12 +36,14 @@ struct RankStats {
     std::uint32_t tiles = 0, chunks = 0;
     double render_ms = 0;  // first tile dealt to last tile done here
     double wait_ms = 0;    // threads' time waiting for tiles, summed
+    double cpu_ms = 0;     // the process's CPU time (all threads) over the render and gather
     std::uint64_t primary_rays = 0, shadow_rays = 0, lattice_visits = 0;
     std::uint64_t peak_memory_bytes = 0;
 };
 
 struct RenderStats {
     double render_ms = 0;
+    double cpu_ms = 0;  // CPU time of the render, all threads (across_ranks: all ranks')
     std::uint64_t primary_rays = 0;
     std::uint64_t shadow_rays = 0;
     std::uint64_t lattice_visits = 0;  // see lattice_visits_this_thread
