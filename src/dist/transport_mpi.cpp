@@ -36,6 +36,19 @@ void wait(MPI_Request& request) {
     }
 }
 
+// A transfer of `bytes` as messages of at most kPiece bytes (one, if empty): start(offset,
+// count, request) begins each, which is then waited for.
+template <class Start>
+void in_pieces(std::size_t bytes, Start&& start) {
+    std::size_t at = 0;
+    do {
+        MPI_Request r;
+        start(at, static_cast<int>(std::min(kPiece, bytes - at)), &r);
+        wait(r);
+        at += kPiece;
+    } while (at < bytes);
+}
+
 }  // namespace
 
 bool start(int& argc, char**& argv) {
@@ -84,37 +97,21 @@ void allgather(const void* mine, std::size_t bytes, void* all) {
 }
 
 void broadcast(void* data, std::size_t bytes) {
-    auto* p = static_cast<std::uint8_t*>(data);
-    for (std::size_t at = 0; at < bytes; at += kPiece) {
-        MPI_Request r;
-        MPI_Ibcast(p + at, static_cast<int>(std::min(kPiece, bytes - at)), MPI_BYTE, 0, MPI_COMM_WORLD,
-                   &r);
-        wait(r);
-    }
+    in_pieces(bytes, [&](std::size_t at, int count, MPI_Request* r) {
+        MPI_Ibcast(static_cast<std::uint8_t*>(data) + at, count, MPI_BYTE, 0, MPI_COMM_WORLD, r);
+    });
 }
 
 void send(int to, int tag, const void* data, std::size_t bytes) {
-    const auto* p = static_cast<const std::uint8_t*>(data);
-    std::size_t at = 0;
-    do {
-        MPI_Request r;
-        MPI_Isend(p + at, static_cast<int>(std::min(kPiece, bytes - at)), MPI_BYTE, to, tag,
-                  MPI_COMM_WORLD, &r);
-        wait(r);
-        at += kPiece;
-    } while (at < bytes);
+    in_pieces(bytes, [&](std::size_t at, int count, MPI_Request* r) {
+        MPI_Isend(static_cast<const std::uint8_t*>(data) + at, count, MPI_BYTE, to, tag, MPI_COMM_WORLD, r);
+    });
 }
 
 void receive(int from, int tag, void* data, std::size_t bytes) {
-    auto* p = static_cast<std::uint8_t*>(data);
-    std::size_t at = 0;
-    do {
-        MPI_Request r;
-        MPI_Irecv(p + at, static_cast<int>(std::min(kPiece, bytes - at)), MPI_BYTE, from, tag,
-                  MPI_COMM_WORLD, &r);
-        wait(r);
-        at += kPiece;
-    } while (at < bytes);
+    in_pieces(bytes, [&](std::size_t at, int count, MPI_Request* r) {
+        MPI_Irecv(static_cast<std::uint8_t*>(data) + at, count, MPI_BYTE, from, tag, MPI_COMM_WORLD, r);
+    });
 }
 
 bool poll(int tag, int& from) {

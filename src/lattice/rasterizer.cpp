@@ -297,7 +297,7 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
         res.hits_counted += c.counted;
         res.tests += c.tests;
     }
-    if (opt.keep_hits && dist::is_root()) res.raw.chunks = std::move(block_hits);
+    if (opt.keep_hits && (!deal_opt.across_ranks || dist::is_root())) res.raw.chunks = std::move(block_hits);
     else res.raw = {};
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return res;
