@@ -68,6 +68,7 @@ int run_rasterize(const RasterizeArgs& a) {
         scene = load_scene(a.scene);
         plan = plan_table(find_primitive(scene, a), a.spec, a.scene);
     });
+    agree_on_scene(a.scene);
     if (path.empty()) {
         const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
                                !a.lattice_dir.empty(), true);

@@ -172,6 +172,7 @@ int run_render(const RenderArgs& a) {
         scene = load_scene(a.scene);
         check_render_budget(scene.camera, a.spp, a.scene);
     });
+    agree_on_scene(a.scene);
     // A mode that is not dealt across ranks renders on rank 0 alone.
     const bool across = dist::distributed() && mode_description(kModes.at(a.mode)).spreads_over_ranks;
     if (!across && !dist::is_root()) return 0;

@@ -1,7 +1,9 @@
 // `lattice`: one binary, several subcommands (render, rasterize, table1, compare, inspect, scatter,
 // table2). Started by mpirun or srun it is one rank of a job (docs/distributed.md).
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <new>
 #include <optional>
@@ -12,6 +14,7 @@
 #include "dist/job.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/hash.h"
 #include "util/interrupt.h"
 
 namespace {
@@ -45,6 +48,12 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv) {
     }
 }
 
+std::uint64_t command_line_fingerprint(int argc, char** argv) {
+    std::uint64_t h = 0;
+    for (int i = 1; i < argc; ++i) h = lat::hash_bytes(argv[i], std::strlen(argv[i]) + 1, h);
+    return h;
+}
+
 int run(int argc, char** argv) {
     CLI::App app{"lattice: ray tracing with three-dimensional lattice textures"};
     app.require_subcommand(1);
@@ -64,6 +73,7 @@ int run(int argc, char** argv) {
         for (auto& c : commands) {
             if (!c.app->parsed()) continue;
             if (!c.across_ranks && !lat::dist::is_root()) return 0;
+            if (c.across_ranks) lat::dist::agree_on(command_line_fingerprint(argc, argv), "the command line");
             return c.run();
         }
     } catch (const lat::Interrupted& e) {

@@ -62,6 +62,16 @@ void agree(const std::function<void()>& step) {
     throw JobInputError(message);
 }
 
+void agree_on(std::uint64_t fingerprint, const std::string& what) {
+    if (!distributed()) return;
+    std::vector<std::uint64_t> all(static_cast<std::size_t>(ranks()));
+    transport::allgather(&fingerprint, sizeof fingerprint, all.data());
+    for (std::size_t r = 1; r < all.size(); ++r)
+        if (all[r] != all[0])
+            throw JobInputError(what + " differs between rank 0 and rank " + std::to_string(r) +
+                                " (every rank must run the same command on the same files)");
+}
+
 void on_root(const std::function<void()>& step) {
     agree([&] {
         if (is_root()) step();

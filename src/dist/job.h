@@ -53,6 +53,10 @@ public:
 void agree(const std::function<void()>& step);
 // agree() with a step that runs on rank 0 only (the others wait, sleeping).
 void on_root(const std::function<void()>& step);
+// Collective: throws JobInputError on every rank unless `fingerprint` is the same on every
+// rank ("WHAT differs between rank 0 and rank N"): ranks rendering one image from different
+// inputs (a node's stale copy of a scene) would otherwise make a wrong image without a word.
+void agree_on(std::uint64_t fingerprint, const std::string& what);
 // Collective: rank 0's answer, on every rank.
 bool root_says(const std::function<bool()>& question);
 

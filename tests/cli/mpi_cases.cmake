@@ -76,19 +76,31 @@ elseif(CASE STREQUAL "errors")
   # The same mistake on every rank: said once, by rank 0.
   run_timed(2 "[^\n]*syntax-error.json:87:[0-9]+: invalid JSON" 30
             ${MPI2} ${LATTICE} render ${DATA}/bad/syntax-error.json -o ${WORK}/x.png)
-  # A mistake on rank 1 only (its own scene, MPMD): said once, naming the rank.
-  run_timed(2 "[^\n]*singular-transform.json: objects\\[2\\]\\.transform: matrix is singular.*\\(on rank 1 of 2, host [^)]+\\)" 30
-            ${MPIEXEC} -q -n 1 --oversubscribe ${LATTICE} render ${P4} -o ${WORK}/y.png
-            : -n 1 ${LATTICE} render ${DATA}/bad/singular-transform.json -o ${WORK}/y.png)
-  # A table cache that rank 1 does not share with rank 0 (MPMD again): rank 1 cannot find the
-  # table rank 0 built.
-  file(MAKE_DIRECTORY ${WORK}/c0 ${WORK}/c1)
-  run_timed(2 "[^\n]*cannot open lattice table.*every rank shares.*\\(on rank 1 of 2" 60
-            ${MPIEXEC} -q -n 1 --oversubscribe ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK}/c0 -o ${WORK}/z.png
-            : -n 1 ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK}/c1 -o ${WORK}/z.png)
+  # Every rank runs the same command line, but in its own directory (`A : B` with --wdir), as
+  # nodes that hold their own copies of the files would.
+  file(MAKE_DIRECTORY ${WORK}/r0/cache ${WORK}/r1/cache)
+  set(SAME_LINE_TWO_DIRS ${MPIEXEC} -q --oversubscribe -n 1 --wdir ${WORK}/r0 ${LATTICE} RENDER
+                         : -n 1 --wdir ${WORK}/r1 ${LATTICE} RENDER)
+  # A mistake in rank 1's copy of the scene only: said once, naming the rank.
+  configure_file(${P4} ${WORK}/r0/scene.json COPYONLY)
+  configure_file(${DATA}/bad/singular-transform.json ${WORK}/r1/scene.json COPYONLY)
+  string(REPLACE "RENDER" "render;scene.json;-o;${WORK}/y.png" cmd "${SAME_LINE_TWO_DIRS}")
+  run_timed(2 "scene.json: objects\\[2\\]\\.transform: matrix is singular.*\\(on rank 1 of 2, host [^)]+\\)" 30 ${cmd})
+  # Two good but different copies: refused, not a patchwork image.
+  configure_file(${DATA}/bad/good.json ${WORK}/r1/scene.json COPYONLY)
+  run_timed(2 "scene.json: the scene file differs between rank 0 and rank 1" 30 ${cmd})
+  # A table cache that rank 1 does not share with rank 0: it cannot find the table rank 0 built.
+  configure_file(${P3} ${WORK}/r0/scene.json COPYONLY)
+  configure_file(${P3} ${WORK}/r1/scene.json COPYONLY)
+  string(REPLACE "RENDER" "render;scene.json;--mode;lattice;--lattice-dir;cache;-o;${WORK}/z.png" cmd "${SAME_LINE_TWO_DIRS}")
+  run_timed(2 "[^\n]*cannot open lattice table.*every rank shares.*\\(on rank 1 of 2" 60 ${cmd})
+  # Different command lines (MPMD): refused.
+  run_timed(2 "the command line differs between rank 0 and rank 1" 30
+            ${MPIEXEC} -q --oversubscribe -n 1 ${LATTICE} render ${P4} -o ${WORK}/w.png
+            : -n 1 ${LATTICE} render ${P4} --spp 2 -o ${WORK}/w.png)
   # Usage errors too.
   run_timed(2 "--spp" 30 ${MPI2} ${LATTICE} render --spp 0 ${P4} -o ${WORK}/u.png)
-  foreach(f x.png y.png z.png u.png)
+  foreach(f x.png y.png z.png w.png u.png)
     if(EXISTS ${WORK}/${f})
       message(FATAL_ERROR "a failed job wrote ${f}")
     endif()
