@@ -108,6 +108,27 @@ TEST_P(EveryEncoding, SameBytesForAnyThreadCount) {
     EXPECT_EQ(std::memcmp(one.payload.data(), two.payload.data(), one.payload.size()), 0);
 }
 
+// Shadow rays ask for t alone (LatticeTable::lookup_t): the same pairs and the same t.
+TEST_P(EveryEncoding, TAloneAnswersAsTheFullLookup) {
+    const Encoding& e = *GetParam();
+    if (e.kind != LatticeTable::Kind::kHits) GTEST_SKIP() << "candidate tables store no t";
+    const Built b = build(e);
+    const BoundaryGrid grid(kContext.cells);
+    int answered = 0;
+    for (std::uint32_t a = 0; a < grid.count(); a += 2)
+        for (std::uint32_t c = 0; c < grid.count(); c += 3) {
+            TableHit hit;
+            double t = -1;
+            const bool full = b.table->lookup(a, c, hit);
+            ASSERT_EQ(b.table->lookup_t(a, c, t), full) << a << " " << c;
+            if (full) {
+                EXPECT_EQ(t, hit.t) << a << " " << c;
+            }
+            answered += full ? 1 : 0;
+        }
+    EXPECT_GT(answered, 100);
+}
+
 TEST_P(EveryEncoding, RoundTripsThroughATableFile) {
     const Encoding& e = *GetParam();
     const Built b = build(e);

@@ -52,7 +52,7 @@ TEST(ImageCompare, OneChannelOfOnePixelOffByTen) {
     EXPECT_EQ(format_psnr(s.psnr_db), "38.92");
     EXPECT_EQ(describe(s),
               "size: 2x2\npsnr_db: 38.92\nrmse: 2.8868\nmean_abs_error: 0.8333\n"
-              "max_abs_error: 10\npixels_over_8: 1 (25.0000%)\n");
+              "max_abs_error: 10\npixels_over_8: 1 (25.0000%)\nssim: n/a\n");
     // Symmetric.
     EXPECT_EQ(compare_images(b, a).rmse, s.rmse);
 }
@@ -214,6 +214,10 @@ TEST(Ssim, MatchesTheFormulaWindowByWindow) {
     }
     EXPECT_NEAR(ssim(a, b), total / 3, 1e-9);
     EXPECT_LT(ssim(a, b), 0.99);
+    // compare (and `lattice compare`) reports it.
+    const ImageDiffStats s = compare_images(a, b);
+    EXPECT_EQ(s.ssim, ssim(a, b));
+    EXPECT_NE(describe(s).find("\nssim: " + format_ssim(total / 3) + "\n"), std::string::npos) << describe(s);
 }
 
 }  // namespace

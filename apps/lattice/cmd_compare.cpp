@@ -1,4 +1,5 @@
 // lattice compare A.png B.png [--diff D.png] [--threshold N] [--json]
+// PSNR, RMSE, errors, share of pixels off and SSIM (io/image_compare.h says how each is defined).
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -29,7 +30,8 @@ int run_compare(const CompareArgs& args) {
                             {"max_abs_error", s.max_abs_error},
                             {"threshold", s.threshold},
                             {"pixels_over_threshold", s.pixels_over_8},
-                            {"share_over_threshold", s.share_over_8}};
+                            {"share_over_threshold", s.share_over_8},
+                            {"ssim", std::isnan(s.ssim) ? nlohmann::json(nullptr) : nlohmann::json(s.ssim)}};
         std::printf("%s\n", j.dump(2).c_str());
     } else {
         std::printf("%s", describe(s).c_str());
@@ -43,7 +45,7 @@ Command add_compare_command(CLI::App& parent) {
     auto args = std::make_shared<CompareArgs>();
     Command c;
     c.app = parent.add_subcommand(
-        "compare", "Compare two PNG images: PSNR, RMSE, largest error, share of pixels off");
+        "compare", "Compare two PNG images: PSNR, RMSE, largest error, share of pixels off, SSIM");
     c.app->add_option("a", args->a, "First image (PNG)")->required();
     c.app->add_option("b", args->b, "Second image (PNG)")->required();
     c.app->add_option("--diff", args->diff, "Write a heat-map of the difference (.png, .pfm, .exr)");

@@ -28,11 +28,7 @@ std::map<std::string, RenderMode> mode_names() {
 }
 const std::map<std::string, RenderMode> kModes = mode_names();
 const std::map<std::string, bool> kOnOff{{"on", true}, {"off", false}};
-const std::map<std::string, LatticeFilter> kFilters = [] {
-    std::map<std::string, LatticeFilter> m;
-    for (const auto& [name, value] : kLatticeFilterNames) m.emplace(name, value);
-    return m;
-}();
+const std::map<std::string, LatticeFilter>& kFilters = lattice_filters();
 const std::map<std::string, Instancing> kInstancing{
     {"auto", Instancing::kAuto}, {"always", Instancing::kAlways}, {"never", Instancing::kNever}};
 

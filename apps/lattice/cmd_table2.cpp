@@ -1,8 +1,10 @@
 // lattice table2 SCENE.json [-o DIR] [--spp N] [--truth-spp N] [--threads N] [--encodings a,b]
+//     [--filter smooth] [--filter-spp 1] [--crop-size 96] [--crop-scale 3]
 // The paper's Table 2 measured: the scene in every render mode (texture, particles, exact,
-// lattice per encoding) against an exact render at many samples per pixel: fidelity (PSNR,
-// SSIM, share of pixels off by more than 8/255), speed (render and preparation, separately)
-// and space (bytes the mode adds to the scene without its instances). docs/table2.md.
+// lattice per encoding, a filtered lattice) against an exact render at many samples per pixel:
+// fidelity (PSNR, SSIM, share of pixels off by more than 8/255), speed (render and
+// preparation, separately) and space (bytes the mode adds to the scene without its
+// instances); the images, one strip of them and one of magnified crops. docs/table2.md.
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +19,7 @@
 #include "lattice/encoding.h"
 #include "render/render_modes.h"
 #include "render/scene_parts.h"
+#include "table2_images.h"
 #include "scene/scene_loader.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -35,33 +38,24 @@ struct Table2Args {
     std::string lattice_dir;
     TextureOptions texture;
     int shadow_map_size = ParticleOptions{}.shadow_map_size;
+    std::string filter = "smooth";  // the filtered-lattice row; "none": no such row
+    int filter_spp = 1;
+    int crop_size = 96, crop_scale = 3;
 };
 
 struct Row {
-    std::string name;  // the image's name: the mode, or lattice-<encoding>
+    std::string name;  // the image's name: the mode, lattice-<encoding> or lattice-<encoding>-<filter>
     const ModeDescription* mode;
+    int spp;
     ModeResult result;
     ImageDiffStats diff;
-    double ssim = 0;
 };
 
-// Images side by side, 4 background-grey pixels apart, in the order given.
-Image8 strip(const std::vector<const Image8*>& images) {
-    constexpr int kGap = 4;
-    int w = 0, h = 0;
-    for (const Image8* im : images) {
-        w += im->width + (w ? kGap : 0);
-        h = std::max(h, im->height);
-    }
-    Image8 out{w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 3, 128)};
-    int x0 = 0;
-    for (const Image8* im : images) {
-        for (int y = 0; y < im->height; ++y)
-            std::copy_n(im->rgb.begin() + static_cast<std::ptrdiff_t>(y) * im->width * 3, im->width * 3,
-                        out.rgb.begin() + (static_cast<std::ptrdiff_t>(y) * w + x0) * 3);
-        x0 += im->width + kGap;
-    }
-    return out;
+// The encoding a filtered lattice uses: the first that stores coverage.
+std::string coverage_encoding() {
+    for (const Encoding* e : lat::encodings())
+        if (e->coverage) return std::string(e->name);
+    return {};
 }
 
 std::string fixed(double v, int digits) {
@@ -71,17 +65,18 @@ std::string fixed(double v, int digits) {
     return text;
 }
 
-std::string markdown(const Table2Args& a, const std::vector<Row>& rows, double truth_ms) {
+std::string markdown(const Table2Args& a, const std::vector<Row>& rows, double truth_ms, double bare_ms) {
     std::ostringstream md;
-    md << "Scene `" << a.scene << "`, " << a.spp << " spp per mode against exact at " << a.truth_spp
-       << " spp (" << fixed(truth_ms / 1000, 1) << " s), " << a.threads << " threads.\n\n";
-    md << "| technique | mode | paper: fidelity / speed / space | PSNR dB | SSIM | pixels off > 8 | "
+    md << "Scene `" << a.scene << "`, against exact at " << a.truth_spp << " spp (" << fixed(truth_ms / 1000, 1)
+       << " s), " << a.threads << " threads. The base alone (exact, without its instances) renders in "
+       << fixed(bare_ms, 0) << " ms at " << a.spp << " spp.\n\n";
+    md << "| technique | mode | spp | paper: fidelity / speed / space | PSNR dB | SSIM | pixels off > 8 | "
           "render ms | build/bake ms | bytes added |\n";
-    md << "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    md << "| --- | --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     for (const Row& r : rows)
-        md << "| " << r.mode->paper_technique << " | " << r.name << " | " << r.mode->paper_fidelity << " / "
-           << r.mode->paper_speed << " / " << r.mode->paper_space << " | " << fixed(r.diff.psnr_db, 2) << " | "
-           << fixed(r.ssim, 4) << " | " << fixed(100 * r.diff.share_over_8, 2) << " % | "
+        md << "| " << r.mode->paper_technique << " | " << r.name << " | " << r.spp << " | " << r.mode->paper_fidelity
+           << " / " << r.mode->paper_speed << " / " << r.mode->paper_space << " | " << fixed(r.diff.psnr_db, 2)
+           << " | " << format_ssim(r.diff.ssim) << " | " << fixed(100 * r.diff.share_over_8, 2) << " % | "
            << fixed(r.result.out.stats.render_ms, 0) << " | "
            << fixed(r.result.prepare_ms + r.result.build_ms, 0) << " | "
            << human_bytes(static_cast<double>(r.result.bytes_added)) << " |\n";
@@ -97,8 +92,9 @@ nlohmann::json row_json(const Row& r) {
                        {"speed", r.mode->paper_speed},
                        {"space", r.mode->paper_space}}},
             {"image", r.name + ".png"},
+            {"spp", r.spp},
             {"psnr_db", num(r.diff.psnr_db)},
-            {"ssim", r.ssim},
+            {"ssim", std::isnan(r.diff.ssim) ? nlohmann::json(nullptr) : nlohmann::json(r.diff.ssim)},
             {"share_over_8", r.diff.share_over_8},
             {"render_ms", r.result.out.stats.render_ms},
             {"prepare_ms", r.result.prepare_ms},
@@ -115,11 +111,15 @@ int run_table2(const Table2Args& a) {
     if (encodings.empty())
         for (const Encoding* e : lat::encodings()) encodings.emplace_back(e->name);
     for (const std::string& e : encodings) find_encoding(e);
+    const LatticeFilter filter = lattice_filters().at(a.filter);
+    const std::string filtered_encoding = filter == LatticeFilter::kNone ? "" : coverage_encoding();
     const Scene scene = load_scene(a.scene);
     check_render_budget(scene.camera, std::max(a.spp, a.truth_spp), a.scene);
     texture_base(scene);    // the texture mode needs a base surface,
     make_particles(scene);  // the particle mode chains
-    for (const std::string& e : encodings) {  // and the lattice mode tables of every encoding
+    std::vector<std::string> planned = encodings;
+    if (!filtered_encoding.empty()) planned.push_back(filtered_encoding);
+    for (const std::string& e : planned) {  // and the lattice mode tables of every encoding
         TableSpec spec;
         spec.encoding = e;
         for (const std::size_t i : instance_objects(scene))
@@ -142,12 +142,13 @@ int run_table2(const Table2Args& a) {
     write_png((fs::path(a.out_dir) / "truth.png").string(), truth.out.display);
 
     settings.spp = a.spp;
+    std::fprintf(stderr, "table2: the base alone\n");
+    const double bare_ms = render_in_mode(base_scene(scene), RenderMode::kExact, settings).out.stats.render_ms;
     std::vector<Row> rows;
     auto run = [&](const std::string& name, RenderMode mode) {
         std::fprintf(stderr, "table2: %s\n", name.c_str());
-        Row r{name, &mode_description(mode), render_in_mode(scene, mode, settings), {}, 0};
+        Row r{name, &mode_description(mode), settings.spp, render_in_mode(scene, mode, settings), {}};
         r.diff = compare_images(r.result.out.display, truth.out.display);
-        r.ssim = ssim(r.result.out.display, truth.out.display);
         write_png((fs::path(a.out_dir) / (name + ".png")).string(), r.result.out.display);
         rows.push_back(std::move(r));
     };
@@ -158,22 +159,40 @@ int run_table2(const Table2Args& a) {
         settings.spec.encoding = e;
         run("lattice-" + e, RenderMode::kLattice);
     }
+    if (!filtered_encoding.empty()) {  // filtering stands in for supersampling: its own spp
+        settings.spec.encoding = filtered_encoding;
+        settings.filtering.filter = filter;
+        settings.filtering.lod = true;
+        settings.spp = a.filter_spp;
+        run("lattice-" + filtered_encoding + "-" + a.filter, RenderMode::kLattice);
+    }
 
     std::vector<const Image8*> images{&truth.out.display};
     for (const Row& r : rows) images.push_back(&r.result.out.display);
-    write_png((fs::path(a.out_dir) / "strip.png").string(), strip(images));
+    write_png((fs::path(a.out_dir) / "strip.png").string(), image_strip(images));
+    const CropRegion crop = busiest_region(truth.out.display, a.crop_size);
+    write_png((fs::path(a.out_dir) / "crops.png").string(), crop_strip(images, crop, a.crop_scale));
 
-    std::string md = markdown(a, rows, truth.out.stats.render_ms);
-    md += "\nStrip (`strip.png`), left to right: truth";
-    for (const Row& r : rows) md += ", " + r.name;
-    md += ".\n";
+    std::string md = markdown(a, rows, truth.out.stats.render_ms, bare_ms);
+    std::string order = "truth";
+    for (const Row& r : rows) order += ", " + r.name;
+    md += "\nStrip (`strip.png`), left to right: " + order + ". Crops (`crops.png`), the same order: " +
+          std::to_string(crop.size) + " x " + std::to_string(crop.size) + " pixels from (" + std::to_string(crop.x) +
+          ", " + std::to_string(crop.y) + ") (the truth's busiest square), " + std::to_string(a.crop_scale) +
+          " x.\n";
     std::printf("%s", md.c_str());
     AtomicFile file(md_path);
     file.write(md.data(), md.size());
     file.commit();
-    nlohmann::json j = {{"scene", a.scene},  {"spp", a.spp},         {"truth_spp", a.truth_spp},
-                        {"threads", a.threads}, {"width", scene.camera.width}, {"height", scene.camera.height},
-                        {"truth_render_ms", truth.out.stats.render_ms}};
+    nlohmann::json j = {{"scene", a.scene},
+                        {"spp", a.spp},
+                        {"truth_spp", a.truth_spp},
+                        {"threads", a.threads},
+                        {"width", scene.camera.width},
+                        {"height", scene.camera.height},
+                        {"truth_render_ms", truth.out.stats.render_ms},
+                        {"bare_base_render_ms", bare_ms},
+                        {"crop", {{"x", crop.x}, {"y", crop.y}, {"size", crop.size}, {"scale", a.crop_scale}}}};
     for (const Row& r : rows) j["rows"].push_back(row_json(r));
     write_json_file((fs::path(a.out_dir) / "table2.json").string(), j);
     return 0;
@@ -201,6 +220,16 @@ Command add_table2_command(CLI::App& parent) {
         ->check(CLI::Range(1, 16));
     c.app->add_option("--shadow-map-size", args->shadow_map_size, "Particles mode: shadow map texels a side")
         ->check(CLI::Range(16, 16384));
+    c.app->add_option("--filter", args->filter,
+                      "The filtered-lattice row: the coverage encoding with this filter (none: no such row)")
+        ->check(CLI::IsMember(lattice_filters()));
+    c.app->add_option("--filter-spp", args->filter_spp,
+                      "Samples per pixel of the filtered lattice (filtering stands in for supersampling)")
+        ->check(CLI::Range(1, 65536));
+    c.app->add_option("--crop-size", args->crop_size, "Side of the magnified crops, pixels")
+        ->check(CLI::Range(8, 4096));
+    c.app->add_option("--crop-scale", args->crop_scale, "Magnification of the crops")
+        ->check(CLI::Range(1, 16));
     c.run = [args] { return run_table2(*args); };
     return c;
 }

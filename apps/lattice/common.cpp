@@ -16,6 +16,15 @@
 
 namespace lat::cli {
 
+const std::map<std::string, LatticeFilter>& lattice_filters() {
+    static const std::map<std::string, LatticeFilter> filters = [] {
+        std::map<std::string, LatticeFilter> m;
+        for (const auto& [name, value] : kLatticeFilterNames) m.emplace(name, value);
+        return m;
+    }();
+    return filters;
+}
+
 void add_table_options(CLI::App& app, TableSpec& spec) {
     // Its range is checked where the table is planned (plan_table), the one place for it.
     app.add_option("--sigma-inv", spec.sigma_inv,

@@ -1,8 +1,11 @@
 #pragma once
 // What several subcommands share: the table options, the thread limit, JSON output files.
+#include <map>
 #include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
+
+#include "lattice/filtered_shape.h"
 
 namespace CLI {
 class App;
@@ -16,6 +19,9 @@ namespace lat::cli {
 
 // --sigma-inv, --encoding and the encodings' error targets, shared by render and rasterize.
 void add_table_options(CLI::App& app, TableSpec& spec);
+
+// The --filter values (render, table2): none, box, smooth.
+const std::map<std::string, LatticeFilter>& lattice_filters();
 
 // Caps oneTBB (and so Embree's builds) at n threads for its lifetime; 0 = all cores.
 class ThreadLimit {

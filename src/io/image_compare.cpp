@@ -87,6 +87,7 @@ ImageDiffStats compare_images(const Image8& a, const Image8& b, int threshold) {
         s.max_abs_error = std::max(s.max_abs_error, e);
         if (e > threshold) ++s.pixels_over_8;
     }
+    s.ssim = ssim(a, b);
     if (pixels == 0) return s;  // nothing differs: the defaults (zeros, infinite PSNR) hold
     const auto channels = static_cast<double>(3 * pixels);
     s.mean_abs_error = static_cast<double>(sum_abs) / channels;
@@ -166,6 +167,13 @@ std::string format_psnr(double psnr_db) {
     return text;
 }
 
+std::string format_ssim(double ssim) {
+    if (std::isnan(ssim)) return "n/a";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4f", ssim);
+    return text;
+}
+
 std::string describe(const ImageDiffStats& s) {
     char share[32], rmse[32], mean[32];
     std::snprintf(share, sizeof share, "%.4f%%", 100.0 * s.share_over_8);
@@ -175,7 +183,7 @@ std::string describe(const ImageDiffStats& s) {
            "\npsnr_db: " + format_psnr(s.psnr_db) + "\nrmse: " + rmse +
            "\nmean_abs_error: " + mean + "\nmax_abs_error: " + std::to_string(s.max_abs_error) +
            "\npixels_over_" + std::to_string(s.threshold) + ": " + std::to_string(s.pixels_over_8) +
-           " (" + share + ")\n";
+           " (" + share + ")\nssim: " + format_ssim(s.ssim) + "\n";
 }
 
 ImageDiffStats compare_png_files(const std::string& path_a, const std::string& path_b,

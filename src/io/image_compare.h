@@ -9,6 +9,7 @@
 //   pixels_over_8   pixels whose largest channel error exceeds `threshold` (8 unless told
 //                   otherwise; the names follow the default), and share_over_8 their share of
 //                   all pixels, 0..1. A pixel is "off" if any channel is off by more than 8.
+//   ssim            the structural similarity index, ssim() below (NaN under 11 x 11 pixels)
 #include <limits>
 #include <string>
 
@@ -25,6 +26,7 @@ struct ImageDiffStats {
     long long pixels_over_8 = 0;
     double share_over_8 = 0.0;
     int threshold = 8;
+    double ssim = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Throws InputError "images differ in size: a.png is 64x48, b.png is 32x32".
@@ -49,6 +51,8 @@ Image8 difference_heatmap(const Image8& a, const Image8& b);
 
 // "inf" for identical images, else two decimals: "38.92".
 std::string format_psnr(double psnr_db);
+// Four decimals, "0.9971"; "n/a" for images under the 11 x 11 window.
+std::string format_ssim(double ssim);
 // One "name: value" line per statistic, names as in ImageDiffStats.
 std::string describe(const ImageDiffStats& s);
 

@@ -44,8 +44,22 @@ bool HitTableShape::intersect(const Ray& r, double tmin, double tmax, Crossing& 
 
 bool HitTableShape::occluded(const Ray& r, double tmin, double tmax) const {
     // The table knows the line's first and last crossings; between them it counts as solid.
-    LineHits lh;
-    return line_hits(r, lh, tmin) && (lh.first.t > tmin || lh.last.t > tmin) && lh.first.t < tmax;
+    // As line_hits, with t alone (no normals).
+    LatticeFrame::Snap s;
+    if (!frame_.snap(r, s) || s.a == s.b) return false;
+    double fwd = 0, rev = 0;
+    if (!table_->lookup_t(s.a, s.b, fwd)) return false;
+    const Vec3 va = to_vec(s.pa), vb = to_vec(s.pb);
+    const double dd = dot(s.d, s.d);
+    const double first = dot(lerp(va, vb, fwd) - s.o, s.d) / dd;
+    if (first >= tmax) return false;
+    if (first > tmin) return true;
+    // The last crossing; without a reverse hit (a table of another closed-ness convention)
+    // it is the first.
+    const double last = table_->lookup_t(s.b, s.a, rev)
+                            ? std::max(first, dot(lerp(vb, va, rev) - s.o, s.d) / dd)
+                            : first;
+    return last > tmin;
 }
 
 void HitTableShape::spans(const Ray& r, SpanList& out) const {

@@ -107,6 +107,15 @@ public:
     // The hit closest to p_a on the segment p_a -> p_b, if any (candidate tables intersect
     // their candidates with the segment exactly).
     virtual bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const = 0;
+    // The same hit's t alone, for shadow rays (two in three rays on the fur plates): encodings
+    // whose normals cost work to decode (dense's part codes evaluate the primitive's gradient)
+    // skip it. Answers exactly when lookup() does.
+    virtual bool lookup_t(std::uint32_t a, std::uint32_t b, double& t) const {
+        TableHit hit;
+        if (!lookup(a, b, hit)) return false;
+        t = hit.t;
+        return true;
+    }
     // Candidate tables: the parts for the pair (a, b); false when there are none.
     virtual bool candidates(std::uint32_t, std::uint32_t, CandidateList&) const { return false; }
     // Prefiltered tables (Encoding::coverage): the pair's coverage; false when the pair's rays

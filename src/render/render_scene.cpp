@@ -47,6 +47,7 @@ void RenderScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) 
     const Shape& shape = *shapes_[h.object];
     hit.t = h.t;
     hit.object = h.object;
+    hit.part = h.crossing.part;
     hit.material = shape.tag(h.crossing, o.material);
     hit.alpha = h.crossing.coverage;
     if (o.xf.is_identity()) {

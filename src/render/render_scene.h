@@ -16,6 +16,7 @@ struct SurfaceHit {
     Vec3 n;  // outward unit normal, world space
     std::uint32_t material = 0;
     std::uint32_t object = 0;
+    std::uint32_t part = 0;  // the shape's part that was hit (a mesh's triangle)
     double alpha = 1;  // coverage: below 1 only for prefiltered lattices (render/layers.h)
 };
 

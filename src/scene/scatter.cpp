@@ -151,16 +151,6 @@ ScatterParams parse_params(const JsonValue& v, const ObjectParser& parser,
     return p;
 }
 
-// Where the primitive stands: the centre of its lattice's base (or of its bounds' base).
-Vec3 root_of(const Primitive& prim) {
-    if (prim.lattice) {
-        const LatticeSpec& l = *prim.lattice;
-        return {0.5 * l.cells[0] * l.sigma, 0.5 * l.cells[1] * l.sigma, 0};
-    }
-    const Bounds3 b = prim.shape->bounds();
-    return {0.5 * (b.lo.x + b.hi.x), 0.5 * (b.lo.y + b.hi.y), b.lo.z};
-}
-
 // A unit vector across n: the comb direction with its normal part removed (another axis when
 // the comb runs along n), so neighbouring instances share their frame.
 Vec3 across(Vec3 n, Vec3 comb) {
@@ -230,6 +220,15 @@ std::vector<SurfaceSample> poisson_samples(const SurfaceSampler& sampler, const 
 
 }  // namespace
 
+Vec3 primitive_root(const Primitive& prim) {
+    if (prim.lattice) {
+        const LatticeSpec& l = *prim.lattice;
+        return {0.5 * l.cells[0] * l.sigma, 0.5 * l.cells[1] * l.sigma, 0};
+    }
+    const Bounds3 b = prim.shape->bounds();
+    return {0.5 * (b.lo.x + b.hi.x), 0.5 * (b.lo.y + b.hi.y), b.lo.z};
+}
+
 void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser& parser,
                     const std::vector<Primitive>& primitives, std::vector<SceneObject>& out) {
     v.allow_keys({"type", "name", "primitive", "on", "count", "density", "seed", "align", "twist",
@@ -238,7 +237,7 @@ void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser&
     const std::unique_ptr<SurfaceSampler> sampler = sampler_for(v, on, parser);
     const ScatterParams p = parse_params(v, parser, primitives, sampler->area());
     const Primitive& prim = primitives[static_cast<std::size_t>(p.primitive)];
-    const Vec3 root = root_of(prim);
+    const Vec3 root = primitive_root(prim);
     std::vector<SurfaceSample> points;
     if (p.min_distance > 0) {
         points = poisson_samples(*sampler, p, v);

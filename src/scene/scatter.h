@@ -17,6 +17,10 @@ namespace lat {
 // takes some 250 bytes, so the limit keeps one scatter within half a gigabyte.
 constexpr std::size_t kMaxScatterCount = 2'000'000;
 
+// Where an instance of the primitive stands, in its coordinates: the centre of the bottom of its
+// lattice box (or of its bounds). A scatter puts this point on the surface.
+Vec3 primitive_root(const Primitive& prim);
+
 // Expands the scatter `v` over the surface object `on` (its JSON, already parsed once as an
 // object of the scene), appending its instances to `out`.
 void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser& parser,

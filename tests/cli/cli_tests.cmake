@@ -114,9 +114,9 @@ add_test(NAME cli.scatter_command_unknown_name
           -DNO_FILE=${CLI_OUT}/placed.json -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 
 # Table 2 (issue 13): the texture and particle modes' own errors, their options, and table2.
-add_test(NAME cli.texture_needs_a_sphere
-  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;texture;${BAD}/texture-no-sphere.json;-o;${CLI_OUT}/tex.png"
-          -DEXIT=2 "-DPATTERN=texture-no-sphere.json: objects\\[1\\]: texture mode maps instances onto the sphere or ellipsoid"
+add_test(NAME cli.texture_base_unmappable
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;texture;${BAD}/texture-halfspace-base.json;-o;${CLI_OUT}/tex.png"
+          -DEXIT=2 "-DPATTERN=texture-halfspace-base.json: objects\\[0\\]: the instances grow from this object, and texture mode maps onto spheres, ellipsoids and triangle meshes only"
           -DNO_FILE=${CLI_OUT}/tex.png -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 add_test(NAME cli.particles_need_a_chain
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;particles;${BAD}/particles-not-chain.json;-o;${CLI_OUT}/par.png"
@@ -124,7 +124,7 @@ add_test(NAME cli.particles_need_a_chain
           -DNO_FILE=${CLI_OUT}/par.png -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 foreach(mode texture particles)
   add_test(NAME cli.${mode}_mode_renders
-    COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;-q;--mode;${mode};--spp;4;${BAD}/good.json;-o;${CLI_OUT}/${mode}.png"
+    COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;-q;--mode;${mode};--spp;4;${BAD}/furred-sphere.json;-o;${CLI_OUT}/${mode}.png"
             -DEXIT=0 -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 endforeach()
 add_test(NAME cli.texture_size_range
@@ -136,14 +136,20 @@ add_test(NAME cli.shadow_map_size_range
 add_test(NAME cli.table2_unknown_encoding
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/good.json;-o;${CLI_OUT}/t2bad;--encodings;hash14,nope"
           -DEXIT=2 "-DPATTERN=nope" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
-add_test(NAME cli.table2_texture_needs_a_sphere
-  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/texture-no-sphere.json;-o;${CLI_OUT}/t2tex;--truth-spp;1"
-          -DEXIT=2 "-DPATTERN=texture-no-sphere.json: objects\\[1\\]: texture mode" -DWORKDIR=${CLI_OUT}
+add_test(NAME cli.table2_texture_base_unmappable
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/texture-halfspace-base.json;-o;${CLI_OUT}/t2tex;--truth-spp;1"
+          -DEXIT=2 "-DPATTERN=texture-halfspace-base.json: objects\\[0\\]: the instances grow from this object" -DWORKDIR=${CLI_OUT}
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 file(MAKE_DIRECTORY ${CLI_OUT}/t2-cache)
 add_test(NAME cli.table2_runs
-  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/good.json;-o;${CLI_OUT}/t2;--truth-spp;4;--spp;2;--encodings;hash14,dense;--lattice-dir;${CLI_OUT}/t2-cache;--texture-size;64"
-          -DEXIT=0 "-DPATTERN=table2: lattice-dense" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/furred-sphere.json;-o;${CLI_OUT}/t2;--truth-spp;4;--spp;2;--encodings;hash14,dense;--lattice-dir;${CLI_OUT}/t2-cache;--texture-size;64"
+          -DEXIT=0 "-DPATTERN=table2: lattice-dense" "-DSTDOUT_PATTERN=\\| lattice-coverage-smooth \\| 1 \\|.*Crops \\(`crops.png`\\)"
+          -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+# compare prints SSIM (issue 13), here of two of table2's images.
+add_test(NAME cli.compare_prints_ssim
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;compare;${CLI_OUT}/t2/truth.png;${CLI_OUT}/t2/texture.png"
+          -DEXIT=0 "-DSTDOUT_PATTERN=ssim: 0\\.[0-9][0-9][0-9][0-9]" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+set_tests_properties(cli.compare_prints_ssim PROPERTIES DEPENDS cli.table2_runs)
 
 # Under mpirun (issue 14), when the build found MPI: 2 ranks against 1 process, and errors.
 # Not in the sanitizer build: Open MPI is not instrumented, and LSan would report its

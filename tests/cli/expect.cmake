@@ -1,6 +1,7 @@
 # Runs one command line and checks what a user would see: the exit code, a message pattern on
-# stderr, and (optionally) that no output file was left behind.
-#   cmake -DCMD="a;b;c" -DEXIT=2 -DPATTERN=regex [-DNO_FILE=path] [-DWORKDIR=dir] -P expect.cmake
+# stderr (and optionally one on stdout), and (optionally) that no output file was left behind.
+#   cmake -DCMD="a;b;c" -DEXIT=2 -DPATTERN=regex [-DSTDOUT_PATTERN=regex] [-DNO_FILE=path]
+#         [-DWORKDIR=dir] -P expect.cmake
 if(NO_FILE)
   file(REMOVE "${NO_FILE}")
 endif()
@@ -11,6 +12,9 @@ if(NOT code EQUAL EXIT)
 endif()
 if(PATTERN AND NOT err MATCHES "${PATTERN}")
   message(FATAL_ERROR "stderr does not match '${PATTERN}':\n${err}")
+endif()
+if(STDOUT_PATTERN AND NOT out MATCHES "${STDOUT_PATTERN}")
+  message(FATAL_ERROR "stdout does not match '${STDOUT_PATTERN}':\n${out}")
 endif()
 string(REGEX MATCHALL "\n" lines "${err}")
 list(LENGTH lines nlines)

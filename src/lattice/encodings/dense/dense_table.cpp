@@ -305,16 +305,26 @@ std::string DenseTable::details() const {
     return buf;
 }
 
-bool DenseTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
+// The record of pair (a, b): its bit offset; false when the pair stores no hit.
+bool DenseTable::record(std::uint32_t a, std::uint32_t b, std::uint64_t& off) const {
     if (a == b || a >= l_.points || b >= l_.points) return false;
     const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
     const std::uint64_t i = pair_index(lo, hi);
     if (!rank_.test(i)) return false;
-    const std::uint64_t k = rank_.rank(i);
     const std::uint32_t field = l_.t_bits + l_.normal_bits;
-    const std::uint64_t off = k * 2 * field + (a < b ? 0 : field);
+    off = rank_.rank(i) * 2 * field + (a < b ? 0 : field);
+    return true;
+}
+
+std::uint64_t DenseTable::normal_code(std::uint64_t off) const {
+    return l_.normal_bits ? read_bits(records_, off + l_.t_bits, l_.normal_bits) : 0;
+}
+
+bool DenseTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
+    std::uint64_t off = 0;
+    if (!record(a, b, off)) return false;
     hit.t = double(read_bits(records_, off, l_.t_bits)) * t_scale_;
-    const std::uint64_t n = l_.normal_bits ? read_bits(records_, off + l_.t_bits, l_.normal_bits) : 0;
+    const std::uint64_t n = normal_code(off);
     if (l_.normal_mode == 0) {
         const int bits = int(l_.normal_bits / 2);
         hit.normal = oct_decode({std::uint32_t(n & ((1u << bits) - 1)), std::uint32_t(n >> bits)}, bits);
@@ -324,6 +334,14 @@ bool DenseTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
     const Vec3 pa = to_vec(grid_.point(a)), pb = to_vec(grid_.point(b));
     const Crossing c{hit.t, part_codes_[2 * n], part_codes_[2 * n + 1]};
     hit.normal = normalize(ctx_.primitive->normal({pa * ctx_.cell, (pb - pa) * ctx_.cell}, c));
+    return true;
+}
+
+bool DenseTable::lookup_t(std::uint32_t a, std::uint32_t b, double& t) const {
+    std::uint64_t off = 0;
+    if (!record(a, b, off)) return false;
+    if (l_.normal_mode != 0 && normal_code(off) >= l_.parts) return false;  // as lookup()
+    t = double(read_bits(records_, off, l_.t_bits)) * t_scale_;
     return true;
 }
 

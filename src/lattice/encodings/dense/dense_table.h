@@ -23,6 +23,7 @@ public:
                const TableContext& ctx);
 
     bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const override;
+    bool lookup_t(std::uint32_t a, std::uint32_t b, double& t) const override;
     std::string encoding() const override { return "dense"; }
     std::string details() const override;
     std::uint64_t entries() const override { return entries_; }
@@ -53,6 +54,9 @@ private:
     TableContext ctx_;
     BoundaryGrid grid_;
     double t_scale_ = 0;
+
+    bool record(std::uint32_t a, std::uint32_t b, std::uint64_t& off) const;
+    std::uint64_t normal_code(std::uint64_t off) const;
 };
 
 }  // namespace lat
