@@ -19,11 +19,17 @@ echo "== complexity (exact against lattice mode as the primitive grows; docs/com
 python3 "$here/complexity.py" "$build/bin/lattice" "$out" --work "$build/complexity" > "$out/complexity.md"
 echo "== scatter (fur on a mesh, 100,000 instances)"
 python3 "$here/scatter.py" "$build/bin/lattice" "$out" > "$out/scatter.md"
+echo "== MPI (2 ranks x 1 thread against 1 rank x 2 threads; docs/distributed.md)"
+if command -v mpirun > /dev/null && "$build/bin/lattice" --version | grep -q "with MPI"; then
+  python3 "$here/distributed.py" "$build/bin/lattice" "$out" > "$out/distributed.md"
+else
+  echo "(skipped: the build did not find MPI)" > "$out/distributed.md"
+fi
 # matplotlib is Debian's python3-matplotlib: plot with Debian's python3 even when another one
 # (pyenv, a virtualenv) comes first in PATH.
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 "$py" "$here/plot_complexity.py" "$out/complexity.json" "$here/../docs/images/complexity.png"
-{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/scatter.md"; } > "$out/summary.md"
+{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/scatter.md" "$out/distributed.md"; } > "$out/summary.md"
 echo
 cat "$out/summary.md"
 echo "results: $out"

@@ -1,10 +1,12 @@
 // lattice rasterize SCENE.json --primitive NAME [--sigma-inv K] [-o FILE.lht] [--encoding E]
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "common.h"
+#include "dist/job.h"
 #include "lattice/cache/table_build.h"
 #include "lattice/cache/table_cache.h"
 #include "scene/scene_loader.h"
@@ -22,27 +24,64 @@ struct RasterizeArgs {
     bool quiet = false;
 };
 
-int run_rasterize(const RasterizeArgs& a) {
-    const Scene scene = load_scene(a.scene);
-    const Primitive* prim = nullptr;
+const Primitive& find_primitive(const Scene& scene, const RasterizeArgs& a) {
     std::string known;
     for (const Primitive& p : scene.primitives) {
-        if (p.name == a.primitive) prim = &p;
+        if (p.name == a.primitive) return p;
         known += (known.empty() ? "" : ", ") + p.name;
     }
-    if (!prim)
-        throw InputError(a.scene + ": no primitive named '" + a.primitive + "'" +
-                         (known.empty() ? " (the scene defines none)" : " (it has: " + known + ")"));
-    const TablePlan plan = plan_table(*prim, a.spec, a.scene);
+    throw InputError(a.scene + ": no primitive named '" + a.primitive + "'" +
+                     (known.empty() ? " (the scene defines none)" : " (it has: " + known + ")"));
+}
+
+// One rank's share of a rasterization spread across an MPI job.
+struct RankShare {
+    int rank = 0;
+    dist::HostName host;
+    std::uint64_t segments = 0, hits = 0;
+    double seconds = 0, cpu_seconds = 0;
+    std::uint64_t peak_memory_bytes = 0;
+};
+
+nlohmann::json rank_shares(const RasterizeResult& r, double build_cpu) {
+    RankShare mine{dist::rank(), dist::HostName::here(), r.pairs_traced_here, r.hits_here, r.seconds,
+                   build_cpu, peak_rss_bytes()};
+    nlohmann::json j = nlohmann::json::array();
+    for (const RankShare& s : dist::gather_values(mine))
+        j.push_back({{"rank", s.rank},
+                     {"host", s.host.text},
+                     {"segments_traced", s.segments},
+                     {"stored_hits", s.hits},
+                     {"rasterize_seconds", s.seconds},
+                     {"build_cpu_seconds", s.cpu_seconds},
+                     {"peak_memory_bytes", s.peak_memory_bytes}});
+    return j;
+}
+
+int run_rasterize(const RasterizeArgs& a) {
+    // In an MPI job every rank loads the scene and plans the table; all of them rasterize,
+    // rank 0 encodes and writes.
+    Scene scene;
+    std::optional<TablePlan> plan;
     std::string path = a.output;
+    dist::agree([&] {
+        scene = load_scene(a.scene);
+        plan = plan_table(find_primitive(scene, a), a.spec, a.scene);
+    });
+    agree_on_scene(a.scene);
     if (path.empty()) {
         const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
-                               !a.lattice_dir.empty());
-        path = cache.path_for(plan);
+                               !a.lattice_dir.empty(), true);
+        path = cache.path_for(*plan);
     }
     const ThreadLimit limit(a.threads);
-    const TableBuild b =
-        build_table_file(plan, path, !a.quiet && ProgressBar::stderr_is_terminal());
+    const bool progress = !a.quiet && dist::is_root() && ProgressBar::stderr_is_terminal();
+    const double cpu0 = cpu_seconds();
+    const TableBuild b = build_table_file(*plan, path, progress, true);
+    const double build_cpu = cpu_seconds() - cpu0;
+    const nlohmann::json ranks = dist::distributed() ? rank_shares(b.raster, build_cpu) : nlohmann::json();
+    if (!dist::is_root()) return 0;
+    const Primitive* prim = plan->primitive;
     const RasterizeResult& r = b.raster;
     const double seconds = r.seconds + b.encode_seconds;
     const double per_entry = r.hits ? double(b.bytes) / double(r.hits) : 0.0;
@@ -63,22 +102,32 @@ int run_rasterize(const RasterizeArgs& a) {
                     per_entry);
     }
     if (!a.stats.empty()) {
-        write_json_file(a.stats, {{"table", path},
-                                  {"primitive", prim->name},
-                                  {"sigma_inv", a.spec.sigma_inv},
-                                  {"encoding", a.spec.encoding},
-                                  {"cells", b.header.cells},
-                                  {"N_lp", r.pairs_eq2},
-                                  {"segments_traced", r.pairs_traced},
-                                  {"N_ix", r.hits_counted},
-                                  {"stored_hits", r.hits},
-                                  {"segment_tests", r.tests},
-                                  {"rasterize_seconds", r.seconds},
-                                  {"encode_seconds", b.encode_seconds},
-                                  {"pairs_per_second", double(r.pairs_eq2) / seconds},
-                                  {"table_bytes", b.bytes},
-                                  {"bytes_per_hit", per_entry},
-                                  {"peak_memory_bytes", peak_rss_bytes()}});
+        nlohmann::json j = {{"table", path},
+                            {"primitive", prim->name},
+                            {"sigma_inv", a.spec.sigma_inv},
+                            {"encoding", a.spec.encoding},
+                            {"cells", b.header.cells},
+                            {"N_lp", r.pairs_eq2},
+                            {"segments_traced", r.pairs_traced},
+                            {"N_ix", r.hits_counted},
+                            {"stored_hits", r.hits},
+                            {"segment_tests", r.tests},
+                            {"rasterize_seconds", r.seconds},
+                            {"encode_seconds", b.encode_seconds},
+                            {"pairs_per_second", double(r.pairs_eq2) / seconds},
+                            {"table_bytes", b.bytes},
+                            {"bytes_per_hit", per_entry},
+                            {"peak_memory_bytes", peak_rss_bytes()}};
+        // The CPU time of the build (check, rasterize, gather, encode, write; every rank's,
+        // summed): its cost whatever else the machine runs.
+        double cpu = build_cpu;
+        if (!ranks.is_null()) {
+            j["ranks"] = ranks;
+            cpu = 0;
+            for (const auto& rank : ranks) cpu += rank["build_cpu_seconds"].get<double>();
+        }
+        j["build_cpu_seconds"] = cpu;
+        write_json_file(a.stats, j);
     }
     return 0;
 }
@@ -99,6 +148,7 @@ Command add_rasterize_command(CLI::App& parent) {
     c.app->add_option("--threads", args->threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(0, 4096));
     c.app->add_flag("-q,--quiet", args->quiet, "No progress bar or summary");
+    c.across_ranks = true;
     c.run = [args] { return run_rasterize(*args); };
     return c;
 }

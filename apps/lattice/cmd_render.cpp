@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "common.h"
+#include "dist/job.h"
 #include "io/image.h"
 #include "render/render_modes.h"
 #include "scene/scene_loader.h"
@@ -77,6 +78,13 @@ void print_summary(const RenderArgs& a, const Scene& scene, const ModeResult& r,
                      human_bytes(static_cast<double>(lattices.table_bytes)).c_str(),
                      std::to_string(lattices.table_entries).c_str(), lattices.built,
                      lattices.build_seconds);
+    if (st.ranks.size() > 1)
+        std::fprintf(stderr, "lattice: render spread over %zu MPI ranks (tiles per rank:%s)\n",
+                     st.ranks.size(), [&] {
+                         std::string tiles;
+                         for (const RankStats& rs : st.ranks) tiles += " " + std::to_string(rs.tiles);
+                         return tiles;
+                     }().c_str());
     std::fprintf(stderr,
                  "lattice: %s %dx%d, %d spp, %s mode: render %.1f ms on %d threads, "
                  "%llu primary + %llu shadow rays, %.2f M rays/s (total %.1f ms, peak %.1f MB)\n",
@@ -116,11 +124,28 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeRes
         j["lattice_visits"] = st.lattice_visits;
     }
     j["render_ms"] = st.render_ms;
+    j["render_cpu_ms"] = st.cpu_ms;
     j["total_ms"] = t.written;
     j["primary_rays"] = st.primary_rays;
     j["shadow_rays"] = st.shadow_rays;
     j["rays_per_second"] = mrays_per_s(st) * 1e6;
     j["peak_memory_bytes"] = peak_rss_bytes();
+    if (!st.ranks.empty()) {
+        j["mpi_ranks"] = st.ranks.size();
+        for (const RankStats& rs : st.ranks)
+            j["ranks"].push_back({{"rank", rs.rank},
+                                  {"host", rs.host},
+                                  {"threads", rs.threads},
+                                  {"tiles", rs.tiles},
+                                  {"chunks", rs.chunks},
+                                  {"render_ms", rs.render_ms},
+                                  {"wait_ms", rs.wait_ms},
+                                  {"cpu_ms", rs.cpu_ms},
+                                  {"primary_rays", rs.primary_rays},
+                                  {"shadow_rays", rs.shadow_rays},
+                                  {"lattice_visits", rs.lattice_visits},
+                                  {"peak_memory_bytes", rs.peak_memory_bytes}});
+    }
     return j;
 }
 
@@ -130,16 +155,27 @@ int run_render(const RenderArgs& a) {
     auto since_start = [&] {
         return std::chrono::duration<double, std::milli>(clock::now() - start).count();
     };
-    // Everything the user can get wrong is checked before the (possibly long) render.
-    const ImageFormat format = image_format_for(a.output);
-    check_writable(a.output);
-    if (!a.stats.empty()) check_writable(a.stats);
+    // Everything the user can get wrong is checked before the (possibly long) render; in an MPI
+    // job every rank loads the scene, and a mistake found on any rank ends them all.
+    ImageFormat format{};
+    Scene scene;
+    dist::agree([&] {
+        format = image_format_for(a.output);
+        if (dist::is_root()) {  // only rank 0 writes
+            check_writable(a.output);
+            if (!a.stats.empty()) check_writable(a.stats);
+        }
+        scene = load_scene(a.scene);
+        check_render_budget(scene.camera, a.spp, a.scene);
+    });
+    agree_on_scene(a.scene);
+    // A mode that is not dealt across ranks renders on rank 0 alone.
+    const bool across = dist::distributed() && mode_description(kModes.at(a.mode)).spreads_over_ranks;
+    if (!across && !dist::is_root()) return 0;
 
     Timings t;
-    const Scene scene = load_scene(a.scene);
-    check_render_budget(scene.camera, a.spp, a.scene);
     const ThreadLimit limit(a.threads);
-    const bool progress = !a.quiet && ProgressBar::stderr_is_terminal();
+    const bool progress = !a.quiet && dist::is_root() && ProgressBar::stderr_is_terminal();
     t.loaded = since_start();
     ModeSettings settings;
     settings.spp = a.spp;
@@ -151,9 +187,11 @@ int run_render(const RenderArgs& a) {
     settings.accel.instancing = kInstancing.at(a.instancing);
     settings.texture = a.texture;
     settings.shadow_map_size = a.shadow_map_size;
+    settings.across_ranks = across;
     // From the render on a signal stops it at the next tile and removes our temporaries.
     settings.before_render = [] { install_interrupt_handlers(); };
     const ModeResult r = render_in_mode(scene, kModes.at(a.mode), settings);
+    if (!dist::is_root()) return 0;
     const RenderOutput& out = r.out;
     write_image(a.output, format, out);
     t.written = since_start();
@@ -207,6 +245,7 @@ Command add_render_command(CLI::App& parent) {
                       "hierarchy (never), or flattened unless that would be huge (auto)")
         ->check(CLI::IsMember(kInstancing));
     c.app->add_flag("-q,--quiet", args->quiet, "No progress bar or summary line");
+    c.across_ranks = true;
     c.run = [args, app = c.app] {
         // A filter needs coverage: unless an encoding was asked for, it takes the one with it.
         if (kFilters.at(args->filter) != LatticeFilter::kNone && app->get_option("--encoding")->count() == 0)

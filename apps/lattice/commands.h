@@ -1,7 +1,8 @@
 #pragma once
 // The `lattice` subcommands. Each adds its options to the app and returns the action that runs
 // when it is chosen; actions return the process exit code and report user errors by throwing
-// lat::InputError (exit code 2).
+// lat::InputError (exit code 2). Under mpirun every rank parses the command line; a command
+// that runs across ranks is run by every rank, any other by rank 0 alone.
 #include <functional>
 
 namespace CLI {
@@ -13,6 +14,7 @@ namespace lat::cli {
 struct Command {
     CLI::App* app = nullptr;
     std::function<int()> run;
+    bool across_ranks = false;  // render and rasterize (docs/distributed.md)
 };
 
 Command add_render_command(CLI::App& parent);

@@ -8,8 +8,11 @@
 #include <nlohmann/json.hpp>
 
 #include "lattice/cache/table_spec.h"
+#include "dist/job.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/file.h"
+#include "util/hash.h"
 
 namespace lat::cli {
 
@@ -57,6 +60,13 @@ ThreadLimit::ThreadLimit(int n) {
 }
 
 ThreadLimit::~ThreadLimit() = default;
+
+void agree_on_scene(const std::string& scene_file) {
+    if (!dist::distributed()) return;
+    std::string bytes;
+    dist::agree([&] { bytes = read_text_file(scene_file, "scene file"); });
+    dist::agree_on(hash_bytes(bytes.data(), bytes.size()), scene_file + ": the scene file");
+}
 
 void write_json_file(const std::string& path, const nlohmann::json& j) {
     AtomicFile out(path);  // a unique temporary: concurrent writers of one path never collide

@@ -36,6 +36,9 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+// Collective in an MPI job: every rank must have read the same scene file (dist::agree_on).
+void agree_on_scene(const std::string& scene_file);
+
 // Writes JSON atomically (temporary + rename); throws InputError naming the path.
 void write_json_file(const std::string& path, const nlohmann::json& j);
 

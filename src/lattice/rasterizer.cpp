@@ -1,13 +1,15 @@
 #include "lattice/rasterizer.h"
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
+#include "dist/deal.h"
+#include "dist/job.h"
 #include "geometry/chain.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/face_cones.h"
@@ -189,6 +191,57 @@ private:
     }
 };
 
+// Rank 0 receives every other rank's blocks: their ids, counts and hit counts, then the hits
+// (which stay in the received buffer, as one more storage of the result).
+void gather_blocks(const dist::DealReport& mine, bool keep_hits, std::vector<Counts>& counts,
+                   std::vector<std::span<const RawHit>>& hits,
+                   std::vector<std::shared_ptr<const ByteBuffer>>& storage) {
+    std::vector<std::uint32_t> ids;
+    for (const auto& [begin, end] : mine.chunks)
+        for (std::uint32_t blk = begin; blk != end; ++blk) ids.push_back(blk);
+    const std::uint64_t n = ids.size();
+    std::vector<Counts> my_counts;
+    std::vector<std::uint64_t> sizes;
+    for (const std::uint32_t blk : ids) {
+        my_counts.push_back(counts[blk]);
+        sizes.push_back(keep_hits ? hits[blk].size() : 0);
+    }
+    const auto bytes = [](const auto& v) {
+        return std::span(reinterpret_cast<const std::uint8_t*>(v.data()), v.size() * sizeof(v[0]));
+    };
+    std::vector<std::span<const std::uint8_t>> pieces{
+        {reinterpret_cast<const std::uint8_t*>(&n), sizeof n}, bytes(ids), bytes(my_counts), bytes(sizes)};
+    if (keep_hits)
+        for (const std::uint32_t blk : ids) pieces.push_back(bytes(hits[blk]));
+    std::vector<ByteBuffer> all = dist::gather_to_root(pieces);
+    for (std::size_t r = 1; r < all.size(); ++r) {
+        auto buffer = std::make_shared<const ByteBuffer>(std::move(all[r]));
+        const std::uint8_t* at = buffer->data();
+        const auto read = [&](auto* out, std::size_t count) {
+            std::memcpy(out, at, count * sizeof(*out));
+            at += count * sizeof(*out);
+        };
+        std::uint64_t m = 0;
+        read(&m, 1);
+        std::vector<std::uint32_t> their_ids(m);
+        std::vector<Counts> their_counts(m);
+        std::vector<std::uint64_t> their_sizes(m);
+        read(their_ids.data(), m);
+        read(their_counts.data(), m);
+        read(their_sizes.data(), m);
+        for (std::size_t i = 0; i < m; ++i) {
+            const std::uint32_t blk = their_ids[i];
+            counts[blk] = their_counts[i];
+            if (!keep_hits) continue;
+            // 4-byte aligned: every field before the hits is a multiple of 4 bytes.
+            hits[blk] = {reinterpret_cast<const RawHit*>(at), their_sizes[i]};
+            at += their_sizes[i] * sizeof(RawHit);
+        }
+        assert(at == buffer->data() + buffer->size());
+        storage.push_back(std::move(buffer));
+    }
+}
+
 }  // namespace
 
 RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) {
@@ -205,9 +258,12 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
     std::vector<std::span<const RawHit>> block_hits(opt.keep_hits ? nblocks : 0);
     std::vector<Counts> block_counts(nblocks);
     tbb::enumerable_thread_specific<Scratch> scratch;
-    ProgressBar bar("rasterize", npoints, opt.progress);
+    ProgressBar bar("rasterize", nblocks, opt.progress && dist::is_root());
 
-    tbb::parallel_for(std::uint32_t{0}, nblocks, [&](std::uint32_t blk) {
+    dist::DealOptions deal_opt;
+    deal_opt.across_ranks = opt.across_ranks && dist::distributed();
+    deal_opt.progress = &bar;
+    const dist::DealReport deal = dist::deal(nblocks, [&](std::uint32_t blk) {
         Scratch& s = scratch.local();
         Counts cnt;
         s.arena.begin_block();
@@ -219,11 +275,20 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
         }
         if (opt.keep_hits) block_hits[blk] = s.arena.end_block();
         block_counts[blk] = cnt;
-        bar.add(a_end - blk * kBlock);
-    });
+    }, deal_opt);
     bar.finish();
 
     RasterizeResult res;
+    if (opt.keep_hits)
+        for (Scratch& s : scratch)
+            for (auto& b : s.arena.buffers()) res.raw.storage.push_back(std::move(b));
+    for (const dist::Chunk& c : deal.chunks)
+        for (std::uint32_t blk = c.begin; blk != c.end; ++blk) {
+            res.pairs_traced_here += block_counts[blk].traced;
+            res.hits_here += block_counts[blk].hits;
+        }
+    // Rank 0 gets the other ranks' blocks; theirs keep only what they counted themselves.
+    if (deal_opt.across_ranks) gather_blocks(deal, opt.keep_hits, block_counts, block_hits, res.raw.storage);
     res.pairs_eq2 = tracer.grid().pairs_eq2();
     for (const Counts& c : block_counts) {
         res.pairs_enumerated += c.enumerated;
@@ -232,11 +297,8 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
         res.hits_counted += c.counted;
         res.tests += c.tests;
     }
-    if (opt.keep_hits) {
-        res.raw.chunks = std::move(block_hits);
-        for (Scratch& s : scratch)
-            for (auto& b : s.arena.buffers()) res.raw.storage.push_back(std::move(b));
-    }
+    if (opt.keep_hits && (!deal_opt.across_ranks || dist::is_root())) res.raw.chunks = std::move(block_hits);
+    else res.raw = {};
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return res;
 }

@@ -1,7 +1,8 @@
 #pragma once
 // Rasterization (paper 2.1): for every ordered pair (p_i, p_o) of grid points on different
 // faces of the lattice box, the intersection of the segment p_i -> p_o with the primitive that
-// is closest to p_i. Parallel over entry points; the result does not depend on thread count.
+// is closest to p_i. Parallel over entry points; the result does not depend on thread (or
+// rank) count.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -16,6 +17,10 @@ struct RasterizeOptions {
     bool progress = false;
     // Trace only every n-th entry point (to estimate a table's size before building it).
     std::uint32_t entry_stride = 1;
+    // Collective: the blocks of entry points are dealt across the ranks of the MPI job
+    // (dist/deal.h) and the hits gathered on rank 0, whose result is then the same as a single
+    // process's; the other ranks' results hold the counts of their own blocks, and no hits.
+    bool across_ranks = false;
 };
 
 struct RasterizeResult {
@@ -26,6 +31,8 @@ struct RasterizeResult {
     std::uint64_t hits_counted = 0;      // N_ix, counted as the paper counts N_lp
     std::uint64_t tests = 0;             // exact segment-part tests performed
     double seconds = 0;
+    // With across_ranks: this rank's own share (segments traced, hits); else the same as above.
+    std::uint64_t pairs_traced_here = 0, hits_here = 0;
     RawHits raw;  // when keep_hits: in entry point order, the same for any thread count
 };
 

@@ -13,9 +13,9 @@ namespace {
 
 constexpr std::array<ModeDescription, 4> kModes{{
     {"exact", RenderMode::kExact, "full ray trace of every primitive", "full ray trace", "high", "slow",
-     "medium"},
+     "medium", true},
     {"lattice", RenderMode::kLattice, "instances through their lattice tables (built on first use and cached)",
-     "lattice", "high", "moderate", "large"},
+     "lattice", "high", "moderate", "large", true},
     {"texture", RenderMode::kTexture,
      "instances replaced by colour, coverage and normal maps baked on the surface they grow from",
      "texture mapping", "low", "very fast", "small"},
@@ -58,6 +58,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
     RenderOptions opt;
     opt.spp = settings.spp;
     opt.progress = settings.progress;
+    opt.across_ranks = settings.across_ranks && mode_description(mode).spreads_over_ranks;
     auto t0 = clock::now();
     switch (mode) {
         case RenderMode::kExact:
@@ -66,7 +67,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             r.bytes_added = instance_geometry_bytes(scene);
             if (mode == RenderMode::kLattice) {
                 const TableCache cache(settings.lattice_dir.empty() ? default_cache_dir() : settings.lattice_dir,
-                                       !settings.lattice_dir.empty());
+                                       !settings.lattice_dir.empty(), opt.across_ranks);
                 LatticeFiltering filtering = settings.filtering;
                 // A pixel's angle, narrowed by the samples that share it.
                 filtering.spread = 2 * std::tan(scene.camera.fov_y_deg * M_PI / 360.0) /

@@ -25,6 +25,9 @@ struct ModeDescription {
     std::string_view help;
     // The paper's Table 2 row for the technique: its name and its fidelity, speed and space.
     std::string_view paper_technique, paper_fidelity, paper_speed, paper_space;
+    // Whether its render is dealt across the ranks of an MPI job; a mode that is not renders
+    // on rank 0 alone (docs/distributed.md).
+    bool spreads_over_ranks = false;
 };
 
 std::span<const ModeDescription> render_modes();
@@ -39,6 +42,9 @@ struct ModeSettings {
     AccelOptions accel;
     TextureOptions texture;
     int shadow_map_size = ParticleOptions{}.shadow_map_size;
+    // Collective, for a mode that spreads_over_ranks: tables built once by all ranks together
+    // and read by each from the cache, tiles dealt across ranks, the image on rank 0.
+    bool across_ranks = false;
     // Called once, when preparation (tables, maps, particles, acceleration) is done and the
     // render proper begins: `render` installs its interrupt handlers there, since table builds
     // do not poll for signals.

@@ -1,19 +1,21 @@
 #include "render/renderer.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include <atomic>
+#include <cassert>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <span>
 
+#include "dist/deal.h"
+#include "dist/job.h"
 #include "lattice/lattice_shape.h"
 #include "render/camera.h"
 #include "render/layers.h"
 #include "render/shading.h"
 #include "util/error.h"
 #include "util/interrupt.h"
+#include "util/memory.h"
 #include "util/progress.h"
 
 namespace lat {
@@ -51,10 +53,153 @@ void stratify(int n, int& nx, int& ny) {
     ny = n / nx;
 }
 
+namespace {
+
+// What every tile needs: the scene, the camera, the sample grid, the image being filled.
+struct TileContext {
+    const RenderScene& rs;
+    const RenderOptions& opt;
+    PinholeCamera cam;
+    int w, h, sx_n, sy_n, spp, tiles_x;
+    double spread;
+    RenderOutput& out;
+};
+
+// Ray counts, added up over the tiles of a render.
+struct TileCounts {
+    std::atomic<std::uint64_t> primary{0}, shadow{0}, visits{0};
+};
+
+void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
+    const Scene& s = tc.rs.scene();
+    const int w = tc.w, h = tc.h, spp = tc.spp;
+    const int x0 = (tile % tc.tiles_x) * kTile, y0 = (tile / tc.tiles_x) * kTile;
+    ShadeCounters counters;
+    // A tile runs on one thread from start to end: its visits are this thread's growth.
+    const std::uint64_t visits0 = lattice_visits_this_thread();
+    std::uint64_t rays = 0;
+    for (int j = y0; j < std::min(h, y0 + kTile); ++j) {
+        for (int i = x0; i < std::min(w, x0 + kTile); ++i) {
+            // One relaxed load per pixel (a tile can take seconds at high spp); the rest is
+            // skipped, and Interrupted thrown by render_image.
+            if (interrupted()) return;
+            Vec3 sum, sum_clamped;
+            for (int k = 0; k < spp; ++k) {
+                double ox = 0.5, oy = 0.5;
+                if (spp > 1) {
+                    const std::uint64_t seed = mix((static_cast<std::uint64_t>(j) * w + i) * 1024 + k);
+                    ox = ((k % tc.sx_n) + unit(seed)) / tc.sx_n;
+                    oy = ((k / tc.sx_n) + unit(mix(seed))) / tc.sy_n;
+                }
+                const Ray ray = tc.cam.ray(i, j, ox, oy);
+                ++rays;
+                SurfaceHit hit;
+                Vec3 c = s.background;
+                if (tc.opt.layered)
+                    c = trace_layers(tc.rs, ray, tc.spread, counters);
+                else if (tc.rs.intersect(ray, 0.0, kInfinity, hit))
+                    c = tc.opt.shader ? tc.opt.shader(ray, hit, counters) : shade(tc.rs, ray, hit, counters);
+                sum += c;
+                sum_clamped += Vec3{std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0),
+                                    std::clamp(c.z, 0.0, 1.0)};
+            }
+            const std::size_t px = (static_cast<std::size_t>(j) * w + i) * 3;
+            for (std::size_t ch = 0; ch < 3; ++ch) {
+                tc.out.radiance.rgb[px + ch] = static_cast<float>(sum[ch] / spp);
+                tc.out.display.rgb[px + ch] = to_byte(sum_clamped[ch] / spp);
+            }
+        }
+    }
+    counts.primary.fetch_add(rays, std::memory_order_relaxed);
+    counts.shadow.fetch_add(counters.shadow_rays, std::memory_order_relaxed);
+    counts.visits.fetch_add(lattice_visits_this_thread() - visits0, std::memory_order_relaxed);
+}
+
+// Calls row(first, count) for each row of the chunks' tiles, in order: the index of its first
+// pixel in the image and its length in pixels.
+template <class F>
+void for_each_tile_row(const TileContext& tc, std::span<const dist::Chunk> chunks, F&& row) {
+    for (const dist::Chunk& c : chunks)
+        for (std::uint32_t tile = c.begin; tile != c.end; ++tile) {
+            const int x0 = static_cast<int>(tile % static_cast<std::uint32_t>(tc.tiles_x)) * kTile;
+            const int y0 = static_cast<int>(tile / static_cast<std::uint32_t>(tc.tiles_x)) * kTile;
+            const auto count = static_cast<std::size_t>(std::min(tc.w, x0 + kTile) - x0);
+            for (int j = y0; j < std::min(tc.h, y0 + kTile); ++j)
+                row(static_cast<std::size_t>(j) * static_cast<std::size_t>(tc.w) + static_cast<std::size_t>(x0), count);
+        }
+}
+
+// Rank 0 receives every other rank's tiles: the chunk list, then the radiance and the display
+// rows of those tiles, in that order (15 bytes a pixel).
+void gather_tiles(const TileContext& tc, const dist::DealReport& mine) {
+    std::vector<float>& radiance = tc.out.radiance.rgb;
+    std::vector<std::uint8_t>& display = tc.out.display.rgb;
+    const std::uint64_t nchunks = mine.chunks.size();
+    std::vector<std::span<const std::uint8_t>> pieces{
+        {reinterpret_cast<const std::uint8_t*>(&nchunks), sizeof nchunks},
+        {reinterpret_cast<const std::uint8_t*>(mine.chunks.data()), nchunks * sizeof(dist::Chunk)}};
+    for_each_tile_row(tc, mine.chunks, [&](std::size_t first, std::size_t count) {
+        pieces.emplace_back(reinterpret_cast<const std::uint8_t*>(radiance.data() + first * 3),
+                            count * 3 * sizeof(float));
+    });
+    for_each_tile_row(tc, mine.chunks, [&](std::size_t first, std::size_t count) {
+        pieces.emplace_back(display.data() + first * 3, count * 3);
+    });
+    const std::vector<ByteBuffer> all = dist::gather_to_root(pieces);
+    for (std::size_t r = 1; r < all.size(); ++r) {
+        const std::uint8_t* from = all[r].data();
+        std::uint64_t n = 0;
+        std::memcpy(&n, from, sizeof n);
+        std::vector<dist::Chunk> chunks(n);
+        std::memcpy(chunks.data(), from + sizeof n, n * sizeof(dist::Chunk));
+        from += sizeof n + n * sizeof(dist::Chunk);
+        for_each_tile_row(tc, chunks, [&](std::size_t first, std::size_t count) {
+            std::memcpy(radiance.data() + first * 3, from, count * 3 * sizeof(float));
+            from += count * 3 * sizeof(float);
+        });
+        for_each_tile_row(tc, chunks, [&](std::size_t first, std::size_t count) {
+            std::memcpy(display.data() + first * 3, from, count * 3);
+            from += count * 3;
+        });
+        assert(from == all[r].data() + all[r].size());
+    }
+}
+
+// Rank 0 receives every rank's figures; the totals become the job's.
+void gather_rank_stats(const dist::DealReport& deal, RenderStats& st) {
+    RankStats mine;
+    mine.rank = dist::rank();
+    const dist::HostName host = dist::HostName::here();
+    std::memcpy(mine.host, host.text, sizeof mine.host);
+    mine.threads = deal.threads;
+    mine.tiles = static_cast<std::uint32_t>(deal.items);
+    mine.chunks = static_cast<std::uint32_t>(deal.chunks.size());
+    mine.render_ms = deal.seconds * 1e3;
+    mine.wait_ms = deal.wait_seconds * 1e3;
+    mine.cpu_ms = st.cpu_ms;
+    mine.primary_rays = st.primary_rays;
+    mine.shadow_rays = st.shadow_rays;
+    mine.lattice_visits = st.lattice_visits;
+    mine.peak_memory_bytes = peak_rss_bytes();
+    st.ranks = dist::gather_values(mine);
+    if (st.ranks.empty()) return;
+    st.primary_rays = st.shadow_rays = st.lattice_visits = 0;
+    st.threads = 0;
+    st.cpu_ms = 0;
+    for (const RankStats& r : st.ranks) {
+        st.primary_rays += r.primary_rays;
+        st.shadow_rays += r.shadow_rays;
+        st.lattice_visits += r.lattice_visits;
+        st.threads += r.threads;
+        st.cpu_ms += r.cpu_ms;
+    }
+}
+
+}  // namespace
+
 RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     const Scene& s = rs.scene();
     const int w = s.camera.width, h = s.camera.height;
-    const PinholeCamera cam(s.camera);
     RenderOutput out;
     out.radiance = {w, h, std::vector<float>(static_cast<std::size_t>(w) * h * 3)};
     out.display = {w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 3)};
@@ -63,65 +208,32 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     const int spp = sx_n * sy_n;
     // A sample's footprint per unit distance: the pixel's angle, shared by its samples.
     const double spread = 2 * std::tan(s.camera.fov_y_deg * M_PI / 360.0) / h / std::sqrt(double(spp));
-
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-    std::atomic<std::uint64_t> primary{0}, shadow{0}, visits{0};
-    ProgressBar bar("render", static_cast<std::uint64_t>(tiles_x) * tiles_y, opt.progress);
-    const auto start = std::chrono::steady_clock::now();
+    const TileContext tc{rs, opt, PinholeCamera(s.camera), w, h, sx_n, sy_n, spp, tiles_x, spread, out};
 
-    tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1), [&](const tbb::blocked_range<int>& range) {
-        for (int tile = range.begin(); tile != range.end(); ++tile) {
-            const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-            ShadeCounters counters;
-            // A tile runs on one thread from start to end: its visits are this thread's growth.
-            const std::uint64_t visits0 = lattice_visits_this_thread();
-            std::uint64_t rays = 0;
-            for (int j = y0; j < std::min(h, y0 + kTile); ++j) {
-                for (int i = x0; i < std::min(w, x0 + kTile); ++i) {
-                    // One relaxed load per pixel (a tile can take seconds at high spp); the
-                    // rest is skipped, and Interrupted thrown below.
-                    if (interrupted()) return;
-                    Vec3 sum, sum_clamped;
-                    for (int k = 0; k < spp; ++k) {
-                        double ox = 0.5, oy = 0.5;
-                        if (spp > 1) {
-                            const std::uint64_t seed = mix((static_cast<std::uint64_t>(j) * w + i) * 1024 + k);
-                            ox = ((k % sx_n) + unit(seed)) / sx_n;
-                            oy = ((k / sx_n) + unit(mix(seed))) / sy_n;
-                        }
-                        const Ray ray = cam.ray(i, j, ox, oy);
-                        ++rays;
-                        SurfaceHit hit;
-                        Vec3 c = s.background;
-                        if (opt.layered)
-                            c = trace_layers(rs, ray, spread, counters);
-                        else if (rs.intersect(ray, 0.0, kInfinity, hit))
-                            c = opt.shader ? opt.shader(ray, hit, counters) : shade(rs, ray, hit, counters);
-                        sum += c;
-                        sum_clamped += Vec3{std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0),
-                                            std::clamp(c.z, 0.0, 1.0)};
-                    }
-                    const std::size_t px = (static_cast<std::size_t>(j) * w + i) * 3;
-                    for (std::size_t ch = 0; ch < 3; ++ch) {
-                        out.radiance.rgb[px + ch] = static_cast<float>(sum[ch] / spp);
-                        out.display.rgb[px + ch] = to_byte(sum_clamped[ch] / spp);
-                    }
-                }
-            }
-            primary.fetch_add(rays, std::memory_order_relaxed);
-            shadow.fetch_add(counters.shadow_rays, std::memory_order_relaxed);
-            visits.fetch_add(lattice_visits_this_thread() - visits0, std::memory_order_relaxed);
-            bar.add(1);
-        }
-    });
+    TileCounts counts;
+    const bool across = opt.across_ranks && dist::distributed();
+    ProgressBar bar("render", static_cast<std::uint64_t>(tiles_x) * tiles_y,
+                    opt.progress && dist::is_root());
+    const auto start = std::chrono::steady_clock::now();
+    const double cpu0 = cpu_seconds();
+    dist::DealOptions deal_opt;
+    deal_opt.across_ranks = across;
+    deal_opt.progress = &bar;
+    const dist::DealReport deal = dist::deal(
+        static_cast<std::uint32_t>(tiles_x * tiles_y),
+        [&](std::uint32_t tile) { render_tile(tc, static_cast<int>(tile), counts); }, deal_opt);
     bar.finish();
     throw_if_interrupted();
+    out.stats.primary_rays = counts.primary.load();
+    out.stats.shadow_rays = counts.shadow.load();
+    out.stats.lattice_visits = counts.visits.load();
+    out.stats.threads = deal.threads;
+    if (across) gather_tiles(tc, deal);
+    out.stats.cpu_ms = (cpu_seconds() - cpu0) * 1e3;
+    if (across) gather_rank_stats(deal, out.stats);
     out.stats.render_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    out.stats.primary_rays = primary.load();
-    out.stats.shadow_rays = shadow.load();
-    out.stats.lattice_visits = visits.load();
-    out.stats.threads = tbb::this_task_arena::max_concurrency();
     return out;
 }
 

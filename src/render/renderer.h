@@ -1,9 +1,11 @@
 #pragma once
-// The tile renderer: oneTBB over image tiles on all cores. Every pixel depends only on its own
-// coordinates, so images are bit-identical for any thread count.
+// The tile renderer: oneTBB over image tiles on all cores, and over the ranks of an MPI job.
+// Every pixel depends only on its own coordinates, so images are bit-identical for any thread
+// and rank count.
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "io/image.h"
 #include "render/render_scene.h"
@@ -21,14 +23,32 @@ struct RenderOptions {
     bool layered = false;
     bool progress = false;
     SurfaceShader shader;  // empty: shade()
+    // Collective: the tiles are dealt across the ranks of the MPI job (dist/deal.h) and the
+    // image is gathered on rank 0; the other ranks return their share of the figures only.
+    bool across_ranks = false;
+};
+
+// One rank's share of a render spread across an MPI job.
+struct RankStats {
+    int rank = 0;
+    char host[64] = {};
+    int threads = 0;
+    std::uint32_t tiles = 0, chunks = 0;
+    double render_ms = 0;  // first tile dealt to last tile done here
+    double wait_ms = 0;    // threads' time waiting for tiles, summed
+    double cpu_ms = 0;     // the process's CPU time (all threads) over the render and gather
+    std::uint64_t primary_rays = 0, shadow_rays = 0, lattice_visits = 0;
+    std::uint64_t peak_memory_bytes = 0;
 };
 
 struct RenderStats {
     double render_ms = 0;
+    double cpu_ms = 0;  // CPU time of the render, all threads (across_ranks: all ranks')
     std::uint64_t primary_rays = 0;
     std::uint64_t shadow_rays = 0;
     std::uint64_t lattice_visits = 0;  // see lattice_visits_this_thread
-    int threads = 0;
+    int threads = 0;  // across_ranks: summed over ranks; the counts too (on rank 0)
+    std::vector<RankStats> ranks;  // across_ranks, on rank 0: one per rank
 };
 
 struct RenderOutput {

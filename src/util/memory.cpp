@@ -12,6 +12,13 @@ std::size_t peak_rss_bytes() {
     return static_cast<std::size_t>(ru.ru_maxrss) * 1024;  // Linux reports kilobytes
 }
 
+double cpu_seconds() {
+    rusage ru{};
+    if (getrusage(RUSAGE_SELF, &ru) != 0) return 0;
+    const auto s = [](const timeval& t) { return double(t.tv_sec) + double(t.tv_usec) * 1e-6; };
+    return s(ru.ru_utime) + s(ru.ru_stime);
+}
+
 std::size_t available_memory_bytes() {
     FILE* f = std::fopen("/proc/meminfo", "r");
     if (!f) return 0;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "dist/job.h"
 #include "lattice/boundary_grid.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -90,22 +91,30 @@ void check_buildable(const TablePlan& plan) {
     if (avail > 0 && need > 0.8 * avail) refuse_memory(plan, rate, need, false);
 }
 
-TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool progress) {
-    check_buildable(plan);
+TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool progress,
+                            bool across_ranks) {
+    // Rank 0 alone checks: it is the one that will hold every hit.
+    if (across_ranks) dist::on_root([&] { check_buildable(plan); });
+    else check_buildable(plan);
     TableBuild b;
     b.header = plan.header;
     RasterizeOptions opt;
     opt.progress = progress;
     opt.keep_hits = plan.encoding->needs_hits;
+    opt.across_ranks = across_ranks;
     b.raster = rasterize(plan.context, opt);
-    const auto t0 = std::chrono::steady_clock::now();
-    const ByteBuffer payload = plan.encoding->build(b.raster.raw, plan.context, plan.options);
-    b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    b.raster.raw = {};
-    b.header.pairs = b.raster.pairs_eq2;
-    b.header.entries = b.raster.hits;
-    write_table_file(path, b.header, payload);
-    b.bytes = payload.size() + kTableHeaderBytes + b.header.metadata.size();
+    const auto encode_and_write = [&] {
+        const auto t0 = std::chrono::steady_clock::now();
+        const ByteBuffer payload = plan.encoding->build(b.raster.raw, plan.context, plan.options);
+        b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        b.raster.raw = {};
+        b.header.pairs = b.raster.pairs_eq2;
+        b.header.entries = b.raster.hits;
+        write_table_file(path, b.header, payload);
+        b.bytes = payload.size() + kTableHeaderBytes + b.header.metadata.size();
+    };
+    if (across_ranks) dist::on_root(encode_and_write);
+    else encode_and_write();
     return b;
 }
 

@@ -22,6 +22,10 @@ struct TableBuild {
 };
 
 // Checks, rasterizes the primitive, encodes the table and writes it to `path` atomically.
-TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool progress);
+// across_ranks (collective, in an MPI job): rank 0 checks, all ranks rasterize their share of
+// the entry points, rank 0 encodes and writes; the other ranks' result holds their own counts
+// only.
+TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool progress,
+                            bool across_ranks = false);
 
 }  // namespace lat

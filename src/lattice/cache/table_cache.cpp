@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "dist/job.h"
 #include "lattice/cache/table_build.h"
 #include "util/error.h"
 
@@ -24,7 +25,24 @@ std::string default_cache_dir() {
     return ".lattice-cache";
 }
 
-TableCache::TableCache(const std::string& dir, bool explicit_dir) : dir_(dir) {
+TableCache::TableCache(const std::string& dir, bool explicit_dir, bool across_ranks)
+    : dir_(dir), across_ranks_(across_ranks && dist::distributed()) {
+    if (!across_ranks_) {
+        open_dir(explicit_dir);
+        remove_stale_temporaries();
+        return;
+    }
+    // Rank 0 first, so that only it creates a missing default directory.
+    dist::on_root([&] {
+        open_dir(explicit_dir);
+        remove_stale_temporaries();
+    });
+    dist::agree([&] {
+        if (!dist::is_root()) open_dir(explicit_dir);
+    });
+}
+
+void TableCache::open_dir(bool explicit_dir) const {
     struct stat st {};
     if (::stat(dir_.c_str(), &st) != 0) {
         if (explicit_dir)
@@ -40,7 +58,6 @@ TableCache::TableCache(const std::string& dir, bool explicit_dir) : dir_(dir) {
     if (::access(dir_.c_str(), R_OK | W_OK | X_OK) != 0)
         throw InputError(dir_ + ": lattice cache directory is not readable and writable: " +
                          std::strerror(errno));
-    remove_stale_temporaries();
 }
 
 // A table is written whole into TARGET.tmp-XXXXXX and renamed (util/atomic_file.h), which takes
@@ -72,22 +89,32 @@ TableCache::Entry TableCache::get(const TablePlan& plan, bool progress) const {
     Entry e;
     e.path = path_for(plan);
     struct stat st {};
-    if (::stat(e.path.c_str(), &st) != 0) {
+    const auto missing = [&] { return ::stat(e.path.c_str(), &st) != 0; };
+    if (across_ranks_ ? dist::root_says(missing) : missing()) {
         const auto t0 = std::chrono::steady_clock::now();
-        build_table_file(plan, e.path, progress);
+        build_table_file(plan, e.path, progress, across_ranks_);
         e.build_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         e.built = true;
     }
+    if (across_ranks_) dist::agree([&] { load(plan, e); });
+    else load(plan, e);
+    return e;
+}
+
+void TableCache::load(const TablePlan& plan, Entry& e) const {
     try {
         LoadedTable lt = load_table_file(e.path, &plan.header, plan.context.primitive);
         e.table = lt.table;
         e.header = lt.header;
         e.bytes = lt.bytes;
     } catch (const InputError& err) {
+        if (across_ranks_ && !dist::is_root() && ::access(e.path.c_str(), F_OK) != 0)
+            throw InputError(std::string(err.what()) +
+                             " (rank 0 has it: the lattice cache directory must be one that every "
+                             "rank shares, see --lattice-dir)");
         throw InputError(std::string(err.what()) + " (delete the file to rebuild it)");
     }
-    return e;
 }
 
 }  // namespace lat
