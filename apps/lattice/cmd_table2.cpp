@@ -65,7 +65,8 @@ std::string fixed(double v, int digits) {
     return text;
 }
 
-std::string markdown(const Table2Args& a, const std::vector<Row>& rows, double truth_ms, double bare_ms) {
+std::string markdown(const Table2Args& a, const std::vector<Row>& rows, double truth_ms, double bare_ms,
+                     const std::string& texture_unavailable) {
     std::ostringstream md;
     md << "Scene `" << a.scene << "`, against exact at " << a.truth_spp << " spp (" << fixed(truth_ms / 1000, 1)
        << " s), " << a.threads << " threads. The base alone (exact, without its instances) renders in "
@@ -80,6 +81,8 @@ std::string markdown(const Table2Args& a, const std::vector<Row>& rows, double t
            << fixed(r.result.out.stats.render_ms, 0) << " | "
            << fixed(r.result.prepare_ms + r.result.build_ms, 0) << " | "
            << human_bytes(static_cast<double>(r.result.bytes_added)) << " |\n";
+    if (!texture_unavailable.empty())
+        md << "\nTexture mapping not measured: " << texture_unavailable << "\n";
     return md.str();
 }
 
@@ -115,7 +118,14 @@ int run_table2(const Table2Args& a) {
     const std::string filtered_encoding = filter == LatticeFilter::kNone ? "" : coverage_encoding();
     const Scene scene = load_scene(a.scene);
     check_render_budget(scene.camera, std::max(a.spp, a.truth_spp), a.scene);
-    texture_base(scene);    // the texture mode needs a base surface,
+    // The texture mode needs a base surface it can map; without one its row is left out (and
+    // said why), as a texture artist would have no map to paint: the other columns still stand.
+    std::string texture_unavailable;
+    try {
+        texture_base(scene);
+    } catch (const InputError& e) {
+        texture_unavailable = e.what();
+    }
     make_particles(scene);  // the particle mode chains
     std::vector<std::string> planned = encodings;
     if (!filtered_encoding.empty()) planned.push_back(filtered_encoding);
@@ -152,7 +162,11 @@ int run_table2(const Table2Args& a) {
         write_png((fs::path(a.out_dir) / (name + ".png")).string(), r.result.out.display);
         rows.push_back(std::move(r));
     };
-    run("texture", RenderMode::kTexture);
+    if (texture_unavailable.empty()) {
+        run("texture", RenderMode::kTexture);
+    } else {
+        std::fprintf(stderr, "table2: texture: not measured: %s\n", texture_unavailable.c_str());
+    }
     run("particles", RenderMode::kParticles);
     run("exact", RenderMode::kExact);
     for (const std::string& e : encodings) {
@@ -173,7 +187,7 @@ int run_table2(const Table2Args& a) {
     const CropRegion crop = busiest_region(truth.out.display, a.crop_size);
     write_png((fs::path(a.out_dir) / "crops.png").string(), crop_strip(images, crop, a.crop_scale));
 
-    std::string md = markdown(a, rows, truth.out.stats.render_ms, bare_ms);
+    std::string md = markdown(a, rows, truth.out.stats.render_ms, bare_ms, texture_unavailable);
     std::string order = "truth";
     for (const Row& r : rows) order += ", " + r.name;
     md += "\nStrip (`strip.png`), left to right: " + order + ". Crops (`crops.png`), the same order: " +
@@ -192,6 +206,8 @@ int run_table2(const Table2Args& a) {
                         {"height", scene.camera.height},
                         {"truth_render_ms", truth.out.stats.render_ms},
                         {"bare_base_render_ms", bare_ms},
+                        {"texture_unavailable", texture_unavailable.empty() ? nlohmann::json(nullptr)
+                                                                            : nlohmann::json(texture_unavailable)},
                         {"crop", {{"x", crop.x}, {"y", crop.y}, {"size", crop.size}, {"scale", a.crop_scale}}}};
     for (const Row& r : rows) j["rows"].push_back(row_json(r));
     write_json_file((fs::path(a.out_dir) / "table2.json").string(), j);
