@@ -1,6 +1,5 @@
 #include "common.h"
 
-#include <tbb/global_control.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -48,20 +47,6 @@ void add_table_options(CLI::App& app, TableSpec& spec) {
            "whichever is smaller (auto)")
         ->check(CLI::IsMember(normals));
 }
-
-// The control is made in place: a global_control limits oneTBB from where it was constructed
-// and copies of it (it has an implicit copy constructor) are not registered with oneTBB, so
-// moving one into place left no limit at all.
-struct ThreadLimit::Impl {
-    explicit Impl(std::size_t n) : control(tbb::global_control::max_allowed_parallelism, n) {}
-    tbb::global_control control;
-};
-
-ThreadLimit::ThreadLimit(int n) {
-    if (n > 0) impl_ = std::make_unique<Impl>(static_cast<std::size_t>(n));
-}
-
-ThreadLimit::~ThreadLimit() = default;
 
 void agree_on_scene(const std::string& scene_file) {
     if (!dist::distributed()) return;

@@ -9,6 +9,7 @@
 
 #include "dist/deal.h"
 #include "dist/job.h"
+#include "dist/message.h"
 #include "lattice/lattice_shape.h"
 #include "render/camera.h"
 #include "render/layers.h"
@@ -146,23 +147,28 @@ void gather_tiles(const TileContext& tc, const dist::DealReport& mine) {
         pieces.emplace_back(display.data() + first * 3, count * 3);
     });
     const std::vector<ByteBuffer> all = dist::gather_to_root(pieces);
+    if (!dist::is_root()) return;
+    // What the other ranks sent is checked before it is copied: every tile of the image from
+    // exactly one rank, and rows that fill the message exactly.
+    const auto tiles_y = static_cast<std::size_t>((tc.h + kTile - 1) / kTile);
+    std::vector<bool> dealt(static_cast<std::size_t>(tc.tiles_x) * tiles_y);
+    dist::mark_dealt(mine.chunks, dealt, dist::MessageReader({}, "tile list", 0));
     for (std::size_t r = 1; r < all.size(); ++r) {
-        const std::uint8_t* from = all[r].data();
-        std::uint64_t n = 0;
-        std::memcpy(&n, from, sizeof n);
-        std::vector<dist::Chunk> chunks(n);
-        std::memcpy(chunks.data(), from + sizeof n, n * sizeof(dist::Chunk));
-        from += sizeof n + n * sizeof(dist::Chunk);
+        dist::MessageReader in({all[r].data(), all[r].size()}, "tiles message", static_cast<int>(r));
+        const std::span<const std::uint8_t> list = in.take(in.read<std::uint64_t>(), sizeof(dist::Chunk));
+        std::vector<dist::Chunk> chunks(list.size() / sizeof(dist::Chunk));
+        if (!list.empty()) std::memcpy(chunks.data(), list.data(), list.size());
+        dist::mark_dealt(chunks, dealt, in);
         for_each_tile_row(tc, chunks, [&](std::size_t first, std::size_t count) {
-            std::memcpy(radiance.data() + first * 3, from, count * 3 * sizeof(float));
-            from += count * 3 * sizeof(float);
+            in.read(radiance.data() + first * 3, count * 3);
         });
         for_each_tile_row(tc, chunks, [&](std::size_t first, std::size_t count) {
-            std::memcpy(display.data() + first * 3, from, count * 3);
-            from += count * 3;
+            in.read(display.data() + first * 3, count * 3);
         });
-        assert(from == all[r].data() + all[r].size());
+        in.expect_end();
     }
+    for (std::size_t t = 0; t < dealt.size(); ++t)
+        if (!dealt[t]) throw dist::MessageError("tile " + std::to_string(t) + " came from no rank");
 }
 
 // Rank 0 receives every rank's figures; the totals become the job's.

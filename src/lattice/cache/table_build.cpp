@@ -113,7 +113,8 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
         write_table_file(path, b.header, payload);
         b.bytes = payload.size() + kTableHeaderBytes + b.header.metadata.size();
     };
-    if (across_ranks) dist::on_root(encode_and_write);
+    // Rank 0 encodes every hit while the other ranks wait: with their cores too, on its node.
+    if (across_ranks) dist::on_root_with_node_threads(encode_and_write);
     else encode_and_write();
     return b;
 }
