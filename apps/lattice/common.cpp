@@ -55,6 +55,14 @@ void agree_on_scene(const std::string& scene_file) {
     dist::agree_on(hash_bytes(bytes.data(), bytes.size()), scene_file + ": the scene file");
 }
 
+nlohmann::json timeline_json(const dist::Timeline& t) {
+    nlohmann::json j = nlohmann::json::object();
+    for (int s = 0; s < static_cast<int>(dist::Step::kCount); ++s)
+        if (const double ms = t[static_cast<std::size_t>(s)]; ms > 0)
+            j[std::string(dist::step_name(static_cast<dist::Step>(s)))] = ms;
+    return j;
+}
+
 void write_json_file(const std::string& path, const nlohmann::json& j) {
     AtomicFile out(path);  // a unique temporary: concurrent writers of one path never collide
     const std::string text = j.dump(2) + "\n";

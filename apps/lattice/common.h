@@ -5,6 +5,7 @@
 #include <string>
 
 #include "lattice/filtered_shape.h"
+#include "dist/timeline.h"
 #include "util/threads.h"  // ThreadLimit, for the commands
 
 namespace CLI {
@@ -25,6 +26,9 @@ const std::map<std::string, LatticeFilter>& lattice_filters();
 
 // Collective in an MPI job: every rank must have read the same scene file (dist::agree_on).
 void agree_on_scene(const std::string& scene_file);
+
+// A rank's timeline (dist/timeline.h) for --stats: {"loaded": ms, ...}, the steps it reached.
+nlohmann::json timeline_json(const dist::Timeline& t);
 
 // Writes JSON atomically (temporary + rename); throws InputError naming the path.
 void write_json_file(const std::string& path, const nlohmann::json& j);

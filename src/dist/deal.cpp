@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "dist/job.h"
+#include "dist/timeline.h"
 #include "dist/transport.h"
 #include "util/progress.h"
 #include "util/threads.h"
@@ -273,8 +274,10 @@ private:
 }  // namespace
 
 DealReport deal(std::uint32_t n, const std::function<void(std::uint32_t)>& work, const DealOptions& options) {
-    if (!options.across_ranks || !distributed()) return deal_here(n, work, options);
-    return Dealer(n, work, options).run();
+    DealReport report = !options.across_ranks || !distributed() ? deal_here(n, work, options)
+                                                                : Dealer(n, work, options).run();
+    mark(Step::kDealt);
+    return report;
 }
 
 }  // namespace lat::dist

@@ -3,13 +3,17 @@
 #include <algorithm>
 #include <cstring>
 
+#include "dist/timeline.h"
 #include "dist/transport.h"
 #include "util/hash.h"
 #include "util/threads.h"
 
 namespace lat::dist {
 
-Session::Session(int& argc, char**& argv) { transport::start(argc, argv); }
+Session::Session(int& argc, char**& argv) {
+    transport::start(argc, argv);
+    mark(Step::kJoined);
+}
 Session::~Session() { transport::stop(); }
 
 int rank() { return transport::rank(); }

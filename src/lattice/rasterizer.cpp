@@ -11,6 +11,7 @@
 #include "dist/deal.h"
 #include "dist/job.h"
 #include "dist/message.h"
+#include "dist/timeline.h"
 #include "geometry/chain.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/face_cones.h"
@@ -298,7 +299,10 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
             res.hits_here += block_counts[blk].hits;
         }
     // Rank 0 gets the other ranks' blocks; theirs keep only what they counted themselves.
-    if (deal_opt.across_ranks) gather_blocks(deal, opt.keep_hits, block_counts, block_hits, res.raw.storage);
+    if (deal_opt.across_ranks) {
+        gather_blocks(deal, opt.keep_hits, block_counts, block_hits, res.raw.storage);
+        dist::mark(dist::Step::kGathered);
+    }
     res.pairs_eq2 = tracer.grid().pairs_eq2();
     for (const Counts& c : block_counts) {
         res.pairs_enumerated += c.enumerated;

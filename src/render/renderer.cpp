@@ -10,6 +10,7 @@
 #include "dist/deal.h"
 #include "dist/job.h"
 #include "dist/message.h"
+#include "dist/timeline.h"
 #include "lattice/lattice_shape.h"
 #include "render/camera.h"
 #include "render/layers.h"
@@ -187,6 +188,7 @@ void gather_rank_stats(const dist::DealReport& deal, RenderStats& st) {
     mine.shadow_rays = st.shadow_rays;
     mine.lattice_visits = st.lattice_visits;
     mine.peak_memory_bytes = peak_rss_bytes();
+    mine.timeline = dist::timeline();
     st.ranks = dist::gather_values(mine);
     if (st.ranks.empty()) return;
     st.primary_rays = st.shadow_rays = st.lattice_visits = 0;
@@ -235,7 +237,10 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     out.stats.shadow_rays = counts.shadow.load();
     out.stats.lattice_visits = counts.visits.load();
     out.stats.threads = deal.threads;
-    if (across) gather_tiles(tc, deal);
+    if (across) {
+        gather_tiles(tc, deal);
+        dist::mark(dist::Step::kGathered);
+    }
     out.stats.cpu_ms = (cpu_seconds() - cpu0) * 1e3;
     if (across) gather_rank_stats(deal, out.stats);
     out.stats.render_ms =
