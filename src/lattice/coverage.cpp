@@ -120,6 +120,28 @@ namespace {
 // where it cannot tell), and the parts narrowed to those whose capsule the bundle of sub-rays
 // can reach. A part left out could not be hit, and the others are tried in the same order with
 // the same rays, so every hit, and the sample, is the definition's to the bit.
+// A part's capsule seen along a pair's direction, in a plane across it: a sub-ray parallel to
+// the pair, shifted by (du, dv), can meet the capsule only if its point w0 + du wu + dv wv there
+// lies within r of the capsule's segment [0, pu].
+struct Shadow {
+    std::uint32_t part;
+    double w0x, w0y, wux, wuy, wvx, wvy, pux, puy, uu, rr;
+
+    bool may_meet(double du, double dv) const {
+        const double wx = w0x + du * wux + dv * wvx, wy = w0y + du * wuy + dv * wvy;
+        const double wu = wx * pux + wy * puy, ww = wx * wx + wy * wy;
+        if (wu <= 0) return ww <= rr;
+        if (wu >= uu) return uu - 2 * wu + ww <= rr;
+        return ww * uu - wu * wu <= rr * uu;
+    }
+};
+
+// A thread's scratch for sampling pairs.
+struct PairWork {
+    std::vector<std::uint32_t> near, maybe;
+    std::vector<Shadow> shadows;
+};
+
 class PairSampler {
 public:
     PairSampler(const Shape& shape, const LatticeFrame& frame, const BoundaryGrid& grid, double h)
@@ -138,10 +160,11 @@ public:
 
     template <class S>
     CoverageSample sample(const S& shape, std::uint32_t a, std::uint32_t b,
-                          const std::vector<std::uint32_t>& parts,
-                          std::vector<std::uint32_t>& near) const {
+                          const std::vector<std::uint32_t>& parts, PairWork& w) const {
+        std::vector<std::uint32_t>& near = w.near;
         const PairRays pr(grid_, grid_.point(a), grid_.point(b));
         if (!near_parts(pr, parts, near)) return summarise(grid_, a, b, {});
+        shadows(pr, near, w.shadows);
         Tally n;
         for (const auto& off : coverage_offsets()) {
             const SubRay s = pr.ray(off[0], off[1]);
@@ -151,7 +174,15 @@ public:
                 (g == PairRays::Snap::kUnsure && !snaps_to(frame_, h_, s, a, b)))
                 continue;
             ++n.rays;
-            trace_sub_ray(shape, h_, s, near, n);
+            if (g == PairRays::Snap::kUnsure || w.shadows.empty()) {
+                trace_sub_ray(shape, h_, s, near, n);
+                continue;
+            }
+            // A guessed snap means both ends unclamped: the sub-ray runs along the shifted line.
+            w.maybe.clear();
+            for (const Shadow& sh : w.shadows)
+                if (sh.may_meet(off[0], off[1])) w.maybe.push_back(sh.part);
+            if (!w.maybe.empty()) trace_sub_ray(shape, h_, s, w.maybe, n);
         }
         return summarise(grid_, a, b, n);
     }
@@ -161,6 +192,24 @@ private:
     const BoundaryGrid& grid_;
     double h_;
     std::vector<Capsule> capsules_;  // per part, lattice units; empty when the shape has none
+
+    // The shadows of the near parts (none when the shape has no capsules).
+    void shadows(const PairRays& pr, const std::vector<std::uint32_t>& near, std::vector<Shadow>& out) const {
+        out.clear();
+        if (capsules_.empty()) return;
+        Vec3 b1, b2;
+        orthonormal_basis(normalize(pr.dir()), b1, b2);
+        const std::size_t u = pr.u_axis(), v = pr.v_axis();
+        for (const std::uint32_t part : near) {
+            const Capsule& c = capsules_[part];
+            const Vec3 w0 = pr.from() - c.a, pu = c.b - c.a;
+            const double pux = dot(pu, b1), puy = dot(pu, b2);
+            // 1e-6 more for the rounding of the projection (lattice units up to thousands).
+            const double r = c.r + 1e-6;
+            out.push_back({part, dot(w0, b1), dot(w0, b2), b1[u], b2[u], b1[v], b2[v], pux, puy,
+                           pux * pux + puy * puy, r * r});
+        }
+    }
 
     // The parts (of `parts`, in order) that a sub-ray can meet: those whose capsule comes within
     // the bundle's reach of the pair's line. False when there is none.
@@ -184,7 +233,7 @@ private:
 struct Scratch {
     std::vector<std::vector<std::uint32_t>> parts;  // per face point: the parts it may meet
     std::vector<std::size_t> touched;
-    std::vector<std::uint32_t> near;
+    PairWork work;
 };
 
 }  // namespace
@@ -230,8 +279,8 @@ std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool pro
                     });
                 for (const std::size_t k : s.touched) {
                     const CoverageSample c =
-                        chain ? sampler.sample(*chain, a, fl.ids[k], s.parts[k], s.near)
-                              : sampler.sample(shape, a, fl.ids[k], s.parts[k], s.near);
+                        chain ? sampler.sample(*chain, a, fl.ids[k], s.parts[k], s.work)
+                              : sampler.sample(shape, a, fl.ids[k], s.parts[k], s.work);
                     if (c.alpha >= kCoverageMinAlpha) out.push_back(c);
                     s.parts[k].clear();
                 }

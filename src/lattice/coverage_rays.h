@@ -37,6 +37,9 @@ public:
 
     const Vec3& from() const { return vp_; }
     const Vec3& dir() const { return d_; }  // q - p
+    // The axes along which du and dv shift.
+    std::size_t u_axis() const { return (ap_ + 1) % 3; }
+    std::size_t v_axis() const { return (ap_ + 2) % 3; }
     // How far any point of a sub-ray with |du|, |dv| <= 1/2 can lie from the line p q: a
     // shifted line is |shift| <= sqrt(2)/2 from it, and clamping the exit onto the box moves it
     // by at most as much as the exit moved from q.
