@@ -39,12 +39,19 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
       point_(levels.back().table, levels.back().ctx,
              levels.back().ctx.cell * kSnapReach + table_error) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
-    for (std::size_t i = 0; i < levels.size(); ++i) {
-        const FilterLevel& l = levels[i];
-        // Only the coarsest level's frame culls (its reach is the largest).
-        const double reach = i == 0 ? reach_cells(filter) * l.ctx.cell + table_error : kInfinity;
-        levels_.push_back({l.table, LatticeFrame(l.ctx, reach), BoundaryGrid(l.ctx.cells)});
-    }
+    // The coarsest level's frame culls for the accelerator (its reach is the largest); each
+    // finer one, of a reach as many times smaller as its cell, rejects the rays the coarsest
+    // lets through that its own pairs cannot answer (intersect). The levels share their box,
+    // so table_error, a share of the box's diagonal, is every level's.
+    for (const FilterLevel& l : levels)
+        levels_.push_back({l.table, LatticeFrame(l.ctx, reach_cells(filter) * l.ctx.cell + table_error),
+                           BoundaryGrid(l.ctx.cells)});
+}
+
+bool FilteredLatticeShape::within_reach(const Level& l, const Ray& r) {
+    for (std::size_t i = 0; i < l.frame.cull_count(); ++i)
+        if (l.frame.cull_meets(i, r)) return true;
+    return false;
 }
 
 void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bool smooth,
@@ -102,15 +109,20 @@ void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bo
     }
 }
 
-void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, Sheet& s) const {
+void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, bool normals, Sheet& s) const {
     CoverageHit h[Blend::kMaxPairs];
     bool found[Blend::kMaxPairs];
-    l.table->coverage_many(b.ia, b.ib, b.n, h, found);
+    l.table->coverage_many(b.ia, b.ib, b.n, h, found, normals);
     for (int i = 0; i < b.n; ++i)
         if (found[i]) s.add(b.w[i], h[i], lerp(to_vec(b.ca[i]), to_vec(b.cb[i]), h[i].t) * l.frame.cell());
 }
 
 bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    return sheet(r, tmin, tmax, !t_footprint.coverage_only, hit);
+}
+
+bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
+                                 Crossing& hit) const {
     // The level whose cell is the footprint wide, at the box's centre along the ray.
     const double dd = dot(r.d, r.d);
     const RayFootprint& fp = t_footprint;
@@ -127,17 +139,26 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
     // The levels of weight above 0: their pairs are found first and their lookups started
     // together, so that the cache misses of the two tables overlap.
     const std::size_t first = w_hi < 1 ? lo : lo + 1, last = w_hi > 0 ? lo + 1 : lo;
+    // The coarser level read has the larger reach: a ray out of it gets no pair from either.
+    if (first > 0 && !within_reach(levels_[first], r)) return false;
     Blend b[2];
     for (std::size_t i = first; i <= last; ++i) {
         blend(levels_[i], r, i == lo ? 1 - w_hi : w_hi, smooth, b[i - first]);
         levels_[i].table->prefetch_coverage(b[i - first].ia, b[i - first].ib, b[i - first].n);
     }
     Sheet s;
-    for (std::size_t i = first; i <= last; ++i) add_blend(levels_[i], b[i - first], s);
+    for (std::size_t i = first; i <= last; ++i) add_blend(levels_[i], b[i - first], normal, s);
     if (s.alpha <= 1e-6) return false;
     const Vec3 p = s.p / s.alpha;
     const double t = dot(p - r.o, r.d) / dd;
     if (!(t > tmin && t < tmax)) return false;
+    // Blends of full pairs round to just under 1: they are opaque (and end the ray's traversal).
+    const float coverage = s.alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(s.alpha);
+    if (!normal) {
+        hit = Crossing(t, 0, SurfacePoint{p, -r.d / std::sqrt(dd)});
+        hit.coverage = coverage;
+        return true;
+    }
     const double ln = length(s.n);
     // The normal is the coverage-weighted mean of the blended pairs' unit normals, left
     // unnormalised: its length (below 1 where they diverge) tells the shading how much the
@@ -150,14 +171,13 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
     const double narrower = std::max(0.0, wanted - level);  // in levels, each half as wide
     const double len = 1 - (1 - std::min(1.0, ln / s.alpha)) * std::exp2(-2 * narrower);
     hit = Crossing(t, 0, SurfacePoint{p, ln > 0 ? s.n / ln * len : -r.d / std::sqrt(dd)});
-    // Blends of full pairs round to just under 1: they are opaque (and end the ray's traversal).
-    hit.coverage = s.alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(s.alpha);
+    hit.coverage = coverage;
     return true;
 }
 
 bool FilteredLatticeShape::occluded(const Ray& r, double tmin, double tmax) const {
     Crossing c;
-    return intersect(r, tmin, tmax, c) && c.coverage >= 0.5f;
+    return sheet(r, tmin, tmax, false, c) && c.coverage >= 0.5f;
 }
 
 }  // namespace lat
