@@ -117,9 +117,6 @@ private:
     LatticeFilter filter_;
     HitTableShape point_;  // the finest level, point-sampled
 
-    // Whether the ray's line passes within the level's reach of the primitive (its cull parts'
-    // capsules; true when it has none): if not, none of the level's pairs it blends is stored.
-    static bool within_reach(const Level& l, const Ray& r);
     // intersect, with or without the sheet's normal.
     bool sheet(const Ray& r, double tmin, double tmax, bool normal, Crossing& hit) const;
     void blend(const Level& l, const Ray& r, double weight, bool smooth, Blend& b) const;
