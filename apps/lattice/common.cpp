@@ -49,14 +49,15 @@ void add_table_options(CLI::App& app, TableSpec& spec) {
         ->check(CLI::IsMember(normals));
 }
 
+// Built in place: a global_control moved from a temporary was unregistered by the temporary's
+// destructor, and --threads had no effect.
 struct ThreadLimit::Impl {
+    explicit Impl(std::size_t n) : control(tbb::global_control::max_allowed_parallelism, n) {}
     tbb::global_control control;
 };
 
 ThreadLimit::ThreadLimit(int n) {
-    if (n > 0)
-        impl_ = std::make_unique<Impl>(Impl{tbb::global_control(
-            tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(n))});
+    if (n > 0) impl_ = std::make_unique<Impl>(static_cast<std::size_t>(n));
 }
 
 ThreadLimit::~ThreadLimit() = default;
