@@ -4,7 +4,8 @@
 // tests and certification use), and the pair's coverage (lattice/coverage.h): the share of the
 // sub-rays snapping to the pair that meet the primitive and their mean hit, which filtered
 // rendering uses. Pairs are indexed densely, a * N + b for N boundary points, by occupancy bits
-// and a rank directory; a record is seven 16-bit fields (alpha in 1/65535).
+// and a rank directory (read through rank lines built at open); a record is seven 16-bit fields
+// (alpha in 1/65535).
 #include <bit>
 #include <cstdint>
 #include <memory>
@@ -54,7 +55,6 @@ private:
     const std::uint8_t* records_ = nullptr;
     std::uint64_t entries_;
     std::size_t size_;  // the payload's and the rank lines'
-
     // Coverage statistics for `inspect`, gathered when the records are checked at open.
     std::uint64_t partial_ = 0;
     double alpha_sum_ = 0;
