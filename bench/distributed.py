@@ -56,10 +56,44 @@ def interleaved(lattice, mpirun, args, stats, key, cpu):
     return min(a, key=key), min(b, key=key), min(map(cpu, a)), min(map(cpu, b)), a + b
 
 
+STEPS = ("joined", "loaded", "checked", "tables", "accel", "dealt", "gathered", "encoded")
+
+
+def print_phases(phases):
+    """Where the time of the best runs went: the plain run's own figures, and each rank's
+    timeline (--stats timeline_ms: when each step ended, from the process's start)."""
+    print("\n## Where the time goes (the best runs above)\n")
+    print("Milliseconds per step. 1 x 2: the plain run's `load_ms`, `prepare_ms` (tables), `build_ms` "
+          "(acceleration structure), `render_ms`, or rasterize and encode. 2 x 1: each rank's step "
+          "durations from its timeline (MPI_Init from the process's start, then from one step to the next); "
+          "`dealt` is the dealt loop (tiles or blocks, waiting for the other rank at its start included), "
+          "`gathered` the gather to rank 0.\n")
+    print("| job | run | " + " | ".join(STEPS) + " | wall (s) |")
+    print("| --- | --- | " + " | ".join("---:" for _ in STEPS) + " | ---: |")
+    for job, a, b in phases:
+        one = {"loaded": a.get("load_ms"), "tables": a.get("prepare_ms"), "accel": a.get("build_ms"),
+               "dealt": a.get("render_ms")}
+        if "rasterize_seconds" in a:
+            one = {"dealt": a["rasterize_seconds"] * 1e3, "encoded": a["encode_seconds"] * 1e3}
+        cells = [f"{one[k]:.0f}" if one.get(k) is not None else "" for k in STEPS]
+        print(f"| {job} | 1 x 2 | " + " | ".join(cells) + f" | {a['wall_s']:.2f} |")
+        for r in b.get("ranks", []):
+            t = r.get("timeline_ms", {})
+            cells, last = [], 0.0
+            for k in STEPS:
+                if k in t:
+                    cells.append(f"{t[k] - last:.0f}")
+                    last = t[k]
+                else:
+                    cells.append("")
+            print(f"| {job} | 2 x 1, rank {r['rank']} | " + " | ".join(cells) + f" | {b['wall_s']:.2f} |")
+
+
 def main(lattice, out, mpirun):
     out = pathlib.Path(out)
     raw = []
     rows = []
+    phases = []  # (job, best 1 x 2 stats, best 2 x 1 stats)
     with tempfile.TemporaryDirectory() as tmp:
         work = pathlib.Path(tmp)
         stats = work / "stats.json"
@@ -76,6 +110,7 @@ def main(lattice, out, mpirun):
             p5[mode] = b
             rows.append((f"Plate 5, 4 spp, {mode}: render", a["render_ms"] / 1e3, b["render_ms"] / 1e3, ca, cb,
                          a["wall_s"], b["wall_s"]))
+            phases.append((f"Plate 5, {mode}", a, b))
         # The hair at sigma^-1 = 4, written outside the cache.
         args = ["rasterize", "-q", str(PLATE5), "--primitive", "hair", "--sigma-inv", "4", "-o", str(work / "h.lht")]
         build_s = lambda s: s["rasterize_seconds"] + s["encode_seconds"]
@@ -83,6 +118,17 @@ def main(lattice, out, mpirun):
         raw += r
         rows.append(("hair, sigma^-1 = 4: rasterize + encode", build_s(a), build_s(b), ca, cb,
                      a["wall_s"], b["wall_s"]))
+        phases.append(("hair, rasterize", a, b))
+        # The fixed cost of a job: mpirun, MPI_Init and MPI_Finalize, with nothing to do.
+        startup = {}
+        for name, cmd in (("plain", [lattice, "--version"]),
+                          ("mpirun", [mpirun, "-q", "-n", "2", "--bind-to", "none", lattice, "--version"])):
+            times = []
+            for _ in range(RUNS):
+                t0 = time.perf_counter()
+                subprocess.run(cmd, check=True, env=ENV, stdout=subprocess.DEVNULL)
+                times.append(time.perf_counter() - t0)
+            startup[name] = min(times)
         raster = b
 
         # 100,000 hairs on the bunny (the scatter benchmark's scene), lattice mode: load and
@@ -117,6 +163,11 @@ def main(lattice, out, mpirun):
     for name, a, b, ca, cb, wa, wb in rows:
         print(f"| {name} | {a:.3f} | {b:.3f} | {b / a:.2f} | {ca:.3f} | {cb:.3f} | {100 * (cb / ca - 1):+.1f} % | "
               f"{wa:.2f} | {wb:.2f} |")
+
+    print(f"\nStart-up alone (`lattice --version`, best of {RUNS}): {startup['plain']:.2f} s plain, "
+          f"{startup['mpirun']:.2f} s under `mpirun -n 2` (mpirun, MPI_Init, MPI_Finalize): a floor under every "
+          "2-rank wall time above.")
+    print_phases(phases)
 
     # Figures for the model.
     ex = p5["exact"]

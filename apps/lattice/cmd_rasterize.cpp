@@ -7,6 +7,7 @@
 #include "commands.h"
 #include "common.h"
 #include "dist/job.h"
+#include "dist/timeline.h"
 #include "lattice/cache/table_build.h"
 #include "lattice/cache/table_cache.h"
 #include "scene/scene_loader.h"
@@ -41,11 +42,12 @@ struct RankShare {
     std::uint64_t segments = 0, hits = 0;
     double seconds = 0, cpu_seconds = 0;
     std::uint64_t peak_memory_bytes = 0;
+    dist::Timeline timeline{};
 };
 
 nlohmann::json rank_shares(const RasterizeResult& r, double build_cpu) {
     RankShare mine{dist::rank(), dist::HostName::here(), r.pairs_traced_here, r.hits_here, r.seconds,
-                   build_cpu, peak_rss_bytes()};
+                   build_cpu, peak_rss_bytes(), dist::timeline()};
     nlohmann::json j = nlohmann::json::array();
     for (const RankShare& s : dist::gather_values(mine))
         j.push_back({{"rank", s.rank},
@@ -54,7 +56,8 @@ nlohmann::json rank_shares(const RasterizeResult& r, double build_cpu) {
                      {"stored_hits", s.hits},
                      {"rasterize_seconds", s.seconds},
                      {"build_cpu_seconds", s.cpu_seconds},
-                     {"peak_memory_bytes", s.peak_memory_bytes}});
+                     {"peak_memory_bytes", s.peak_memory_bytes},
+                     {"timeline_ms", timeline_json(s.timeline)}});
     return j;
 }
 
@@ -69,6 +72,7 @@ int run_rasterize(const RasterizeArgs& a) {
         plan = plan_table(find_primitive(scene, a), a.spec, a.scene);
     });
     agree_on_scene(a.scene);
+    dist::mark(dist::Step::kLoaded);
     if (path.empty()) {
         const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
                                !a.lattice_dir.empty(), true);

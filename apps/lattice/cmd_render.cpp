@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "common.h"
 #include "dist/job.h"
+#include "dist/timeline.h"
 #include "io/image.h"
 #include "render/render_modes.h"
 #include "scene/scene_loader.h"
@@ -144,7 +145,8 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeRes
                                   {"primary_rays", rs.primary_rays},
                                   {"shadow_rays", rs.shadow_rays},
                                   {"lattice_visits", rs.lattice_visits},
-                                  {"peak_memory_bytes", rs.peak_memory_bytes}});
+                                  {"peak_memory_bytes", rs.peak_memory_bytes},
+                                  {"timeline_ms", timeline_json(rs.timeline)}});
     }
     return j;
 }
@@ -169,6 +171,7 @@ int run_render(const RenderArgs& a) {
         check_render_budget(scene.camera, a.spp, a.scene);
     });
     agree_on_scene(a.scene);
+    dist::mark(dist::Step::kLoaded);
     // A mode that is not dealt across ranks renders on rank 0 alone.
     const bool across = dist::distributed() && mode_description(kModes.at(a.mode)).spreads_over_ranks;
     if (!across && !dist::is_root()) return 0;

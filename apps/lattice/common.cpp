@@ -1,6 +1,5 @@
 #include "common.h"
 
-#include <tbb/global_control.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -49,24 +48,19 @@ void add_table_options(CLI::App& app, TableSpec& spec) {
         ->check(CLI::IsMember(normals));
 }
 
-// Built in place: a global_control moved from a temporary was unregistered by the temporary's
-// destructor, and --threads had no effect.
-struct ThreadLimit::Impl {
-    explicit Impl(std::size_t n) : control(tbb::global_control::max_allowed_parallelism, n) {}
-    tbb::global_control control;
-};
-
-ThreadLimit::ThreadLimit(int n) {
-    if (n > 0) impl_ = std::make_unique<Impl>(static_cast<std::size_t>(n));
-}
-
-ThreadLimit::~ThreadLimit() = default;
-
 void agree_on_scene(const std::string& scene_file) {
     if (!dist::distributed()) return;
     std::string bytes;
     dist::agree([&] { bytes = read_text_file(scene_file, "scene file"); });
     dist::agree_on(hash_bytes(bytes.data(), bytes.size()), scene_file + ": the scene file");
+}
+
+nlohmann::json timeline_json(const dist::Timeline& t) {
+    nlohmann::json j = nlohmann::json::object();
+    for (int s = 0; s < static_cast<int>(dist::Step::kCount); ++s)
+        if (const double ms = t[static_cast<std::size_t>(s)]; ms > 0)
+            j[std::string(dist::step_name(static_cast<dist::Step>(s)))] = ms;
+    return j;
 }
 
 void write_json_file(const std::string& path, const nlohmann::json& j) {

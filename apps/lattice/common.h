@@ -1,11 +1,12 @@
 #pragma once
 // What several subcommands share: the table options, the thread limit, JSON output files.
 #include <map>
-#include <memory>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 
 #include "lattice/filtered_shape.h"
+#include "dist/timeline.h"
+#include "util/threads.h"  // ThreadLimit, for the commands
 
 namespace CLI {
 class App;
@@ -23,21 +24,11 @@ void add_table_options(CLI::App& app, TableSpec& spec);
 // The --filter values (render, table2): none, box, smooth.
 const std::map<std::string, LatticeFilter>& lattice_filters();
 
-// Caps oneTBB (and so Embree's builds) at n threads for its lifetime; 0 = all cores.
-class ThreadLimit {
-public:
-    explicit ThreadLimit(int n);
-    ~ThreadLimit();
-    ThreadLimit(const ThreadLimit&) = delete;
-    ThreadLimit& operator=(const ThreadLimit&) = delete;
-
-private:
-    struct Impl;
-    std::unique_ptr<Impl> impl_;
-};
-
 // Collective in an MPI job: every rank must have read the same scene file (dist::agree_on).
 void agree_on_scene(const std::string& scene_file);
+
+// A rank's timeline (dist/timeline.h) for --stats: {"loaded": ms, ...}, the steps it reached.
+nlohmann::json timeline_json(const dist::Timeline& t);
 
 // Writes JSON atomically (temporary + rename); throws InputError naming the path.
 void write_json_file(const std::string& path, const nlohmann::json& j);

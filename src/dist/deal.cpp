@@ -1,10 +1,8 @@
 #include "dist/deal.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -16,8 +14,10 @@
 #include <thread>
 
 #include "dist/job.h"
+#include "dist/timeline.h"
 #include "dist/transport.h"
 #include "util/progress.h"
+#include "util/threads.h"
 
 namespace lat::dist {
 namespace {
@@ -26,12 +26,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-int thread_count() {
-    return static_cast<int>(std::min<std::size_t>(
-        static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()),
-        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
 }
 
 // A chunk is at least one item per thread of the rank that asks, else its share of what is
@@ -280,8 +274,10 @@ private:
 }  // namespace
 
 DealReport deal(std::uint32_t n, const std::function<void(std::uint32_t)>& work, const DealOptions& options) {
-    if (!options.across_ranks || !distributed()) return deal_here(n, work, options);
-    return Dealer(n, work, options).run();
+    DealReport report = !options.across_ranks || !distributed() ? deal_here(n, work, options)
+                                                                : Dealer(n, work, options).run();
+    mark(Step::kDealt);
+    return report;
 }
 
 }  // namespace lat::dist

@@ -3,11 +3,17 @@
 #include <algorithm>
 #include <cstring>
 
+#include "dist/timeline.h"
 #include "dist/transport.h"
+#include "util/hash.h"
+#include "util/threads.h"
 
 namespace lat::dist {
 
-Session::Session(int& argc, char**& argv) { transport::start(argc, argv); }
+Session::Session(int& argc, char**& argv) {
+    transport::start(argc, argv);
+    mark(Step::kJoined);
+}
 Session::~Session() { transport::stop(); }
 
 int rank() { return transport::rank(); }
@@ -75,6 +81,27 @@ void agree_on(std::uint64_t fingerprint, const std::string& what) {
 void on_root(const std::function<void()>& step) {
     agree([&] {
         if (is_root()) step();
+    });
+}
+
+void on_root_with_node_threads(const std::function<void()>& step) {
+    if (!distributed()) return step();
+    // Each rank's host (hashed) and thread count.
+    struct Rank {
+        std::uint64_t host;
+        std::int64_t threads;
+    };
+    const std::string host = transport::host();
+    const Rank mine{hash_bytes(host.data(), host.size()), thread_count()};
+    std::vector<Rank> all(static_cast<std::size_t>(ranks()));
+    transport::allgather(&mine, sizeof mine, all.data());
+    std::int64_t node_threads = 0;
+    for (const Rank& r : all)
+        if (r.host == all[0].host) node_threads += r.threads;
+    on_root([&] {
+        const WiderThreads wider(static_cast<int>(std::min<std::int64_t>(
+            node_threads, core_count())));
+        step();
     });
 }
 

@@ -53,6 +53,10 @@ public:
 void agree(const std::function<void()>& step);
 // agree() with a step that runs on rank 0 only (the others wait, sleeping).
 void on_root(const std::function<void()>& step);
+// on_root() for a step that can use more threads than a rank has: while the other ranks wait
+// (asleep), rank 0 may use the threads of every rank on its node (their cores are idle), at
+// most the cores it may run on. For rank 0's share of a table build (encoding every hit).
+void on_root_with_node_threads(const std::function<void()>& step);
 // Collective: throws JobInputError on every rank unless `fingerprint` is the same on every
 // rank ("WHAT differs between rank 0 and rank N"): ranks rendering one image from different
 // inputs (a node's stale copy of a scene) would otherwise make a wrong image without a word.

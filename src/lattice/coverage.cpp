@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "geometry/chain.h"
 #include "lattice/face_cones.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/octahedral.h"
@@ -15,53 +16,67 @@
 namespace lat {
 namespace {
 
-// The sub-rays of one pair, intersected with the given parts of the primitive (the closest hit
-// of each), summed into the pair's coverage.
-// Sub-rays that the renderer would snap to another pair (their exit rounds elsewhere, or they
-// clip to other faces) are not the pair's rays, and are left out of its share.
-template <class Parts>
-CoverageSample sample_pair(const Shape& shape, const LatticeFrame& frame, const BoundaryGrid& grid,
-                           double h, std::uint32_t a, std::uint32_t b, const Parts& parts) {
-    const GridPoint ga = grid.point(a), gb = grid.point(b);
+// The coverage of the pair from the hits of its own sub-rays (those snap takes to the pair).
+struct Tally {
     int hits = 0, rays = 0;
     Vec3 psum, nsum;
-    for (int k = 0; k < kCoverageRays; ++k) {
-        const auto [p, q] = coverage_ray(grid, ga, gb, k);
-        if (p == q) continue;  // squeezed onto a box edge: no ray
-        const Ray r{p * h, (q - p) * h};
-        LatticeFrame::Snap sn;
-        if (!frame.snap(r, sn) || sn.a != a || sn.b != b) continue;
-        ++rays;
-        double best = 1.0 + 1e-12;
-        Crossing bc;
-        bool hit = false;
-        for (const std::uint32_t part : parts) {
-            Crossing c;
-            if (shape.intersect_primitive(part, r, 0.0, best, c)) best = c.t, bc = c, hit = true;
-        }
-        if (!hit) continue;
-        ++hits;
-        psum += lerp(p, q, bc.t);
-        nsum += shape.normal(r, bc);
-    }
+};
+
+CoverageSample summarise(const BoundaryGrid& grid, std::uint32_t a, std::uint32_t b, const Tally& n) {
     CoverageSample s;
     s.a = a, s.b = b;
-    if (hits == 0) return s;
-    s.alpha = static_cast<float>(hits) / static_cast<float>(rays);
-    const Vec3 va = to_vec(ga), d = to_vec(gb) - va;
-    s.t = static_cast<float>(std::clamp(dot(psum / hits - va, d) / dot(d, d), 0.0, 1.0));
+    if (n.hits == 0) return s;
+    s.alpha = static_cast<float>(n.hits) / static_cast<float>(n.rays);
+    const Vec3 va = to_vec(grid.point(a)), d = to_vec(grid.point(b)) - va;
+    s.t = static_cast<float>(std::clamp(dot(n.psum / n.hits - va, d) / dot(d, d), 0.0, 1.0));
     // Opposite normals can cancel (a sub-ray bundle grazing both sides of a thin part): any
     // unit vector is then as good a mean as another, and the pair's alpha carries the weight.
-    const double len = length(nsum);
-    const Oct o = oct_encode(len > 1e-9 ? nsum / len : Vec3{0, 0, 1}, kRawNormalBits);
+    const double len = length(n.nsum);
+    const Oct o = oct_encode(len > 1e-9 ? n.nsum / len : Vec3{0, 0, 1}, kRawNormalBits);
     s.nu = static_cast<std::uint16_t>(o.u), s.nv = static_cast<std::uint16_t>(o.v);
     return s;
 }
 
-struct Scratch {
-    std::vector<std::vector<std::uint32_t>> parts;  // per face point: the parts it may meet
-    std::vector<std::size_t> touched;
-};
+// The closest hit of the sub-ray (lattice units) with the given parts, added to the tally.
+template <class S, class Parts>
+void trace_sub_ray(const S& shape, double h, const SubRay& s, const Parts& parts, Tally& n) {
+    const Ray r{s.p * h, (s.q - s.p) * h};
+    double best = 1.0 + 1e-12;
+    Crossing bc;
+    bool hit = false;
+    for (const std::uint32_t part : parts) {
+        Crossing c;
+        if (shape.intersect_primitive(part, r, 0.0, best, c)) best = c.t, bc = c, hit = true;
+    }
+    if (!hit) return;
+    ++n.hits;
+    n.psum += lerp(s.p, s.q, bc.t);
+    n.nsum += shape.normal(r, bc);
+}
+
+// Whether snap takes the sub-ray to the pair (a, b): the definition.
+bool snaps_to(const LatticeFrame& frame, double h, const SubRay& s, std::uint32_t a, std::uint32_t b) {
+    const Ray r{s.p * h, (s.q - s.p) * h};
+    LatticeFrame::Snap sn;
+    return frame.snap(r, sn) && sn.a == a && sn.b == b;
+}
+
+// The definition: every sub-ray snapped, and intersected with the given parts (the closest hit
+// of each). Sub-rays that the renderer would snap to another pair (their exit rounds
+// elsewhere, or they clip to other faces) are not the pair's rays, and are left out of its share.
+template <class Parts>
+CoverageSample sample_pair(const Shape& shape, const LatticeFrame& frame, const BoundaryGrid& grid,
+                           double h, std::uint32_t a, std::uint32_t b, const Parts& parts) {
+    const PairRays pr(grid, grid.point(a), grid.point(b));
+    Tally n;
+    for (const auto& off : coverage_offsets()) {
+        const SubRay s = pr.ray(off[0], off[1]);
+        if (s.p == s.q || !snaps_to(frame, h, s, a, b)) continue;  // squeezed onto a box edge: no ray
+        ++n.rays;
+        trace_sub_ray(shape, h, s, parts, n);
+    }
+    return summarise(grid, a, b, n);
+}
 
 }  // namespace
 
@@ -80,28 +95,6 @@ const std::array<std::array<double, 2>, kCoverageRays>& coverage_offsets() {
     return offsets;
 }
 
-namespace {
-
-// The axis of p's face that the direction d crosses most squarely.
-std::size_t crossing_axis(const BoundaryGrid& grid, const GridPoint& p, const Vec3& d) {
-    const std::uint8_t faces = grid.faces(p);
-    std::size_t axis = 0;
-    double best = -1;
-    for (int f = 0; f < 6; ++f)
-        if ((faces >> f) & 1) {
-            const auto ax = static_cast<std::size_t>(BoundaryGrid::face_axis(f));
-            if (std::abs(d[ax]) > best) best = std::abs(d[ax]), axis = ax;
-        }
-    return axis;
-}
-
-Vec3 clamp_to_box(Vec3 v, const std::array<int, 3>& n) {
-    for (std::size_t k = 0; k < 3; ++k) v[k] = std::clamp(v[k], 0.0, double(n[k]));
-    return v;
-}
-
-}  // namespace
-
 SubRay coverage_ray(const BoundaryGrid& grid, const GridPoint& p, const GridPoint& q, int k) {
     const auto& off = coverage_offsets()[static_cast<std::size_t>(k)];
     return coverage_ray(grid, p, q, off[0], off[1]);
@@ -109,15 +102,7 @@ SubRay coverage_ray(const BoundaryGrid& grid, const GridPoint& p, const GridPoin
 
 SubRay coverage_ray(const BoundaryGrid& grid, const GridPoint& p, const GridPoint& q, double du,
                     double dv) {
-    const Vec3 vp = to_vec(p), vq = to_vec(q), d = vq - vp;
-    const std::size_t ap = crossing_axis(grid, p, d), aq = crossing_axis(grid, q, d);
-    Vec3 shift;
-    shift[(ap + 1) % 3] = du;
-    shift[(ap + 2) % 3] = dv;
-    // The shifted line leaves through the plane of q's face where it meets it.
-    Vec3 e = vq + shift;
-    if (d[aq] != 0) e = e - d * (shift[aq] / d[aq]);
-    return {clamp_to_box(vp + shift, grid.cells()), clamp_to_box(e, grid.cells())};
+    return PairRays(grid, p, q).ray(du, dv);
 }
 
 CoverageSample pair_coverage(const TableContext& ctx, std::uint32_t a, std::uint32_t b) {
@@ -128,6 +113,131 @@ CoverageSample pair_coverage(const TableContext& ctx, std::uint32_t a, std::uint
     return sample_pair(*ctx.primitive, frame, grid, ctx.cell, a, b, all);
 }
 
+namespace {
+
+// The build's way to the same result as sample_pair, given the parts a pair's cone culling
+// left (sorted): the sub-rays' snaps guessed from their ends (PairRays::guess_snap, snap
+// where it cannot tell), and the parts narrowed to those whose capsule the bundle of sub-rays
+// can reach. A part left out could not be hit, and the others are tried in the same order with
+// the same rays, so every hit, and the sample, is the definition's to the bit.
+// A part's capsule seen along a pair's direction, in a plane across it: a sub-ray parallel to
+// the pair, shifted by (du, dv), can meet the capsule only if its point w0 + du wu + dv wv there
+// lies within r of the capsule's segment [0, pu].
+struct Shadow {
+    std::uint32_t part;
+    double w0x, w0y, wux, wuy, wvx, wvy, pux, puy, uu, rr;
+
+    bool may_meet(double du, double dv) const {
+        const double wx = w0x + du * wux + dv * wvx, wy = w0y + du * wuy + dv * wvy;
+        const double wu = wx * pux + wy * puy, ww = wx * wx + wy * wy;
+        if (wu <= 0) return ww <= rr;
+        if (wu >= uu) return uu - 2 * wu + ww <= rr;
+        return ww * uu - wu * wu <= rr * uu;
+    }
+};
+
+// A thread's scratch for sampling pairs.
+struct PairWork {
+    std::vector<std::uint32_t> near, maybe;
+    std::vector<Shadow> shadows;
+};
+
+class PairSampler {
+public:
+    PairSampler(const Shape& shape, const LatticeFrame& frame, const BoundaryGrid& grid, double h)
+        : frame_(frame), grid_(grid), h_(h) {
+        for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
+            Capsule c;
+            if (!shape.primitive_capsule(i, c)) {
+                capsules_.clear();
+                break;
+            }
+            // Lattice units, grown by the parts' touch tolerance (a relative 1e-9 on r^2) and
+            // rounding: a hit lies in the capsule.
+            capsules_.push_back({c.a / h, c.b / h, c.r / h * (1 + 1e-7) + 1e-6});
+        }
+    }
+
+    template <class S>
+    CoverageSample sample(const S& shape, std::uint32_t a, std::uint32_t b,
+                          const std::vector<std::uint32_t>& parts, PairWork& w) const {
+        std::vector<std::uint32_t>& near = w.near;
+        const PairRays pr(grid_, grid_.point(a), grid_.point(b));
+        if (!near_parts(pr, parts, near)) return summarise(grid_, a, b, {});
+        shadows(pr, near, w.shadows);
+        Tally n;
+        for (const auto& off : coverage_offsets()) {
+            const SubRay s = pr.ray(off[0], off[1]);
+            if (s.p == s.q) continue;
+            const PairRays::Snap g = pr.guess_snap(s);
+            if (g == PairRays::Snap::kOther ||
+                (g == PairRays::Snap::kUnsure && !snaps_to(frame_, h_, s, a, b)))
+                continue;
+            ++n.rays;
+            if (g == PairRays::Snap::kUnsure || w.shadows.empty()) {
+                trace_sub_ray(shape, h_, s, near, n);
+                continue;
+            }
+            // A guessed snap means both ends unclamped: the sub-ray runs along the shifted line.
+            w.maybe.clear();
+            for (const Shadow& sh : w.shadows)
+                if (sh.may_meet(off[0], off[1])) w.maybe.push_back(sh.part);
+            if (!w.maybe.empty()) trace_sub_ray(shape, h_, s, w.maybe, n);
+        }
+        return summarise(grid_, a, b, n);
+    }
+
+private:
+    const LatticeFrame& frame_;
+    const BoundaryGrid& grid_;
+    double h_;
+    std::vector<Capsule> capsules_;  // per part, lattice units; empty when the shape has none
+
+    // The shadows of the near parts (none when the shape has no capsules).
+    void shadows(const PairRays& pr, const std::vector<std::uint32_t>& near, std::vector<Shadow>& out) const {
+        out.clear();
+        if (capsules_.empty()) return;
+        Vec3 b1, b2;
+        orthonormal_basis(normalize(pr.dir()), b1, b2);
+        const std::size_t u = pr.u_axis(), v = pr.v_axis();
+        for (const std::uint32_t part : near) {
+            const Capsule& c = capsules_[part];
+            const Vec3 w0 = pr.from() - c.a, pu = c.b - c.a;
+            const double pux = dot(pu, b1), puy = dot(pu, b2);
+            // 1e-6 more for the rounding of the projection (lattice units up to thousands).
+            const double r = c.r + 1e-6;
+            out.push_back({part, dot(w0, b1), dot(w0, b2), b1[u], b2[u], b1[v], b2[v], pux, puy,
+                           pux * pux + puy * puy, r * r});
+        }
+    }
+
+    // The parts (of `parts`, in order) that a sub-ray can meet: those whose capsule comes within
+    // the bundle's reach of the pair's line. False when there is none.
+    bool near_parts(const PairRays& pr, const std::vector<std::uint32_t>& parts,
+                    std::vector<std::uint32_t>& near) const {
+        near.clear();
+        if (capsules_.empty()) {
+            near = parts;
+            return !near.empty();
+        }
+        const double reach = pr.reach() + 1e-6;
+        for (const std::uint32_t part : parts) {
+            Capsule c = capsules_[part];
+            c.r += reach;
+            if (c.meets_line(pr.from(), pr.dir())) near.push_back(part);
+        }
+        return !near.empty();
+    }
+};
+
+struct Scratch {
+    std::vector<std::vector<std::uint32_t>> parts;  // per face point: the parts it may meet
+    std::vector<std::size_t> touched;
+    PairWork work;
+};
+
+}  // namespace
+
 std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool progress) {
     const Shape& shape = *ctx.primitive;
     const BoundaryGrid grid(ctx.cells);
@@ -137,6 +247,10 @@ std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool pro
     // part it meets has its bounding sphere, grown by that, in the cone from p_i: the culling of
     // the rasterizer with grown spheres, grouped by part in ascending order.
     const std::vector<PartSphere> cull = part_spheres(shape, ctx.cell, 1.0, 1e-9);
+    const PairSampler sampler(shape, frame, grid, ctx.cell);
+    // Chains (the common primitive) are traced through their concrete type, without virtual
+    // calls in the innermost loop.
+    const auto* chain = dynamic_cast<const ChainShape*>(&shape);
     std::array<FaceLayout, 6> faces;
     for (int f = 0; f < 6; ++f) faces[static_cast<std::size_t>(f)] = layout_face(grid, f);
 
@@ -165,7 +279,8 @@ std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool pro
                     });
                 for (const std::size_t k : s.touched) {
                     const CoverageSample c =
-                        sample_pair(shape, frame, grid, ctx.cell, a, fl.ids[k], s.parts[k]);
+                        chain ? sampler.sample(*chain, a, fl.ids[k], s.parts[k], s.work)
+                              : sampler.sample(shape, a, fl.ids[k], s.parts[k], s.work);
                     if (c.alpha >= kCoverageMinAlpha) out.push_back(c);
                     s.parts[k].clear();
                 }

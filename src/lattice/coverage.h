@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "lattice/boundary_grid.h"
+#include "lattice/coverage_rays.h"
 #include "lattice/table.h"
 
 namespace lat {
@@ -41,10 +42,8 @@ const std::array<std::array<double, 2>, kCoverageRays>& coverage_offsets();
 
 // Sub-ray k (0 <= k < kCoverageRays) of the pair (p, q), lattice units: the segment shifted by
 // the k-th offset within the face of p that it crosses most squarely, from that face's plane to
-// the plane of q's face (the one it crosses most squarely), its ends kept on the box.
-struct SubRay {
-    Vec3 p, q;
-};
+// the plane of q's face (the one it crosses most squarely), its ends kept on the box
+// (PairRays::ray).
 SubRay coverage_ray(const BoundaryGrid& grid, const GridPoint& p, const GridPoint& q, int k);
 // The same for any shift (du, dv) along the face's next two axes (x -> y, z; y -> z, x; z -> x, y).
 SubRay coverage_ray(const BoundaryGrid& grid, const GridPoint& p, const GridPoint& q, double du,

@@ -45,6 +45,7 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach) {
     bool capsules = true;
     for (std::size_t i = 0; i < n; ++i) {
         Piece p;
+        p.part = static_cast<std::uint32_t>(i);
         p.box = lat::intersect(expand(primitive->primitive_bounds(i), reach), box_);
         capsules = capsules && primitive->primitive_capsule(i, p.capsule);
         p.capsule.r += reach;
@@ -63,6 +64,10 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach) {
     }
     capsules = capsules && !few.empty() && few.size() <= kMaxCullParts;
     if (capsules) pieces = std::move(few);
+    if (!capsules && n <= kMaxPlacedParts) {
+        primitive_ = primitive;
+        reach_ = reach;
+    }
     for (Piece& p : pieces) p.key = p.box.center()[axis];
     std::stable_sort(pieces.begin(), pieces.end(),
                      [](const Piece& a, const Piece& b) { return a.key < b.key; });
@@ -99,6 +104,11 @@ void LatticeFrame::group(const std::vector<Piece>& pieces, bool capsules) {
         const std::size_t first = g * pieces.size() / groups, end = (g + 1) * pieces.size() / groups;
         CullPart part{{}, 0, 0};
         for (std::size_t i = first; i < end; ++i) part.box = merge(part.box, pieces[i].box);
+        if (primitive_) {
+            part.part_first = static_cast<std::uint32_t>(parts_.size());
+            part.part_count = static_cast<std::uint32_t>(end - first);
+            for (std::size_t i = first; i < end; ++i) parts_.push_back(pieces[i].part);
+        }
         if (capsules) {
             part.first = static_cast<std::uint32_t>(capsules_.size());
             part.count = static_cast<std::uint32_t>(end - first);
@@ -109,7 +119,8 @@ void LatticeFrame::group(const std::vector<Piece>& pieces, bool capsules) {
         total += volume(part.box);
     }
     // A primitive that fills its box (a thin spike) gains nothing from several boxes.
-    if (!tested && total >= volume(box_)) cull_.assign(1, {box_, 0, 0});
+    if (!tested && total >= volume(box_))
+        cull_.assign(1, {box_, 0, 0, 0, static_cast<std::uint32_t>(parts_.size())});
     if (cull_.size() == 1 && !tested) split_in_halves();
 }
 
@@ -126,7 +137,8 @@ void LatticeFrame::split_in_halves() {
     const std::size_t axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     Bounds3 low = whole, high = whole;
     low.hi[axis] = high.lo[axis] = whole.lo[axis] + 0.5 * ext[axis];
-    cull_ = {{low, 0, 0}, {high, 0, 0}};
+    const CullPart& w = cull_.front();
+    cull_ = {{low, 0, 0, w.part_first, w.part_count}, {high, 0, 0, w.part_first, w.part_count}};
 }
 
 bool LatticeFrame::cull_meets(std::size_t i, const Ray& r) const {
@@ -137,13 +149,33 @@ bool LatticeFrame::cull_meets(std::size_t i, const Ray& r) const {
     return false;
 }
 
+// A point within the reach of a part (primitive units) lies within reach times the largest
+// stretch of xf of the placed part. That stretch squared, the largest eigenvalue of M^T M, is
+// at most the largest absolute row sum of M^T M (Gershgorin): exact for rotations and scales.
+Bounds3 LatticeFrame::placed_parts(const CullPart& p, const Transform& xf) const {
+    const Mat3& m = xf.forward().m;
+    double stretch2 = 0;
+    for (int i = 0; i < 3; ++i) {
+        double row = 0;
+        for (int j = 0; j < 3; ++j) row += std::abs(dot(m.col(i), m.col(j)));
+        stretch2 = std::max(stretch2, row);
+    }
+    const double grow = reach_ * std::sqrt(stretch2) * (1 + 1e-12);
+    Bounds3 placed;
+    for (std::uint32_t k = p.part_first; k < p.part_first + p.part_count; ++k)
+        placed = merge(placed, expand(primitive_->primitive_bounds(parts_[k], xf), grow));
+    return placed;
+}
+
 Bounds3 LatticeFrame::cull_bounds(std::size_t i, const Transform& xf) const {
     const CullPart& p = cull_[i];
+    Bounds3 bounds = xf.bounds(p.box);
+    if (p.part_count > 0) bounds = lat::intersect(bounds, placed_parts(p, xf));
+    if (p.count == 0) return bounds;
     Bounds3 placed;
     for (std::uint32_t k = p.first; k < p.first + p.count; ++k)
         placed = merge(placed, capsules_[k].placed_bounds(xf));
-    const Bounds3 clipped = xf.bounds(p.box);
-    return p.count == 0 ? clipped : lat::intersect(clipped, placed);
+    return lat::intersect(bounds, placed);
 }
 
 bool LatticeFrame::snap(const Ray& r, Snap& s) const {

@@ -51,15 +51,27 @@ private:
     struct CullPart {
         Bounds3 box;
         std::uint32_t first, count;
+        // The primitive's parts in it, parts_[part_first, part_first + part_count): its world
+        // bounds are also those of the placed parts grown by the reach (tight for turned
+        // instances, where the box around the turned box is loose). None: the box alone.
+        std::uint32_t part_first = 0, part_count = 0;
     };
     std::vector<CullPart> cull_;
     std::vector<Capsule> capsules_;
+    std::vector<std::uint32_t> parts_;
+    const Shape* primitive_ = nullptr;
+    double reach_ = 0;
+    // Placed bounds are computed per part and instance when the scene is built: only for
+    // primitives of at most this many parts.
+    static constexpr std::size_t kMaxPlacedParts = 256;
 
     struct Piece {  // one part of the primitive, as culling sees it
         Bounds3 box;
         Capsule capsule;
         double key = 0;
+        std::uint32_t part = 0;
     };
+    Bounds3 placed_parts(const CullPart& p, const Transform& xf) const;
     void make_cull_parts(const Shape* primitive, double reach);
     static void drop_covered(std::vector<Piece>& pieces);
     void group(const std::vector<Piece>& pieces, bool capsules);

@@ -10,6 +10,8 @@
 
 #include "dist/deal.h"
 #include "dist/job.h"
+#include "dist/message.h"
+#include "dist/timeline.h"
 #include "geometry/chain.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/face_cones.h"
@@ -214,32 +216,41 @@ void gather_blocks(const dist::DealReport& mine, bool keep_hits, std::vector<Cou
     if (keep_hits)
         for (const std::uint32_t blk : ids) pieces.push_back(bytes(hits[blk]));
     std::vector<ByteBuffer> all = dist::gather_to_root(pieces);
+    if (!dist::is_root()) return;
+    // What the other ranks sent is checked before it is used: every block from exactly one
+    // rank, hit counts that fill the message exactly.
+    std::vector<bool> dealt(counts.size());
+    dist::mark_dealt(mine.chunks, dealt, dist::MessageReader({}, "block list", 0));
     for (std::size_t r = 1; r < all.size(); ++r) {
         auto buffer = std::make_shared<const ByteBuffer>(std::move(all[r]));
-        const std::uint8_t* at = buffer->data();
-        const auto read = [&](auto* out, std::size_t count) {
-            std::memcpy(out, at, count * sizeof(*out));
-            at += count * sizeof(*out);
+        dist::MessageReader in({buffer->data(), buffer->size()}, "rasterized blocks", static_cast<int>(r));
+        const std::uint64_t m = in.read<std::uint64_t>();
+        const auto list = [&](auto& v) {  // m values, checked to fit before they are allocated
+            const std::span<const std::uint8_t> b = in.take(m, sizeof(v[0]));
+            v.resize(m);
+            if (m) std::memcpy(v.data(), b.data(), b.size());
         };
-        std::uint64_t m = 0;
-        read(&m, 1);
-        std::vector<std::uint32_t> their_ids(m);
-        std::vector<Counts> their_counts(m);
-        std::vector<std::uint64_t> their_sizes(m);
-        read(their_ids.data(), m);
-        read(their_counts.data(), m);
-        read(their_sizes.data(), m);
+        std::vector<std::uint32_t> their_ids;
+        std::vector<Counts> their_counts;
+        std::vector<std::uint64_t> their_sizes;
+        list(their_ids);
+        list(their_counts);
+        list(their_sizes);
         for (std::size_t i = 0; i < m; ++i) {
             const std::uint32_t blk = their_ids[i];
+            const dist::Chunk one{blk, blk + 1};
+            dist::mark_dealt(std::span(&one, 1), dealt, in);
             counts[blk] = their_counts[i];
             if (!keep_hits) continue;
             // 4-byte aligned: every field before the hits is a multiple of 4 bytes.
-            hits[blk] = {reinterpret_cast<const RawHit*>(at), their_sizes[i]};
-            at += their_sizes[i] * sizeof(RawHit);
+            const std::span<const std::uint8_t> b = in.take(their_sizes[i], sizeof(RawHit));
+            hits[blk] = {reinterpret_cast<const RawHit*>(b.data()), their_sizes[i]};
         }
-        assert(at == buffer->data() + buffer->size());
+        in.expect_end();
         storage.push_back(std::move(buffer));
     }
+    for (std::size_t b = 0; b < dealt.size(); ++b)
+        if (!dealt[b]) throw dist::MessageError("block " + std::to_string(b) + " came from no rank");
 }
 
 }  // namespace
@@ -288,7 +299,10 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
             res.hits_here += block_counts[blk].hits;
         }
     // Rank 0 gets the other ranks' blocks; theirs keep only what they counted themselves.
-    if (deal_opt.across_ranks) gather_blocks(deal, opt.keep_hits, block_counts, block_hits, res.raw.storage);
+    if (deal_opt.across_ranks) {
+        gather_blocks(deal, opt.keep_hits, block_counts, block_hits, res.raw.storage);
+        dist::mark(dist::Step::kGathered);
+    }
     res.pairs_eq2 = tracer.grid().pairs_eq2();
     for (const Counts& c : block_counts) {
         res.pairs_enumerated += c.enumerated;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "dist/timeline.h"
 #include "geometry/chain.h"
 #include "render/scene_parts.h"
 
@@ -78,9 +79,11 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
                 r.bytes_added += r.lattices.table_bytes;
             }
             r.prepare_ms = ms_since(t0);
+            dist::mark(dist::Step::kTables);
             t0 = clock::now();
             const RenderScene rs(scene, instance_shape, settings.accel);
             r.build_ms = ms_since(t0);
+            dist::mark(dist::Step::kAccel);
             if (settings.before_render) settings.before_render();
             r.out = render_image(rs, opt);
             break;

@@ -9,6 +9,8 @@
 
 #include "dist/deal.h"
 #include "dist/job.h"
+#include "dist/message.h"
+#include "dist/timeline.h"
 #include "lattice/lattice_shape.h"
 #include "render/camera.h"
 #include "render/layers.h"
@@ -146,23 +148,28 @@ void gather_tiles(const TileContext& tc, const dist::DealReport& mine) {
         pieces.emplace_back(display.data() + first * 3, count * 3);
     });
     const std::vector<ByteBuffer> all = dist::gather_to_root(pieces);
+    if (!dist::is_root()) return;
+    // What the other ranks sent is checked before it is copied: every tile of the image from
+    // exactly one rank, and rows that fill the message exactly.
+    const auto tiles_y = static_cast<std::size_t>((tc.h + kTile - 1) / kTile);
+    std::vector<bool> dealt(static_cast<std::size_t>(tc.tiles_x) * tiles_y);
+    dist::mark_dealt(mine.chunks, dealt, dist::MessageReader({}, "tile list", 0));
     for (std::size_t r = 1; r < all.size(); ++r) {
-        const std::uint8_t* from = all[r].data();
-        std::uint64_t n = 0;
-        std::memcpy(&n, from, sizeof n);
-        std::vector<dist::Chunk> chunks(n);
-        std::memcpy(chunks.data(), from + sizeof n, n * sizeof(dist::Chunk));
-        from += sizeof n + n * sizeof(dist::Chunk);
+        dist::MessageReader in({all[r].data(), all[r].size()}, "tiles message", static_cast<int>(r));
+        const std::span<const std::uint8_t> list = in.take(in.read<std::uint64_t>(), sizeof(dist::Chunk));
+        std::vector<dist::Chunk> chunks(list.size() / sizeof(dist::Chunk));
+        if (!list.empty()) std::memcpy(chunks.data(), list.data(), list.size());
+        dist::mark_dealt(chunks, dealt, in);
         for_each_tile_row(tc, chunks, [&](std::size_t first, std::size_t count) {
-            std::memcpy(radiance.data() + first * 3, from, count * 3 * sizeof(float));
-            from += count * 3 * sizeof(float);
+            in.read(radiance.data() + first * 3, count * 3);
         });
         for_each_tile_row(tc, chunks, [&](std::size_t first, std::size_t count) {
-            std::memcpy(display.data() + first * 3, from, count * 3);
-            from += count * 3;
+            in.read(display.data() + first * 3, count * 3);
         });
-        assert(from == all[r].data() + all[r].size());
+        in.expect_end();
     }
+    for (std::size_t t = 0; t < dealt.size(); ++t)
+        if (!dealt[t]) throw dist::MessageError("tile " + std::to_string(t) + " came from no rank");
 }
 
 // Rank 0 receives every rank's figures; the totals become the job's.
@@ -181,6 +188,7 @@ void gather_rank_stats(const dist::DealReport& deal, RenderStats& st) {
     mine.shadow_rays = st.shadow_rays;
     mine.lattice_visits = st.lattice_visits;
     mine.peak_memory_bytes = peak_rss_bytes();
+    mine.timeline = dist::timeline();
     st.ranks = dist::gather_values(mine);
     if (st.ranks.empty()) return;
     st.primary_rays = st.shadow_rays = st.lattice_visits = 0;
@@ -229,7 +237,10 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     out.stats.shadow_rays = counts.shadow.load();
     out.stats.lattice_visits = counts.visits.load();
     out.stats.threads = deal.threads;
-    if (across) gather_tiles(tc, deal);
+    if (across) {
+        gather_tiles(tc, deal);
+        dist::mark(dist::Step::kGathered);
+    }
     out.stats.cpu_ms = (cpu_seconds() - cpu0) * 1e3;
     if (across) gather_rank_stats(deal, out.stats);
     out.stats.render_ms =

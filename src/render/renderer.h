@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "dist/timeline.h"
 #include "io/image.h"
 #include "render/render_scene.h"
 #include "render/shading.h"
@@ -39,6 +40,7 @@ struct RankStats {
     double cpu_ms = 0;     // the process's CPU time (all threads) over the render and gather
     std::uint64_t primary_rays = 0, shadow_rays = 0, lattice_visits = 0;
     std::uint64_t peak_memory_bytes = 0;
+    dist::Timeline timeline{};  // when each step ended here
 };
 
 struct RenderStats {

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "dist/job.h"
+#include "dist/timeline.h"
 #include "lattice/boundary_grid.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -96,6 +97,7 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
     // Rank 0 alone checks: it is the one that will hold every hit.
     if (across_ranks) dist::on_root([&] { check_buildable(plan); });
     else check_buildable(plan);
+    dist::mark(dist::Step::kChecked);
     TableBuild b;
     b.header = plan.header;
     RasterizeOptions opt;
@@ -112,8 +114,10 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
         b.header.entries = b.raster.hits;
         write_table_file(path, b.header, payload);
         b.bytes = payload.size() + kTableHeaderBytes + b.header.metadata.size();
+        dist::mark(dist::Step::kEncoded);
     };
-    if (across_ranks) dist::on_root(encode_and_write);
+    // Rank 0 encodes every hit while the other ranks wait: with their cores too, on its node.
+    if (across_ranks) dist::on_root_with_node_threads(encode_and_write);
     else encode_and_write();
     return b;
 }
