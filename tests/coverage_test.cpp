@@ -13,6 +13,7 @@
 #include "lattice/coverage.h"
 #include "lattice/coverage_rays.h"
 #include "lattice/encoding.h"
+#include "lattice/filtered_shape.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/rasterizer.h"
 #include "render/renderer.h"
@@ -135,6 +136,74 @@ TEST(Coverage, TheTableAnswersTheCoverage) {
         EXPECT_NEAR(h.t, c.t, 1e-4);
     }
     EXPECT_NE(table->details().find("partly covered"), std::string::npos);
+}
+
+// The lookups the smooth filter makes (coverage_many, through the rank lines built at open)
+// find exactly the stored pairs, with or without their normals.
+TEST(Coverage, ManyLookupsFindExactlyTheStoredPairs) {
+    const Encoding& e = find_encoding("coverage");
+    const RasterizeResult r = rasterize(kContext);
+    const ByteBuffer payload = e.build(r.raw, kContext, {});
+    const auto table = e.open(payload.data(), payload.size(), r.hits, kContext);
+    const std::uint32_t n = BoundaryGrid(kContext.cells).count();
+    std::vector<std::uint8_t> stored(std::size_t{n} * n, 0);
+    for (const CoverageSample& c : rasterize_coverage(kContext, false))
+        stored[std::size_t{c.a} * n + c.b] = c.alpha > 0;
+    int found_pairs = 0;
+    for (std::uint32_t a = 0; a < n; ++a)
+        for (std::uint32_t b0 = 0; b0 < n; b0 += 5) {
+            std::uint32_t as[5], bs[5];
+            for (int i = 0; i < 5; ++i) as[i] = a, bs[i] = std::min(b0 + std::uint32_t(i), n);
+            CoverageHit with[5], without[5];
+            bool f1[5], f2[5];
+            table->coverage_many(as, bs, 5, with, f1, true);
+            table->coverage_many(as, bs, 5, without, f2, false);
+            for (int i = 0; i < 5; ++i) {
+                const bool want = bs[i] < n && stored[std::size_t{a} * n + bs[i]];
+                ASSERT_EQ(f1[i], want) << a << " " << bs[i];
+                ASSERT_EQ(f2[i], want);
+                if (!want) continue;
+                ++found_pairs;
+                EXPECT_EQ(with[i].alpha, without[i].alpha);
+                EXPECT_EQ(with[i].t, without[i].t);
+                EXPECT_NEAR(length(with[i].normal), 1.0, 1e-9);
+            }
+        }
+    EXPECT_GT(found_pairs, 100);
+}
+
+// Shadow rays ask for the coverage alone (RayFootprint::coverage_only): the same sheets, where
+// they lie and how much they cover, as for camera rays.
+TEST(Coverage, ShadowRaysGetTheSameSheetsWithoutNormals) {
+    const Encoding& e = find_encoding("coverage");
+    const RasterizeResult r = rasterize(kContext);
+    const ByteBuffer payload = e.build(r.raw, kContext, {});
+    std::shared_ptr<const LatticeTable> table = e.open(payload.data(), payload.size(), r.hits, kContext);
+    const FilteredLatticeShape shape({{table, kContext}}, LatticeFilter::kSmooth,
+                                     e.error_bound(kContext, {}));
+    std::mt19937_64 rng(7);
+    const Bounds3 box = shape.bounds();
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    auto point = [&] {
+        return box.lo + Vec3{u(rng), u(rng), u(rng)} * (box.hi - box.lo);
+    };
+    int hits = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 p = point(), q = point();
+        const Ray ray{p - (q - p), (q - p) / length(q - p)};
+        Crossing camera, shadow;
+        set_ray_footprint({});
+        const bool h1 = shape.intersect(ray, 0.0, kInfinity, camera);
+        set_ray_footprint({0, 0, true});
+        const bool h2 = shape.intersect(ray, 0.0, kInfinity, shadow);
+        ASSERT_EQ(h1, h2);
+        if (!h1) continue;
+        ++hits;
+        EXPECT_EQ(camera.t, shadow.t);
+        EXPECT_EQ(camera.coverage, shadow.coverage);
+    }
+    set_ray_footprint({});
+    EXPECT_GT(hits, 100);
 }
 
 // A hair of radius 0.15 in cells of 1, across the view, 2.3 pixels a cell.

@@ -29,6 +29,9 @@ inline constexpr std::array<std::pair<std::string_view, LatticeFilter>, 3> kLatt
 // is; 0 (the default) asks for the finest level.
 struct RayFootprint {
     double width0 = 0, spread = 0;
+    // The ray wants only each sheet's coverage and where it lies (a shadow ray's transmittance):
+    // the normals are not decoded, and the crossing's normal faces the ray.
+    bool coverage_only = false;
 };
 void set_ray_footprint(const RayFootprint& f);
 const RayFootprint& ray_footprint();
@@ -114,9 +117,11 @@ private:
     LatticeFilter filter_;
     HitTableShape point_;  // the finest level, point-sampled
 
+    // intersect, with or without the sheet's normal.
+    bool sheet(const Ray& r, double tmin, double tmax, bool normal, Crossing& hit) const;
     void blend(const Level& l, const Ray& r, double weight, bool smooth, Blend& b) const;
     // Looks the blend's pairs up and adds them to the sheet.
-    void add_blend(const Level& l, const Blend& b, Sheet& s) const;
+    void add_blend(const Level& l, const Blend& b, bool normals, Sheet& s) const;
 };
 
 }  // namespace lat

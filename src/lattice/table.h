@@ -122,9 +122,11 @@ public:
     // (nearly) all miss.
     virtual bool coverage(std::uint32_t, std::uint32_t, CoverageHit&) const { return false; }
     // The coverage of n pairs (a[i], b[i]) at once, found[i] saying whether each has one: lets
-    // a table overlap the memory accesses of the pairs a smooth filter blends.
+    // a table overlap the memory accesses of the pairs a smooth filter blends. normals: false
+    // when only alpha and t are wanted (shadow rays' transmittance): the normals may be left
+    // unset.
     virtual void coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
-                               CoverageHit* out, bool* found) const {
+                               CoverageHit* out, bool* found, bool /*normals*/) const {
         for (int i = 0; i < n; ++i) found[i] = coverage(a[i], b[i], out[i]);
     }
     // A hint that coverage_many will soon be asked for these pairs: the table may start

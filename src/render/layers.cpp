@@ -10,7 +10,7 @@ namespace {
 Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, double width,
                  ShadeCounters& counters) {
     return shade_with(rs, ray, hit, counters, [&](const Ray& r, double tmin, double tmax, double dist) {
-        set_ray_footprint({width, -width / dist});
+        set_ray_footprint({width, -width / dist, true});
         return transmittance(rs, r, tmin, tmax, hit.object);
     });
 }

@@ -13,7 +13,7 @@ namespace lat {
 namespace {
 
 constexpr std::uint64_t kMagic = 0x3152'4556'4F43ull;  // "COVER1"
-constexpr std::size_t kRecordBytes = CoverageTable::kFields * 2;
+constexpr std::size_t kRecordBytes = CoverageTable::kRecordBytes;
 constexpr double kTScale = 65534.0;
 constexpr double kAlphaScale = 65535.0;
 
@@ -135,9 +135,16 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
         fail("occupancy bits past the last pair");
     points_ = h.points;
     occupied_ = h.occupied;
-    rank_ = RankIndex(occ, counts);
-    occ_ = occ;
-    counts_ = counts;
+    const std::uint64_t nlines = (s.nwords + RankLine::kWords - 1) / RankLine::kWords;
+    lines_ = std::make_unique<RankLine[]>(nlines);
+    size_ += nlines * sizeof(RankLine);
+    std::uint64_t below = 0;
+    for (std::uint64_t w = 0; w < s.nwords; ++w) {
+        RankLine& l = lines_[w / RankLine::kWords];
+        if (w % RankLine::kWords == 0) l.base = below;
+        l.bits[w % RankLine::kWords] = occ[w];
+        below += static_cast<std::uint64_t>(std::popcount(occ[w]));
+    }
     records_ = payload + s.records;
     std::uint64_t centers = 0;
     for (std::uint64_t i = 0; i < occupied_; ++i) {
@@ -153,10 +160,8 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
 }
 
 const std::uint8_t* CoverageTable::record(std::uint32_t a, std::uint32_t b) const {
-    if (a >= points_ || b >= points_) return nullptr;
-    const std::uint64_t i = static_cast<std::uint64_t>(a) * points_ + b;
-    if (!rank_.test(i)) return nullptr;
-    return records_ + rank_.rank(i) * kRecordBytes;
+    const std::uint64_t i = pair_index(a, b);
+    return i == ~0ull ? nullptr : record_at(i);
 }
 
 bool CoverageTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
@@ -167,24 +172,24 @@ bool CoverageTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) cons
     return true;
 }
 
-void CoverageTable::decode(const std::uint8_t* r, CoverageHit& hit) {
+void CoverageTable::decode(const std::uint8_t* r, CoverageHit& hit, bool normal) {
     hit.alpha = field(r, kAlpha) / kAlphaScale;
     hit.t = field(r, kMeanT) / kTScale;
-    hit.normal = oct_decode({field(r, kMeanNu), field(r, kMeanNv)}, kRawNormalBits);
+    if (normal) hit.normal = oct_decode({field(r, kMeanNu), field(r, kMeanNv)}, kRawNormalBits);
 }
 
 bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const {
     const std::uint8_t* r = record(a, b);
     if (!r || field(r, kAlpha) == 0) return false;
-    decode(r, hit);
+    decode(r, hit, true);
     return true;
 }
 
 void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
-                                  CoverageHit* out, bool* found) const {
+                                  CoverageHit* out, bool* found, bool normals) const {
     // Three passes, each prefetching what the next reads, so that the cache misses of the pairs
-    // (occupancy word, rank count, record: three a pair in a table of hundreds of MB) overlap
-    // instead of following one another.
+    // (rank line, record: two a pair in a table of hundreds of MB) overlap instead of following
+    // one another.
     constexpr int kMax = 16;
     std::uint64_t idx[kMax];
     const std::uint8_t* rec[kMax];
@@ -193,13 +198,12 @@ void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b
         for (int i = 0; i < m; ++i) idx[i] = pair_index(a[base + i], b[base + i]);
         prefetch_coverage(a + base, b + base, m);
         for (int i = 0; i < m; ++i) {
-            rec[i] = idx[i] != ~0ull && rank_.test(idx[i]) ? records_ + rank_.rank(idx[i]) * kRecordBytes
-                                                            : nullptr;
+            rec[i] = idx[i] != ~0ull ? record_at(idx[i]) : nullptr;
             if (rec[i]) __builtin_prefetch(rec[i]);
         }
         for (int i = 0; i < m; ++i) {
             found[base + i] = rec[i] && field(rec[i], kAlpha) != 0;
-            if (found[base + i]) decode(rec[i], out[base + i]);
+            if (found[base + i]) decode(rec[i], out[base + i], normals);
         }
     }
 }
@@ -207,9 +211,7 @@ void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b
 void CoverageTable::prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const {
     for (int i = 0; i < n; ++i) {
         const std::uint64_t idx = pair_index(a[i], b[i]);
-        if (idx == ~0ull) continue;
-        __builtin_prefetch(occ_ + (idx >> 6));
-        __builtin_prefetch(counts_ + (idx >> 6) / RankIndex::kBlockWords);
+        if (idx != ~0ull) __builtin_prefetch(line_of(idx));
     }
 }
 
