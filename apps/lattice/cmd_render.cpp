@@ -11,6 +11,7 @@
 #include "dist/job.h"
 #include "dist/timeline.h"
 #include "io/image.h"
+#include "lattice/encoding.h"
 #include "render/render_modes.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
@@ -45,12 +46,19 @@ struct RenderArgs {
     std::string instancing = "auto";
     TextureOptions texture;
     int shadow_map_size = ParticleOptions{}.shadow_map_size;
-    std::string filter = "none";
+    std::string filter = "smooth";
     std::string lod = "on";
     bool quiet = false;
 
     bool lattice_mode() const { return kModes.at(mode) == RenderMode::kLattice; }
 };
+
+// Whether the encoding of that name (if any) stores coverage.
+bool has_coverage(const std::string& name) {
+    for (const Encoding* e : encodings())
+        if (e->name == name) return e->coverage;
+    return false;
+}
 
 // Wall-clock milestones of a render command, in milliseconds from its start.
 struct Timings {
@@ -236,8 +244,9 @@ Command add_render_command(CLI::App& parent) {
     add_table_options(*c.app, args->spec);
     c.app->add_option("--filter", args->filter,
                       "lattice mode: none (point-sampled tables, as rasterized), box (each pair's "
-                      "coverage) or smooth (coverage blended over the neighbouring pairs); a filter "
-                      "uses the coverage encoding")
+                      "coverage) or smooth (coverage blended over the neighbouring pairs, the "
+                      "default unless --encoding names one without coverage); a filter uses the "
+                      "coverage encoding")
         ->check(CLI::IsMember(kFilters));
     c.app->add_option("--lod", args->lod,
                       "lattice mode with a filter: levels of detail, sigma^-1 = K, 2K, 4K as "
@@ -250,8 +259,12 @@ Command add_render_command(CLI::App& parent) {
     c.app->add_flag("-q,--quiet", args->quiet, "No progress bar or summary line");
     c.across_ranks = true;
     c.run = [args, app = c.app] {
-        // A filter needs coverage: unless an encoding was asked for, it takes the one with it.
-        if (kFilters.at(args->filter) != LatticeFilter::kNone && app->get_option("--encoding")->count() == 0)
+        // A filter needs coverage: unless an encoding was asked for, it takes the one with it;
+        // an encoding without coverage asked for alone means its point-sampled table.
+        const bool encoding_given = app->get_option("--encoding")->count() > 0;
+        if (encoding_given && app->get_option("--filter")->count() == 0 && !has_coverage(args->spec.encoding))
+            args->filter = "none";
+        if (kFilters.at(args->filter) != LatticeFilter::kNone && !encoding_given)
             args->spec.encoding = "coverage";
         return run_render(*args);
     };

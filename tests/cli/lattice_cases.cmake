@@ -14,7 +14,7 @@ if(CASE STREQUAL "corrupt")
   # Overwrite one byte of the payload in place.
   execute_process(COMMAND sh -c "printf Z | dd of='${tables}' bs=1 seek=300 conv=notrunc 2>/dev/null")
   run(2 "hair-s1-hash14-[0-9a-f]+\\.lht: not a valid lattice table: payload checksum mismatch"
-      ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/x.png)
+      ${LATTICE} render -q ${P3} --mode lattice --filter none --lattice-dir ${WORK} -o ${WORK}/x.png)
   if(EXISTS ${WORK}/x.png)
     message(FATAL_ERROR "an image was written")
   endif()
@@ -25,14 +25,14 @@ elseif(CASE STREQUAL "truncated")
   math(EXPR keep "${size} - 1000")
   execute_process(COMMAND truncate -s ${keep} ${tables})
   run(2 "not a valid lattice table: file holds [0-9]+ bytes after the header, header says [0-9]+ \\(truncated\\?\\)"
-      ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/x.png)
+      ${LATTICE} render -q ${P3} --mode lattice --filter none --lattice-dir ${WORK} -o ${WORK}/x.png)
 elseif(CASE STREQUAL "other_primitive")
   # The hair's cache file replaced by the thistle spike's table.
   run(0 "" ${LATTICE} rasterize -q ${P3} --primitive hair --lattice-dir ${WORK})
   file(GLOB hair ${WORK}/hair-*.lht)
   run(0 "" ${LATTICE} rasterize -q ${P2} --primitive spike -o ${hair})
   run(2 "lattice table is for hash14, 1 x 1 x 20 cells \\(sigma 1, sigma\\^-1 1\\), expected hash14, 7 x 7 x 20 cells"
-      ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/x.png)
+      ${LATTICE} render -q ${P3} --mode lattice --filter none --lattice-dir ${WORK} -o ${WORK}/x.png)
 elseif(CASE STREQUAL "missing_dir")
   run(2 "no/such/dir: lattice cache directory does not exist"
       ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK}/no/such/dir -o ${WORK}/x.png)
@@ -66,7 +66,8 @@ elseif(CASE STREQUAL "sigma_inv_range")
   run(2 "--sigma-inv: sigma\\^-1 = 0 is out of range"
       ${LATTICE} render -q ${P3} --mode lattice --sigma-inv 0 --lattice-dir ${WORK} -o ${WORK}/x.png)
 elseif(CASE STREQUAL "filter")
-  # Filtered lattices: the coverage table is built and used; --filter none is the plain lattice.
+  # Filtered lattices: the coverage table is built and used; smooth is the default, and
+  # --filter none is the plain lattice, as is an encoding without coverage asked for alone.
   run(0 "" ${LATTICE} render -q ${P3} --mode lattice --filter smooth --lod off --lattice-dir ${WORK}
       -o ${WORK}/smooth.png --stats ${WORK}/s.json)
   file(READ ${WORK}/s.json stats)
@@ -78,10 +79,15 @@ elseif(CASE STREQUAL "filter")
     message(FATAL_ERROR "no coverage table in the cache")
   endif()
   run(0 "" ${LATTICE} render -q ${P3} --mode lattice --filter none --lattice-dir ${WORK} -o ${WORK}/none.png)
-  run(0 "" ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/plain.png)
+  run(0 "" ${LATTICE} render -q ${P3} --mode lattice --encoding hash14 --lattice-dir ${WORK} -o ${WORK}/plain.png)
   execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/none.png ${WORK}/plain.png RESULT_VARIABLE differ)
   if(differ)
     message(FATAL_ERROR "--filter none differs from the plain lattice image")
+  endif()
+  run(0 "" ${LATTICE} render -q ${P3} --mode lattice --lod off --lattice-dir ${WORK} -o ${WORK}/default.png)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/smooth.png ${WORK}/default.png RESULT_VARIABLE differ)
+  if(differ)
+    message(FATAL_ERROR "the default filter is not smooth")
   endif()
   execute_process(COMMAND ${LATTICE} inspect ${tables} --no-certify OUTPUT_VARIABLE out RESULT_VARIABLE code)
   if(NOT code EQUAL 0 OR NOT out MATCHES "partly covered")
@@ -112,8 +118,8 @@ elseif(CASE STREQUAL "tilted_tori_fit")
   run(0 "" ${LATTICE} rasterize -q ${LIMITS}/tilted-tori.json --primitive rings -o ${WORK}/t.lht)
 elseif(CASE STREQUAL "render_then_reuse")
   # A lattice render builds its table once, then finds it in the cache.
-  run(0 "1 table .*1 built" ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/a.png)
-  run(0 "1 table .*0 built" ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK} -o ${WORK}/b.png)
+  run(0 "1 table .*1 built" ${LATTICE} render ${P3} --mode lattice --filter none --lattice-dir ${WORK} -o ${WORK}/a.png)
+  run(0 "1 table .*0 built" ${LATTICE} render ${P3} --mode lattice --filter none --lattice-dir ${WORK} -o ${WORK}/b.png)
   execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/a.png ${WORK}/b.png RESULT_VARIABLE same)
   if(NOT same EQUAL 0)
     message(FATAL_ERROR "the cached table renders a different image")

@@ -44,14 +44,14 @@ if(CASE STREQUAL "render_exact")
 elseif(CASE STREQUAL "render_lattice")
   # The two ranks build the missing table together: the same table, the same image.
   file(MAKE_DIRECTORY ${WORK}/one ${WORK}/two)
-  run(0 "" ${LATTICE} render -q ${P3} --mode lattice --lattice-dir ${WORK}/one -o ${WORK}/one.png)
-  run(0 "1 built" ${MPI2} ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK}/two -o ${WORK}/two.png)
+  run(0 "" ${LATTICE} render -q ${P3} --mode lattice --filter none --lattice-dir ${WORK}/one -o ${WORK}/one.png)
+  run(0 "1 built" ${MPI2} ${LATTICE} render ${P3} --mode lattice --filter none --lattice-dir ${WORK}/two -o ${WORK}/two.png)
   same(${WORK}/one.png ${WORK}/two.png "lattice render")
   file(GLOB one ${WORK}/one/*.lht)
   file(GLOB two ${WORK}/two/*.lht)
   same("${one}" "${two}" "table built while rendering")
   # And with the table already cached: loaded by both ranks, nothing built.
-  run(0 "0 built" ${MPI2} ${LATTICE} render ${P3} --mode lattice --lattice-dir ${WORK}/two -o ${WORK}/again.png)
+  run(0 "0 built" ${MPI2} ${LATTICE} render ${P3} --mode lattice --filter none --lattice-dir ${WORK}/two -o ${WORK}/again.png)
   same(${WORK}/one.png ${WORK}/again.png "lattice render from the cache")
 elseif(CASE STREQUAL "rasterize")
   foreach(encoding hash14 dense candidates)
@@ -92,7 +92,7 @@ elseif(CASE STREQUAL "errors")
   # A table cache that rank 1 does not share with rank 0: it cannot find the table rank 0 built.
   configure_file(${P3} ${WORK}/r0/scene.json COPYONLY)
   configure_file(${P3} ${WORK}/r1/scene.json COPYONLY)
-  string(REPLACE "RENDER" "render;scene.json;--mode;lattice;--lattice-dir;cache;-o;${WORK}/z.png" cmd "${SAME_LINE_TWO_DIRS}")
+  string(REPLACE "RENDER" "render;scene.json;--mode;lattice;--filter;none;--lattice-dir;cache;-o;${WORK}/z.png" cmd "${SAME_LINE_TWO_DIRS}")
   run_timed(2 "[^\n]*cannot open lattice table.*every rank shares.*\\(on rank 1 of 2" 60 ${cmd})
   # Different command lines (MPMD): refused.
   run_timed(2 "the command line differs between rank 0 and rank 1" 30
