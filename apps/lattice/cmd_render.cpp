@@ -53,13 +53,6 @@ struct RenderArgs {
     bool lattice_mode() const { return kModes.at(mode) == RenderMode::kLattice; }
 };
 
-// Whether the encoding of that name (if any) stores coverage.
-bool has_coverage(const std::string& name) {
-    for (const Encoding* e : encodings())
-        if (e->name == name) return e->coverage;
-    return false;
-}
-
 // Wall-clock milestones of a render command, in milliseconds from its start.
 struct Timings {
     double loaded = 0, written = 0;
@@ -262,7 +255,7 @@ Command add_render_command(CLI::App& parent) {
         // A filter needs coverage: unless an encoding was asked for, it takes the one with it;
         // an encoding without coverage asked for alone means its point-sampled table.
         const bool encoding_given = app->get_option("--encoding")->count() > 0;
-        if (encoding_given && app->get_option("--filter")->count() == 0 && !has_coverage(args->spec.encoding))
+        if (encoding_given && app->get_option("--filter")->count() == 0 && !find_encoding(args->spec.encoding).coverage)
             args->filter = "none";
         if (kFilters.at(args->filter) != LatticeFilter::kNone && !encoding_given)
             args->spec.encoding = "coverage";

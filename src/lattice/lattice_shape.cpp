@@ -137,8 +137,8 @@ void LatticeFrame::split_in_halves() {
     const std::size_t axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     Bounds3 low = whole, high = whole;
     low.hi[axis] = high.lo[axis] = whole.lo[axis] + 0.5 * ext[axis];
-    const CullPart& w = cull_.front();
-    cull_ = {{low, 0, 0, w.part_first, w.part_count}, {high, 0, 0, w.part_first, w.part_count}};
+    const std::uint32_t first = cull_.front().part_first, count = cull_.front().part_count;
+    cull_ = {{low, 0, 0, first, count}, {high, 0, 0, first, count}};
 }
 
 bool LatticeFrame::cull_meets(std::size_t i, const Ray& r) const {
