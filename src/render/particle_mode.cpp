@@ -2,7 +2,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -18,6 +17,7 @@
 #include "util/error.h"
 #include "util/interrupt.h"
 #include "util/progress.h"
+#include "util/threads.h"
 
 namespace lat {
 namespace {
@@ -354,7 +354,7 @@ RenderOutput render_particles(const Scene& scene, const ParticleSet& set, const 
     out.stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     out.stats.primary_rays = primary.load();
     out.stats.shadow_rays = shadow.load();
-    out.stats.threads = tbb::this_task_arena::max_concurrency();
+    out.stats.threads = thread_count();
     return out;
 }
 
