@@ -63,6 +63,14 @@ public:
         std::vector<int> all(static_cast<std::size_t>(ranks()));
         transport::allgather(&threads_, sizeof threads_, all.data());
         for (const int t : all) total_threads_ += static_cast<std::uint64_t>(t);
+        // Every rank's first chunk, rank by rank, as rank 0 would deal them: each rank works
+        // out its own, so no rank waits for an answer at the start.
+        for (std::size_t r = 0; r < all.size(); ++r) {
+            const Chunk c = take(static_cast<std::uint64_t>(all[r]));
+            if (static_cast<int>(r) == rank()) push(c);
+            if (r > 0 && c.begin == c.end) ++told_done_;  // it knows: it will not ask
+        }
+        if (!is_root()) next_ = 0;  // only rank 0 deals the rest
     }
 
     DealReport run() {
