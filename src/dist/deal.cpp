@@ -8,7 +8,6 @@
 #include <atomic>
 #include <chrono>
 #include <deque>
-#include <exception>
 #include <mutex>
 
 #include "dist/job.h"
@@ -32,6 +31,7 @@ constexpr std::uint64_t kGuide = 4;
 
 // See Dealer::keep().
 constexpr double kLeadSeconds = 0.004;
+constexpr std::uint64_t kLeadRounds = 8;
 
 DealReport deal_here(std::uint32_t n, const std::function<void(std::uint32_t)>& work,
                      const DealOptions& opt) {
@@ -70,22 +70,14 @@ public:
             if (static_cast<int>(r) == rank()) push(c);
             if (r > 0 && c.begin == c.end) ++told_done_;  // it knows: it will not ask
         }
-        if (!is_root()) next_ = 0;  // only rank 0 deals the rest
     }
 
     DealReport run() {
-        const auto t0 = Clock::now();
-        t0_ = t0;
-        std::exception_ptr error;
-        try {
-            tbb::parallel_for(
-                tbb::blocked_range<int>(0, threads_, 1),
-                [&](const tbb::blocked_range<int>&) { work_here(); }, tbb::simple_partitioner());
-        } catch (...) {
-            error = std::current_exception();
-        }
-        if (error) std::rethrow_exception(error);
-        report_.seconds = seconds_since(t0);
+        t0_ = Clock::now();
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, threads_, 1),
+            [&](const tbb::blocked_range<int>&) { work_here(); }, tbb::simple_partitioner());
+        report_.seconds = seconds_since(t0_);
         // Rank 0 answers the last requests (each told there is nothing left) after its own
         // items: the others may still be finishing theirs.
         if (is_root())
@@ -104,7 +96,7 @@ private:
     const int threads_;
     std::uint64_t total_threads_ = 0;
     Clock::time_point t0_;
-    DealReport report_;  // chunks and items: under talk_
+    DealReport report_;  // chunks and items: written by push()
     std::atomic<std::uint64_t> done_{0};
     std::atomic<double> waited_{0};
 
@@ -117,10 +109,10 @@ private:
 
     // The message lock: only its holder calls MPI, and only it touches what follows.
     std::mutex talk_;
-    std::uint32_t next_ = 0;  // rank 0: items dealt so far
+    std::uint32_t next_ = 0;  // rank 0: items dealt so far (elsewhere: only the first round)
     int told_done_ = 0;       // rank 0: ranks told there is nothing left
     bool asked_ = false;      // other ranks: a request is waiting for its answer
-    std::uint64_t reported_ = 0;
+    std::uint64_t reported_ = 0;  // other ranks: items done, as told to rank 0 so far
 
     // One body per thread: items until none are left, talking between them.
     void work_here() {
@@ -162,6 +154,8 @@ private:
         return true;
     }
 
+    // A dealt chunk into the queue (empty: there will be no more). Callers hold talk_, or are
+    // the constructor: report_ is theirs.
     void push(Chunk c) {
         const std::lock_guard lock(queue_);
         if (c.begin == c.end) {
@@ -187,7 +181,8 @@ private:
         if (is_root()) {
             answer_requests();
             // Its own chunk, taken when the last round of items has started.
-            if (low(static_cast<std::uint64_t>(threads_))) push(take(static_cast<std::uint64_t>(threads_)));
+            const auto threads = static_cast<std::uint64_t>(threads_);
+            if (low(threads)) push(take(threads));
         } else {
             ask();
         }
@@ -219,15 +214,17 @@ private:
         return any;
     }
 
-    // How many items not started an asking rank keeps: two rounds of its threads, and at least
-    // kLeadSeconds of work at its pace so far. Rank 0 answers between two of its own items,
-    // which may cost many times this rank's (a tile of fur against one of sky).
+    // How many items not started an asking rank keeps: two rounds of its threads, and about
+    // kLeadSeconds of work at its pace so far (at most kLeadRounds rounds, lest a rank whose
+    // first items were sky hoard fur). Rank 0 answers only between two of its own items: the
+    // lead covers its items costing up to about kLeadSeconds per thread.
     std::uint64_t keep() const {
         const auto threads = static_cast<std::uint64_t>(threads_);
         const std::uint64_t done = done_.load(std::memory_order_relaxed);
         if (done < threads) return 2 * threads;
         const double per_item = seconds_since(t0_) / static_cast<double>(done);
-        return std::max(2 * threads, static_cast<std::uint64_t>(kLeadSeconds / per_item));
+        const auto lead = static_cast<std::uint64_t>(kLeadSeconds / per_item);
+        return std::clamp(lead, 2 * threads, kLeadRounds * threads);
     }
 
     // Other ranks: takes the answer to the request sent, or sends one when down to keep()

@@ -12,10 +12,9 @@ class ProgressBar;
 namespace lat::dist {
 
 struct DealOptions {
-    // Collective: spread the items over every rank of the job. Rank 0 deals them in chunks
-    // that shrink as the items run out (guided self-scheduling), each rank asking for its next
-    // chunk while it still has two rounds of items left, so that no thread waits for the
-    // network; each rank runs its chunks on all its threads. False (and in a single process):
+    // Collective: spread the items over every rank of the job, in chunks that shrink as the
+    // items run out (guided self-scheduling), dealt by rank 0 and run by each rank on all its
+    // threads (how and why: docs/distributed.md, "Dealing"). False (and in a single process):
     // one oneTBB loop over all items here.
     bool across_ranks = false;
     ProgressBar* progress = nullptr;  // one unit per item; on rank 0 it counts every rank's

@@ -58,13 +58,14 @@ bool start(int& argc, char**& argv) {
     int provided = 0;
     MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided);
     joined = true;
-    if (provided < MPI_THREAD_SERIALIZED) {
-        std::fputs("lattice: error: the MPI library does not let threads call it one at a time "
-                   "(MPI_THREAD_SERIALIZED), which the dealt loops need\n", stderr);
-        MPI_Abort(MPI_COMM_WORLD, 2);
-    }
     MPI_Comm_rank(MPI_COMM_WORLD, &my_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &world_size);
+    if (provided < MPI_THREAD_SERIALIZED) {
+        if (my_rank == 0)
+            std::fputs("lattice: error: the MPI library does not let threads call it one at a "
+                       "time (MPI_THREAD_SERIALIZED), which the dealt loops need\n", stderr);
+        MPI_Abort(MPI_COMM_WORLD, 2);
+    }
     return true;
 }
 

@@ -2,6 +2,7 @@
 
 #include <sys/mman.h>
 
+#include <cstdint>
 #include <new>
 
 namespace lat {
@@ -9,9 +10,12 @@ namespace lat {
 ByteBuffer::ByteBuffer(std::size_t size) : size_(size) {
     if (size == 0) return;
     constexpr std::size_t kHuge = std::size_t{2} << 20;
+    if (size > SIZE_MAX - 2 * kHuge) throw std::bad_alloc();  // the roundings below would wrap
     mapped_ = (size + kHuge - 1) / kHuge * kHuge;
-    // Huge pages need 2 MB-aligned ranges: map 2 MB more, keep the aligned middle.
-    void* p = ::mmap(nullptr, mapped_ + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    // Huge pages need 2 MB-aligned ranges: map 2 MB more, keep the aligned middle (recent
+    // kernels align large anonymous mappings themselves; older ones do not).
+    void* p = ::mmap(nullptr, mapped_ + kHuge, PROT_READ | PROT_WRITE,
+                     MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p == MAP_FAILED) throw std::bad_alloc();
     const auto start = reinterpret_cast<std::uintptr_t>(p);
     const std::uintptr_t aligned = (start + kHuge - 1) / kHuge * kHuge;

@@ -41,6 +41,17 @@ if(CASE STREQUAL "render_exact")
     run(0 "" ${MPI2} ${LATTICE} render -q ${P4} --spp 2 -o ${WORK}/two.${ext})
     same(${WORK}/one.${ext} ${WORK}/two.${ext} "exact render (${ext})")
   endforeach()
+  # 3 ranks x 2 threads: rank 0 deals to two askers; on an image of 3 tiles, fewer than the
+  # job's 6 threads, some ranks' first chunks are empty (they must not be waited for).
+  run(0 "" ${MPIEXEC} -q -n 3 --oversubscribe ${LATTICE} render -q ${P4} --spp 2 --threads 2 -o ${WORK}/three.png)
+  same(${WORK}/one.png ${WORK}/three.png "exact render (3 ranks)")
+  file(READ ${P4} scene)
+  string(JSON scene SET "${scene}" camera width 40)
+  string(JSON scene SET "${scene}" camera height 16)
+  file(WRITE ${WORK}/tiny.json "${scene}")
+  run(0 "" ${LATTICE} render -q ${WORK}/tiny.json -o ${WORK}/tiny-one.png)
+  run(0 "" ${MPIEXEC} -q -n 3 --oversubscribe ${LATTICE} render -q ${WORK}/tiny.json --threads 2 -o ${WORK}/tiny-three.png)
+  same(${WORK}/tiny-one.png ${WORK}/tiny-three.png "exact render of 3 tiles (3 ranks)")
 elseif(CASE STREQUAL "render_lattice")
   # The two ranks build the missing table together: the same table, the same image.
   file(MAKE_DIRECTORY ${WORK}/one ${WORK}/two)
