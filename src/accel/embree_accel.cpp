@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <cstdlib>
 #include <cstddef>
 #include <map>
 #include <stdexcept>
@@ -46,18 +45,6 @@ struct QueryContext {
     std::vector<AccelHit>* partial = nullptr;
     LayerStop stop;
     double transmitted = 1;
-    // intersect_layers: visits of shapes that split them (Shape::start_visit), started in the
-    // traversal and finished together after it (or when the buffer fills), in visit order.
-    struct PendingVisit {
-        std::uint32_t object;
-        unsigned geom, prim, inst;
-        double tmin;
-        Ray local;
-        Shape::Visit visit;
-    };
-    static constexpr unsigned kMaxPending = 8;
-    PendingVisit* pending = nullptr;  // kMaxPending of them, when set
-    unsigned n_pending = 0;
     // A partial crossing met; whether it blocks a shadow ray. For camera rays the crossings are
     // kept in ray order and cut where compositing will stop (LayerStop), and tmax and the
     // traversal's tfar come down to the last one kept.
@@ -146,8 +133,8 @@ void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax);
 
 // Embree's closest-hit traversal; the callbacks record what they find in ctx.
 template <class Context>
-void trace_closest(RTCScene scene, Context& ctx, const Ray& r, double tmin, double tmax,
-                   RTCRayHit& rh) {
+void trace_closest(RTCScene scene, Context& ctx, const Ray& r, double tmin, double tmax) {
+    alignas(16) RTCRayHit rh;
     set_rtc_ray(rh.ray, r, tmin, tmax);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -269,54 +256,21 @@ struct EmbreeAccel::Impl {
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
-        const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
-        auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
-        const unsigned rtc_inst = K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID;
-        if (K == Kind::kDirect && ctx->pending) {
-            QueryContext::PendingVisit& v = ctx->pending[ctx->n_pending];
-            if (shape.start_visit(local, v.visit)) {
-                v.object = t.object, v.geom = args->geomID, v.prim = args->primID;
-                v.inst = rtc_inst, v.tmin = tmin, v.local = local;
-                static const unsigned xn = getenv("LAT_DEFER_N") ? unsigned(atoi(getenv("LAT_DEFER_N"))) : 8;
-                if (++ctx->n_pending == xn) self->finish_visits(ctx, *rh);
-                return;
-            }
-        }
         const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
+        const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
         Crossing c;
         const bool hit = K == Kind::kDirect
                              ? shape.intersect(local, tmin, tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, tmax, c);
-        if (hit) self->accept(ctx, *rh, t.object, c, args->geomID, args->primID, rtc_inst);
-    }
-
-    // A crossing found for the query: partial crossings are kept, and the ray goes on (unless
-    // that blocks a shadow ray); others are the closest so far.
-    void accept(QueryContext* ctx, RTCRayHit& rh, std::uint32_t obj, const Crossing& c,
-                unsigned geom, unsigned prim, unsigned inst) const {
-        if (ctx->partial && c.coverage < 1.0f && !ctx->add_partial({c.t, obj, c}, rh.ray.tfar))
+        if (!hit) return;
+        auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+        // Partial crossings are kept, and the ray goes on (unless that blocks a shadow ray).
+        if (ctx->partial && c.coverage < 1.0f && !ctx->add_partial({c.t, t.object, c}, rh->ray.tfar))
             return;
-        record(ctx, &rh, obj, c, geom, prim, inst);
+        self->record(ctx, rh, t.object, c, args->geomID, args->primID,
+                     K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
         // A blocked shadow ray needs no closer crossing: the traversal ends.
-        if (ctx->stop.blocked_below > 0) rh.ray.tfar = -INFINITY;
-    }
-
-    // Finishes the pending visits in the order they were started, as the callback would have
-    // one by one (the same ranges, the same crossings kept), after starting the fetches of all.
-    void finish_visits(QueryContext* ctx, RTCRayHit& rh) const {
-        const unsigned n = ctx->n_pending;
-        ctx->n_pending = 0;
-        for (unsigned i = 0; i < n; ++i)
-            objects[ctx->pending[i].object].shape->fetch_visit(ctx->pending[i].visit);
-        for (unsigned i = 0; i < n; ++i) {
-            // A blocked shadow ray is answered: the rest cannot unblock it.
-            if (ctx->found && ctx->stop.blocked_below > 0) return;
-            const QueryContext::PendingVisit& v = ctx->pending[i];
-            const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
-            Crossing c;
-            if (objects[v.object].shape->finish_visit(v.local, v.tmin, tmax, v.visit, c))
-                accept(ctx, rh, v.object, c, v.geom, v.prim, v.inst);
-        }
+        if (ctx->stop.blocked_below > 0) rh->ray.tfar = -INFINITY;
     }
 
     template <Kind K>
@@ -459,8 +413,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, hit);
 
-    alignas(16) RTCRayHit rh;
-    if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax, rh);
+    if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax);
 
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
@@ -485,14 +438,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     ctx.self = self;
     ctx.partial = &partial;
     ctx.stop = stop;
-    QueryContext::PendingVisit pending[QueryContext::kMaxPending];
-    static const int xmode = getenv("LAT_DEFER_MODE") ? atoi(getenv("LAT_DEFER_MODE")) : 2;
-    if (xmode == 2 || (xmode == 1 && stop.blocked_below > 0)) ctx.pending = pending;
-    if (traceable) {
-        alignas(16) RTCRayHit rh;
-        trace_closest(m.scene, ctx, r, tmin, tmax, rh);
-        m.finish_visits(&ctx, rh);
-    }
+    if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax);
     const bool blocked = ctx.found && stop.blocked_below > 0;
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;

@@ -174,22 +174,6 @@ public:
     // bounds: a cheap test that saves the shape's own.
     virtual bool cull_meets(std::size_t, const Ray&) const { return true; }
 
-    // A visit split in two, for shapes whose answer waits on memory (prefiltered lattices
-    // whose tables are hundreds of MB): start_visit does the ray's arithmetic and starts
-    // fetching what the answer reads, fetch_visit starts the fetches that depend on the first
-    // ones, and finish_visit answers exactly as intersect would. A traversal starts every
-    // visit of a ray before finishing any, so that their cache misses overlap instead of
-    // following one another. start_visit false: the shape does not split (use intersect).
-    static constexpr std::size_t kVisitBytes = 512;
-    struct alignas(16) Visit {
-        unsigned char bytes[kVisitBytes];
-    };
-    virtual bool start_visit(const Ray&, Visit&) const { return false; }
-    virtual void fetch_visit(const Visit&) const {}
-    virtual bool finish_visit(const Ray&, double, double, const Visit&, Crossing&) const {
-        return false;
-    }
-
     // CSG trees carry a material tag per leaf; other shapes answer with the fallback.
     virtual std::uint32_t tag(const Crossing&, std::uint32_t fallback) const { return fallback; }
 };

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <type_traits>
 
 namespace lat {
 namespace {
@@ -122,31 +121,6 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
 
 bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
                                  Crossing& hit) const {
-    PendingSheet p;
-    begin_sheet(r, normal, p);
-    return end_sheet(r, tmin, tmax, p, hit);
-}
-
-bool FilteredLatticeShape::start_visit(const Ray& r, Visit& v) const {
-    static_assert(sizeof(PendingSheet) <= sizeof(Visit::bytes) &&
-                  alignof(PendingSheet) <= alignof(Visit) &&
-                  std::is_trivially_destructible_v<PendingSheet>);
-    begin_sheet(r, !t_footprint.coverage_only, *new (v.bytes) PendingSheet);
-    return true;
-}
-
-void FilteredLatticeShape::fetch_visit(const Visit& v) const {
-    const PendingSheet& p = pending(v);
-    for (std::size_t i = 0; i < p.levels; ++i)
-        levels_[p.first + i].table->prefetch_coverage_records(p.b[i].ia, p.b[i].ib, p.b[i].n);
-}
-
-bool FilteredLatticeShape::finish_visit(const Ray& r, double tmin, double tmax, const Visit& v,
-                                        Crossing& hit) const {
-    return end_sheet(r, tmin, tmax, pending(v), hit);
-}
-
-void FilteredLatticeShape::begin_sheet(const Ray& r, bool normal, PendingSheet& p) const {
     // The level whose cell is the footprint wide, at the box's centre along the ray.
     const double dd = dot(r.d, r.d);
     const RayFootprint& fp = t_footprint;
@@ -162,24 +136,14 @@ void FilteredLatticeShape::begin_sheet(const Ray& r, bool normal, PendingSheet& 
     const double w_hi = lod_blend(level - double(lo), smooth ? kLodBlendBand : 1.0);
     // The levels of weight above 0: their pairs are found first and their lookups started
     // together, so that the cache misses of the two tables overlap.
-    p.first = w_hi < 1 ? lo : lo + 1;
-    p.levels = (w_hi > 0 ? lo + 1 : lo) + 1 - p.first;
-    p.narrower = std::max(0.0, wanted - level);
-    p.normal = normal;
-    for (std::size_t i = 0; i < p.levels; ++i) {
-        const std::size_t l = p.first + i;
-        blend(levels_[l], r, l == lo ? 1 - w_hi : w_hi, smooth, p.b[i]);
-        levels_[l].table->prefetch_coverage(p.b[i].ia, p.b[i].ib, p.b[i].n);
+    const std::size_t first = w_hi < 1 ? lo : lo + 1, last = w_hi > 0 ? lo + 1 : lo;
+    Blend b[2];
+    for (std::size_t i = first; i <= last; ++i) {
+        blend(levels_[i], r, i == lo ? 1 - w_hi : w_hi, smooth, b[i - first]);
+        levels_[i].table->prefetch_coverage(b[i - first].ia, b[i - first].ib, b[i - first].n);
     }
-}
-
-bool FilteredLatticeShape::end_sheet(const Ray& r, double tmin, double tmax,
-                                     const PendingSheet& pend, Crossing& hit) const {
-    const bool normal = pend.normal;
     Sheet s;
-    for (std::size_t i = 0; i < pend.levels; ++i)
-        add_blend(levels_[pend.first + i], pend.b[i], normal, s);
-    const double dd = dot(r.d, r.d);
+    for (std::size_t i = first; i <= last; ++i) add_blend(levels_[i], b[i - first], normal, s);
     if (s.alpha <= 1e-6) return false;
     const Vec3 p = s.p / s.alpha;
     const double t = dot(p - r.o, r.d) / dd;
@@ -200,8 +164,8 @@ bool FilteredLatticeShape::end_sheet(const Ray& r, double tmin, double tmax,
     // 1 - length, goes as the width squared (unscaled, scaled, without normal filtering:
     // Plate 2, thistles, 36.3, 39.6, 39.6 dB; Plate 3, a hair close up, 42.2, 43.1, 43.1 dB;
     // Plates 4 and 5 need no scaling).
-    // pend.narrower: in levels, each half as wide.
-    const double len = 1 - (1 - std::min(1.0, ln / s.alpha)) * std::exp2(-2 * pend.narrower);
+    const double narrower = std::max(0.0, wanted - level);  // in levels, each half as wide
+    const double len = 1 - (1 - std::min(1.0, ln / s.alpha)) * std::exp2(-2 * narrower);
     hit = Crossing(t, 0, SurfacePoint{p, ln > 0 ? s.n / ln * len : -r.d / std::sqrt(dd)});
     hit.coverage = coverage;
     return true;

@@ -11,7 +11,6 @@
 // As a CSG leaf, for `inside` and for spans, the lattice is point-sampled through the finest
 // level's own hits, exactly as without filtering.
 #include <memory>
-#include <new>
 #include <string_view>
 #include <vector>
 
@@ -85,12 +84,6 @@ public:
         return levels_.front().frame.cull_meets(i, r);
     }
     double surface_tolerance() const override { return 2.0 * levels_.front().frame.cell(); }
-    // intersect in two steps (Shape::start_visit): the levels and pairs, with their rank lines
-    // fetched; their records fetched; the lookups and the sheet.
-    bool start_visit(const Ray& r, Visit& v) const override;
-    void fetch_visit(const Visit& v) const override;
-    bool finish_visit(const Ray& r, double tmin, double tmax, const Visit& v,
-                      Crossing& hit) const override;
 
 private:
     struct Level {
@@ -124,21 +117,8 @@ private:
     LatticeFilter filter_;
     HitTableShape point_;  // the finest level, point-sampled
 
-    // A sheet between its two steps: the pairs of the one or two levels it blends.
-    struct PendingSheet {
-        Blend b[2];
-        std::size_t first = 0, levels = 0;  // levels_[first], ... levels_[first + levels - 1]
-        double narrower = 0;  // how many levels finer than the finest the footprint asks for
-        bool normal = true;
-    };
-    // intersect, with or without the sheet's normal: begin_sheet then end_sheet.
+    // intersect, with or without the sheet's normal.
     bool sheet(const Ray& r, double tmin, double tmax, bool normal, Crossing& hit) const;
-    void begin_sheet(const Ray& r, bool normal, PendingSheet& p) const;
-    bool end_sheet(const Ray& r, double tmin, double tmax, const PendingSheet& p,
-                   Crossing& hit) const;
-    static const PendingSheet& pending(const Visit& v) {
-        return *std::launder(reinterpret_cast<const PendingSheet*>(v.bytes));
-    }
     void blend(const Level& l, const Ray& r, double weight, bool smooth, Blend& b) const;
     // Looks the blend's pairs up and adds them to the sheet.
     void add_blend(const Level& l, const Blend& b, bool normals, Sheet& s) const;

@@ -132,9 +132,6 @@ public:
     // A hint that coverage_many will soon be asked for these pairs: the table may start
     // fetching what locates them, so that the lookups of several tables overlap.
     virtual void prefetch_coverage(const std::uint32_t*, const std::uint32_t*, int) const {}
-    // The second step, once what prefetch_coverage fetched has had time to arrive: the table
-    // may start fetching the pairs' records themselves.
-    virtual void prefetch_coverage_records(const std::uint32_t*, const std::uint32_t*, int) const {}
 
     virtual std::string encoding() const = 0;
     // Encoding-specific facts for `lattice inspect` (widths, counts), one line; may be empty.

@@ -136,13 +136,11 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
     points_ = h.points;
     occupied_ = h.occupied;
     const std::uint64_t nlines = (s.nwords + RankLine::kWords - 1) / RankLine::kWords;
-    lines_buf_ = ByteBuffer(nlines * sizeof(RankLine));
-    auto* lines = reinterpret_cast<RankLine*>(lines_buf_.data());
-    lines_ = lines;
+    lines_ = std::make_unique<RankLine[]>(nlines);
     size_ += nlines * sizeof(RankLine);
     std::uint64_t below = 0;
     for (std::uint64_t w = 0; w < s.nwords; ++w) {
-        RankLine& l = lines[w / RankLine::kWords];
+        RankLine& l = lines_[w / RankLine::kWords];
         if (w % RankLine::kWords == 0) l.base = below;
         l.bits[w % RankLine::kWords] = occ[w];
         below += static_cast<std::uint64_t>(std::popcount(occ[w]));
@@ -214,15 +212,6 @@ void CoverageTable::prefetch_coverage(const std::uint32_t* a, const std::uint32_
     for (int i = 0; i < n; ++i) {
         const std::uint64_t idx = pair_index(a[i], b[i]);
         if (idx != ~0ull) __builtin_prefetch(line_of(idx));
-    }
-}
-
-void CoverageTable::prefetch_coverage_records(const std::uint32_t* a, const std::uint32_t* b,
-                                              int n) const {
-    for (int i = 0; i < n; ++i) {
-        const std::uint64_t idx = pair_index(a[i], b[i]);
-        const std::uint8_t* r = idx != ~0ull ? record_at(idx) : nullptr;
-        if (r) __builtin_prefetch(r);
     }
 }
 

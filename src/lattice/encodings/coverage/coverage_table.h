@@ -28,8 +28,6 @@ public:
     void coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n, CoverageHit* out,
                        bool* found, bool normals) const override;
     void prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const override;
-    void prefetch_coverage_records(const std::uint32_t* a, const std::uint32_t* b,
-                                   int n) const override;
     std::string encoding() const override { return "coverage"; }
     std::string details() const override;
     std::uint64_t entries() const override { return entries_; }
@@ -53,10 +51,7 @@ private:
     static_assert(sizeof(RankLine) == 64);
     std::uint32_t points_ = 0;
     std::uint64_t occupied_ = 0;
-    // In huge pages (ByteBuffer): lookups land at random over tens of MB of lines, and with
-    // 4 kB pages each would also miss the TLB.
-    ByteBuffer lines_buf_;
-    const RankLine* lines_ = nullptr;
+    std::unique_ptr<RankLine[]> lines_;
     const std::uint8_t* records_ = nullptr;
     std::uint64_t entries_;
     std::size_t size_;  // the payload's and the rank lines'
