@@ -120,8 +120,9 @@ private:
     // intersect, with or without the sheet's normal.
     bool sheet(const Ray& r, double tmin, double tmax, bool normal, Crossing& hit) const;
     void blend(const Level& l, const Ray& r, double weight, bool smooth, Blend& b) const;
-    // Looks the blend's pairs up and adds them to the sheet.
-    void add_blend(const Level& l, const Blend& b, bool normals, Sheet& s) const;
+    // Looks the blend's pairs up and adds those that r meets after tmin to the sheet.
+    void add_blend(const Level& l, const Blend& b, bool normals, const Ray& r, double tmin,
+                   Sheet& s) const;
 };
 
 }  // namespace lat
