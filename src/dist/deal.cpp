@@ -7,11 +7,9 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <deque>
 #include <exception>
 #include <mutex>
-#include <thread>
 
 #include "dist/job.h"
 #include "dist/timeline.h"
@@ -32,77 +30,8 @@ double seconds_since(Clock::time_point t) {
 // left divided by kGuide: big chunks first (few messages), small ones last (even finish).
 constexpr std::uint64_t kGuide = 4;
 
-// The items dealt to this rank and not started yet. Its threads take them one by one; the main
-// thread (which alone talks to the other ranks) refills it when it runs low.
-class ChunkQueue {
-public:
-    explicit ChunkQueue(std::uint64_t low) : low_(low) {}
-
-    void push(Chunk c) {
-        const std::lock_guard lock(m_);
-        chunks_.push_back(c);
-        queued_ += c.end - c.begin;
-        work_.notify_all();
-    }
-    // No more chunks will come (or a thread failed): waiting threads return.
-    void close() {
-        const std::lock_guard lock(m_);
-        closed_ = true;
-        work_.notify_all();
-        main_.notify_one();
-    }
-    // The next item, waiting for one to be dealt; false when there will be none.
-    bool pop(std::uint32_t& item, double& waited) {
-        std::unique_lock lock(m_);
-        if (queued_ == 0 && !closed_) {
-            const auto t0 = Clock::now();
-            work_.wait(lock, [&] { return queued_ > 0 || closed_; });
-            waited += seconds_since(t0);
-        }
-        if (queued_ == 0 || failed_) return false;
-        Chunk& c = chunks_.front();
-        item = c.begin++;
-        if (c.begin == c.end) chunks_.pop_front();
-        if (--queued_ <= low_) main_.notify_one();
-        return true;
-    }
-    void fail() {
-        const std::lock_guard lock(m_);
-        failed_ = true;
-        chunks_.clear();
-        queued_ = 0;
-        closed_ = true;
-        work_.notify_all();
-    }
-    // The threads are done: wakes the main thread.
-    void finish() {
-        const std::lock_guard lock(m_);
-        finished_ = true;
-        main_.notify_one();
-    }
-    bool low() {
-        const std::lock_guard lock(m_);
-        return !closed_ && queued_ <= low_;
-    }
-    bool finished() {
-        const std::lock_guard lock(m_);
-        return finished_;
-    }
-    // The main thread sleeps until the queue runs low, the threads finish, or `ns` pass.
-    void wait(long ns) {
-        std::unique_lock lock(m_);
-        main_.wait_for(lock, std::chrono::nanoseconds(ns),
-                       [&] { return finished_ || (!closed_ && queued_ <= low_); });
-    }
-
-private:
-    std::mutex m_;
-    std::condition_variable work_, main_;
-    std::deque<Chunk> chunks_;
-    std::uint64_t queued_ = 0;
-    const std::uint64_t low_;
-    bool closed_ = false, failed_ = false, finished_ = false;
-};
+// See Dealer::keep().
+constexpr double kLeadSeconds = 0.004;
 
 DealReport deal_here(std::uint32_t n, const std::function<void(std::uint32_t)>& work,
                      const DealOptions& opt) {
@@ -121,32 +50,49 @@ DealReport deal_here(std::uint32_t n, const std::function<void(std::uint32_t)>& 
     return report;
 }
 
-// One rank's part in a dealt loop: its threads work through a ChunkQueue while the main thread
-// deals (rank 0) or asks for chunks (the others).
+// One rank's part in a dealt loop. Its threads take items from a queue of dealt chunks; between
+// two items, whichever thread gets the message lock talks to the other ranks (MPI_THREAD_
+// SERIALIZED): rank 0 answers requests and refills its own queue, the others ask for their
+// next chunk. So no thread wakes up only to poll: on a node whose cores all render, a polling
+// thread would take its core from a renderer a thousand times a second.
 class Dealer {
 public:
     Dealer(std::uint32_t n, const std::function<void(std::uint32_t)>& work, const DealOptions& opt)
-        : n_(n), work_(work), opt_(opt), threads_(thread_count()),
-          queue_(2 * static_cast<std::uint64_t>(threads_)) {
+        : n_(n), work_(work), opt_(opt), threads_(thread_count()) {
         report_.threads = threads_;
         std::vector<int> all(static_cast<std::size_t>(ranks()));
         transport::allgather(&threads_, sizeof threads_, all.data());
         for (const int t : all) total_threads_ += static_cast<std::uint64_t>(t);
+        // Every rank's first chunk, rank by rank, as rank 0 would deal them: each rank works
+        // out its own, so no rank waits for an answer at the start.
+        for (std::size_t r = 0; r < all.size(); ++r) {
+            const Chunk c = take(static_cast<std::uint64_t>(all[r]));
+            if (static_cast<int>(r) == rank()) push(c);
+            if (r > 0 && c.begin == c.end) ++told_done_;  // it knows: it will not ask
+        }
+        if (!is_root()) next_ = 0;  // only rank 0 deals the rest
     }
 
     DealReport run() {
         const auto t0 = Clock::now();
-        std::thread workers([&] { work_here(); });
+        t0_ = t0;
+        std::exception_ptr error;
         try {
-            if (is_root()) deal(); else ask();
+            tbb::parallel_for(
+                tbb::blocked_range<int>(0, threads_, 1),
+                [&](const tbb::blocked_range<int>&) { work_here(); }, tbb::simple_partitioner());
         } catch (...) {
-            queue_.fail();
-            workers.join();
-            throw;
+            error = std::current_exception();
         }
-        workers.join();
-        if (error_) std::rethrow_exception(error_);
+        if (error) std::rethrow_exception(error);
         report_.seconds = seconds_since(t0);
+        // Rank 0 answers the last requests (each told there is nothing left) after its own
+        // items: the others may still be finishing theirs.
+        if (is_root())
+            for (int idle = 0; told_done_ < ranks() - 1; ++idle) {
+                if (answer_requests()) idle = 0;
+                transport::idle_wait(idle);
+            }
         report_.wait_seconds = waited_.load();
         return std::move(report_);
     }
@@ -157,38 +103,94 @@ private:
     const DealOptions& opt_;
     const int threads_;
     std::uint64_t total_threads_ = 0;
-    ChunkQueue queue_;
-    DealReport report_;
+    Clock::time_point t0_;
+    DealReport report_;  // chunks and items: under talk_
     std::atomic<std::uint64_t> done_{0};
     std::atomic<double> waited_{0};
-    std::exception_ptr error_;
-    std::uint32_t next_ = 0;  // rank 0: items dealt so far
 
-    // On this rank's threads (a oneTBB loop with one body per thread, each taking items).
+    // The queue of items dealt here and not started (under queue_).
+    std::mutex queue_;
+    std::deque<Chunk> chunks_;
+    std::uint64_t queued_ = 0;
+    bool closed_ = false;  // no more chunks will come
+    std::atomic<bool> failed_{false};
+
+    // The message lock: only its holder calls MPI, and only it touches what follows.
+    std::mutex talk_;
+    std::uint32_t next_ = 0;  // rank 0: items dealt so far
+    int told_done_ = 0;       // rank 0: ranks told there is nothing left
+    bool asked_ = false;      // other ranks: a request is waiting for its answer
+    std::uint64_t reported_ = 0;
+
+    // One body per thread: items until none are left, talking between them.
     void work_here() {
+        double waited = 0;
         try {
-            tbb::parallel_for(
-                tbb::blocked_range<int>(0, threads_, 1),
-                [&](const tbb::blocked_range<int>&) {
-                    double waited = 0;
-                    std::uint32_t i = 0;
-                    try {
-                        while (queue_.pop(i, waited)) {
-                            work_(i);
-                            done_.fetch_add(1, std::memory_order_relaxed);
-                            if (opt_.progress && is_root()) opt_.progress->add(1);
-                        }
-                    } catch (...) {
-                        queue_.fail();  // the other threads stop too, instead of waiting
-                        throw;
-                    }
-                    waited_.fetch_add(waited);
-                },
-                tbb::simple_partitioner());
+            for (int idle = 0;;) {
+                talk();
+                std::uint32_t i = 0;
+                bool closed = false;
+                if (pop(i, closed)) {
+                    work_(i);
+                    done_.fetch_add(1, std::memory_order_relaxed);
+                    if (opt_.progress && is_root()) opt_.progress->add(1);
+                    idle = 0;
+                    continue;
+                }
+                if (closed || failed_) break;
+                // Nothing here yet: a chunk is on its way (another thread may hold the lock).
+                const auto w0 = Clock::now();
+                transport::idle_wait(idle++);
+                waited += seconds_since(w0);
+            }
         } catch (...) {
-            error_ = std::current_exception();
+            failed_ = true;  // the other threads stop too, instead of waiting
+            waited_.fetch_add(waited);
+            throw;
         }
-        queue_.finish();
+        waited_.fetch_add(waited);
+    }
+
+    bool pop(std::uint32_t& item, bool& closed) {
+        const std::lock_guard lock(queue_);
+        closed = closed_;
+        if (queued_ == 0 || failed_) return false;
+        Chunk& c = chunks_.front();
+        item = c.begin++;
+        if (c.begin == c.end) chunks_.pop_front();
+        --queued_;
+        return true;
+    }
+
+    void push(Chunk c) {
+        const std::lock_guard lock(queue_);
+        if (c.begin == c.end) {
+            closed_ = true;  // the dealer has no items left
+            return;
+        }
+        report_.chunks.push_back(c);
+        report_.items += c.end - c.begin;
+        chunks_.push_back(c);
+        queued_ += c.end - c.begin;
+    }
+
+    // Whether this rank holds at most `keep` items not started (and more may come).
+    bool low(std::uint64_t keep) {
+        const std::lock_guard lock(queue_);
+        return !closed_ && queued_ <= keep;
+    }
+
+    // One round of messages, by whichever thread gets the lock first; the others go on working.
+    void talk() {
+        std::unique_lock lock(talk_, std::try_to_lock);
+        if (!lock.owns_lock()) return;
+        if (is_root()) {
+            answer_requests();
+            // Its own chunk, taken when the last round of items has started.
+            if (low(static_cast<std::uint64_t>(threads_))) push(take(static_cast<std::uint64_t>(threads_)));
+        } else {
+            ask();
+        }
     }
 
     Chunk take(std::uint64_t threads) {
@@ -200,73 +202,51 @@ private:
         return c;
     }
 
-    // Rank 0: answers every request, and keeps its own queue filled, until every rank has been
-    // told there is nothing left and its own threads are done.
-    void deal() {
-        int told_done = 0;
-        bool closed = false;
-        for (int idle = 0;; ++idle) {
-            int from = 0;
-            while (transport::poll(transport::kDealRequest, from)) {
-                std::uint32_t request[2];  // the asker's threads, items done since it last asked
-                transport::receive(from, transport::kDealRequest, request, sizeof request);
-                if (opt_.progress) opt_.progress->add(request[1]);
-                const Chunk c = take(request[0]);
-                const std::uint32_t reply[2] = {c.begin, c.end};
-                transport::send(from, transport::kDealReply, reply, sizeof reply);
-                if (c.begin == c.end) ++told_done;
-                idle = 0;
-            }
-            if (!closed && queue_.low()) {
-                const Chunk c = take(static_cast<std::uint64_t>(threads_));
-                if (c.begin == c.end) {
-                    queue_.close();
-                    closed = true;
-                } else {
-                    queue_.push(c);
-                    report_.chunks.push_back(c);
-                    report_.items += c.end - c.begin;
-                }
-                idle = 0;
-            }
-            if (queue_.finished() && (error_ || (closed && told_done == ranks() - 1))) return;
-            queue_.wait(transport::idle_pause_ns(idle));
+    // Rank 0: answers every request waiting; whether there was one.
+    bool answer_requests() {
+        bool any = false;
+        int from = 0;
+        while (transport::poll(transport::kDealRequest, from)) {
+            std::uint32_t request[2];  // the asker's threads, items done since it last asked
+            transport::receive(from, transport::kDealRequest, request, sizeof request);
+            if (opt_.progress) opt_.progress->add(request[1]);
+            const Chunk c = take(request[0]);
+            const std::uint32_t reply[2] = {c.begin, c.end};
+            transport::send(from, transport::kDealReply, reply, sizeof reply);
+            if (c.begin == c.end) ++told_done_;
+            any = true;
         }
+        return any;
     }
 
-    // Other ranks: one request at a time, sent while the queue still holds two rounds of items
-    // (rank 0 may take up to a millisecond to answer).
+    // How many items not started an asking rank keeps: two rounds of its threads, and at least
+    // kLeadSeconds of work at its pace so far. Rank 0 answers between two of its own items,
+    // which may cost many times this rank's (a tile of fur against one of sky).
+    std::uint64_t keep() const {
+        const auto threads = static_cast<std::uint64_t>(threads_);
+        const std::uint64_t done = done_.load(std::memory_order_relaxed);
+        if (done < threads) return 2 * threads;
+        const double per_item = seconds_since(t0_) / static_cast<double>(done);
+        return std::max(2 * threads, static_cast<std::uint64_t>(kLeadSeconds / per_item));
+    }
+
+    // Other ranks: takes the answer to the request sent, or sends one when down to keep()
+    // items (one request at a time).
     void ask() {
-        bool asked = false, closed = false;
-        std::uint64_t reported = 0;
-        for (int idle = 0;; ++idle) {
-            int from = 0;
-            if (asked && transport::poll(transport::kDealReply, from)) {
-                std::uint32_t reply[2];
-                transport::receive(0, transport::kDealReply, reply, sizeof reply);
-                asked = false;
-                idle = 0;
-                if (reply[0] == reply[1]) {
-                    queue_.close();
-                    closed = true;
-                } else {
-                    queue_.push({reply[0], reply[1]});
-                    report_.chunks.push_back({reply[0], reply[1]});
-                    report_.items += reply[1] - reply[0];
-                }
-            }
-            if (!asked && !closed && queue_.low()) {
-                const std::uint64_t done = done_.load();
-                const std::uint32_t request[2] = {static_cast<std::uint32_t>(threads_),
-                                                  static_cast<std::uint32_t>(done - reported)};
-                reported = done;
-                transport::send(0, transport::kDealRequest, request, sizeof request);
-                asked = true;
-                idle = 0;
-            }
-            if (queue_.finished()) return;
-            if (asked) transport::idle_wait(idle);
-            else queue_.wait(10'000'000);
+        int from = 0;
+        if (asked_ && transport::poll(transport::kDealReply, from)) {
+            std::uint32_t reply[2];
+            transport::receive(0, transport::kDealReply, reply, sizeof reply);
+            asked_ = false;
+            push({reply[0], reply[1]});
+        }
+        if (!asked_ && low(keep())) {
+            const std::uint64_t done = done_.load();
+            const std::uint32_t request[2] = {static_cast<std::uint32_t>(threads_),
+                                              static_cast<std::uint32_t>(done - reported_)};
+            reported_ = done;
+            transport::send(0, transport::kDealRequest, request, sizeof request);
+            asked_ = true;
         }
     }
 };

@@ -1,10 +1,12 @@
-// MPI (the build found it): compiled instead of transport_local.cpp. Only the main thread calls
-// MPI (MPI_THREAD_FUNNELED): the dealer's worker threads never do.
+// MPI (the build found it): compiled instead of transport_local.cpp. One thread at a time calls
+// MPI (MPI_THREAD_SERIALIZED): the main thread, or in a dealt loop the worker that holds the
+// dealer's message lock.
 #include <mpi.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <ctime>
 
@@ -54,8 +56,13 @@ void in_pieces(std::size_t bytes, Start&& start) {
 bool start(int& argc, char**& argv) {
     if (!launched_by_process_manager()) return false;
     int provided = 0;
-    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+    MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided);
     joined = true;
+    if (provided < MPI_THREAD_SERIALIZED) {
+        std::fputs("lattice: error: the MPI library does not let threads call it one at a time "
+                   "(MPI_THREAD_SERIALIZED), which the dealt loops need\n", stderr);
+        MPI_Abort(MPI_COMM_WORLD, 2);
+    }
     MPI_Comm_rank(MPI_COMM_WORLD, &my_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &world_size);
     return true;

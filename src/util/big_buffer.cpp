@@ -10,10 +10,16 @@ ByteBuffer::ByteBuffer(std::size_t size) : size_(size) {
     if (size == 0) return;
     constexpr std::size_t kHuge = std::size_t{2} << 20;
     mapped_ = (size + kHuge - 1) / kHuge * kHuge;
-    void* p = ::mmap(nullptr, mapped_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    // Huge pages need 2 MB-aligned ranges: map 2 MB more, keep the aligned middle.
+    void* p = ::mmap(nullptr, mapped_ + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p == MAP_FAILED) throw std::bad_alloc();
-    ::madvise(p, mapped_, MADV_HUGEPAGE);  // a hint; fine if refused
-    data_ = static_cast<std::uint8_t*>(p);
+    const auto start = reinterpret_cast<std::uintptr_t>(p);
+    const std::uintptr_t aligned = (start + kHuge - 1) / kHuge * kHuge;
+    if (aligned > start) ::munmap(p, aligned - start);
+    if (const std::uintptr_t end = start + mapped_ + kHuge; end > aligned + mapped_)
+        ::munmap(reinterpret_cast<void*>(aligned + mapped_), end - aligned - mapped_);
+    data_ = reinterpret_cast<std::uint8_t*>(aligned);
+    ::madvise(data_, mapped_, MADV_HUGEPAGE);  // a hint; fine if refused
 }
 
 ByteBuffer::~ByteBuffer() {
