@@ -40,7 +40,7 @@ const RayFootprint& ray_footprint();
 // filter's linear blend, then matches a pixel's box best (Plate 4 at 512^2: 0.7, 0.85, 1.0 and
 // 1.2 gave 35.9, 36.0, 35.8 and 34.9 dB against the 256-spp exact image, with shadow rays
 // that missed the hairs they started in). Retuned once those were fixed, on six fur scenes
-// (docs/filtering.md): 0.78 against 0.85, +0.0 to +0.3 dB on each; 0.7 lost 0.3 dB on one.
+// (docs/filtering.md): 0.78 against 0.85, -0.01 to +0.25 dB on each; 0.7 lost 0.3 dB on one.
 inline constexpr double kCellPerFootprint = 0.78;
 // The level (real; 0 is the lattice of cell cell0, each next one halves it) for a footprint of
 // this width, in the same units.
