@@ -2,7 +2,9 @@
 """Lattice table encodings, measured through the `lattice` command itself: for the Plate 3 hair
 at sigma^-1 = 1, 2, 4 and every encoding, build time and bytes (rasterize --stats) and the
 certified error (inspect --json); then Plates 4 and 5 rendered in lattice mode with each
-encoding (sigma^-1 = 1, 2 threads): render time, peak memory and PSNR against exact mode.
+encoding, point-sampled (sigma^-1 = 1, --filter none, 2 threads), and with the coverage encoding
+also smoothed (the default filter, levels of detail on): render time, peak memory and PSNR against
+exact mode.
 Writes bench/results/encodings.json and prints a Markdown summary."""
 import json
 import os
@@ -54,16 +56,20 @@ def main():
         e = json.load(open(stats))
         results["renders"].append({"plate": plate, "mode": "exact", "render_ms": e["render_ms"],
                                    "peak_memory_bytes": e["peak_memory_bytes"], "psnr_db": None})
-        for enc in encodings():
-            img = os.path.join(work, f"{plate}-{enc}.png")
-            run("render", "-q", scene, "-o", img, "--threads", "2", "--mode", "lattice",
-                "--encoding", enc, "--lattice-dir", work, "--stats", stats)  # builds the table
-            run("render", "-q", scene, "-o", img, "--threads", "2", "--mode", "lattice",
-                "--encoding", enc, "--lattice-dir", work, "--stats", stats)  # timed: cached
+        # Every encoding point-sampled (--filter none: with the coverage encoding the default
+        # filter would be smooth, with its levels of detail), then coverage with the default
+        # filter (smooth, levels sigma^-1 = 2 and 4 at these plates' distance) as its own row.
+        for enc, filt, label in [(e, "none", e) for e in encodings()] + [
+                ("coverage", "smooth", "coverage smooth")]:
+            img = os.path.join(work, f"{plate}-{enc}-{filt}.png")
+            args = ["render", "-q", scene, "-o", img, "--threads", "2", "--mode", "lattice",
+                    "--encoding", enc, "--filter", filt, "--lattice-dir", work, "--stats", stats]
+            run(*args)  # builds the table
+            run(*args)  # timed: cached
             l = json.load(open(stats))
             cmp = json.loads(run("compare", exact, img, "--json"))
             results["renders"].append({
-                "plate": plate, "mode": "lattice", "encoding": enc, "render_ms": l["render_ms"],
+                "plate": plate, "mode": "lattice", "encoding": label, "render_ms": l["render_ms"],
                 "peak_memory_bytes": l["peak_memory_bytes"], "table_bytes": l["table_bytes"],
                 "psnr_db": cmp["psnr_db"], "share_over_8": cmp["share_over_threshold"]})
     json.dump(results, open(os.path.join(OUT, "encodings.json"), "w"), indent=2)

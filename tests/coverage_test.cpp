@@ -206,6 +206,41 @@ TEST(Coverage, ShadowRaysGetTheSameSheetsWithoutNormals) {
     EXPECT_GT(hits, 100);
 }
 
+// A ray that starts inside the box (a shadow ray leaving a surface among fur) between two
+// crossings of the primitive, one behind it and one ahead: its pairs' first crossings lie
+// behind it, and the sheet is made of their last crossings (the reversed pairs), so that the
+// primitive still blocks it. Before, the sheet lay behind the start and the ray went through.
+TEST(Coverage, ARayStartingBetweenTwoCrossingsIsStillBlocked) {
+    const Encoding& e = find_encoding("coverage");
+    const RasterizeResult r = rasterize(kContext);
+    const ByteBuffer payload = e.build(r.raw, kContext, {});
+    std::shared_ptr<const LatticeTable> table = e.open(payload.data(), payload.size(), r.hits, kContext);
+    const FilteredLatticeShape shape({{table, kContext}}, LatticeFilter::kSmooth,
+                                     e.error_bound(kContext, {}));
+    std::mt19937_64 rng(11);
+    const Bounds3 box = shape.bounds();
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    set_ray_footprint({0, 0, true});
+    int between = 0, blocked = 0;
+    for (int i = 0; i < 200000 && between < 300; ++i) {
+        const Vec3 o = box.lo + Vec3{u(rng), u(rng), u(rng)} * (box.hi - box.lo);
+        const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+        Crossing ahead, behind;
+        // Clear of the primitive on both sides by half a cell.
+        if (hook().inside(o) || !hook().intersect({o, d}, 0.5 * kContext.cell, kInfinity, ahead) ||
+            !hook().intersect({o, -d}, 0.5 * kContext.cell, kInfinity, behind) ||
+            hook().intersect({o, d}, 0.0, 0.5 * kContext.cell, ahead) ||
+            hook().intersect({o, -d}, 0.0, 0.5 * kContext.cell, behind))
+            continue;
+        ++between;
+        Crossing c;
+        blocked += shape.intersect({o, d}, 1e-9, kInfinity, c) && c.t > 0 && c.coverage >= 0.5f;
+    }
+    set_ray_footprint({});
+    ASSERT_GE(between, 100);
+    EXPECT_GT(double(blocked) / between, 0.8) << blocked << " of " << between;
+}
+
 // A hair of radius 0.15 in cells of 1, across the view, 2.3 pixels a cell.
 const char* kThinHair = R"({
   "camera": {"eye": [3, -60, 4], "look_at": [3, 0, 4], "up": [0, 0, 1], "fov_y_deg": 10, "width": 96, "height": 96},

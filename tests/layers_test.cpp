@@ -1,7 +1,8 @@
 // Tracing through partial hits (issue 10, render/layers.h): EmbreeAccel::intersect_layers finds
 // the partial crossings in ray order, each object's once, stops where compositing stops without
 // changing what it composites, and sums shadow rays' transmittance; and the shading of a mean
-// of normals (phong_term's normal_length) keeps the light the specular lobe reflects.
+// of normals (phong_term's normal_length) keeps the light the specular lobe reflects and takes
+// the mean of the clamped diffuse terms.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -151,11 +152,38 @@ TEST(Layers, AMeanNormalWidensTheSpecularLobeKeepingItsLight) {
     const Vec3 n{0, 0, 1};
     EXPECT_LT(phong_term(m, {1, 1, 1}, n, n, n, {1, 1, 1}, 0.99).x,
               phong_term(m, {1, 1, 1}, n, n, n, {1, 1, 1}, 1.0).x);
-    // The diffuse term is linear in the normal: the mean of the normals' terms.
-    m.ks = 0;
-    const Vec3 l = normalize(Vec3{1, 0, 2});
-    EXPECT_NEAR(phong_term(m, {1, 1, 1}, n, l, n, {1, 1, 1}, 0.8).x,
-                0.8 * phong_term(m, {1, 1, 1}, n, l, n, {1, 1, 1}, 1.0).x, 1e-15);
+}
+
+// The diffuse term of a mean normal is the mean of clamped terms (diffuse_mean): for a normal
+// n.l of the stated mean and variance, by numerical integration; at length 1 the plain term.
+TEST(Layers, TheDiffuseTermOfAMeanNormalIsTheMeanOfClampedTerms) {
+    for (const double len : {0.0, 0.3, 0.7, 0.95})
+        for (const double nl : {-0.9, -0.3, 0.0, 0.4, 1.0}) {
+            const double mean = len * nl, sd = std::sqrt((1 - len * len) / 3);
+            double sum = 0, w = 0;
+            for (int i = -4000; i <= 4000; ++i) {
+                const double z = i / 500.0, g = std::exp(-0.5 * z * z);
+                sum += g * std::max(0.0, mean + sd * z), w += g;
+            }
+            EXPECT_NEAR(diffuse_mean(nl, len), sum / w, 1e-6) << len << " " << nl;
+            EXPECT_GE(diffuse_mean(nl, len), std::max(0.0, mean));
+        }
+    EXPECT_EQ(diffuse_mean(0.4, 1.0), 0.4);
+    EXPECT_EQ(diffuse_mean(-0.4, 1.0), 0.0);
+    // Unit normals spread evenly over the half of a cylinder that faces the viewer, lit from
+    // the side: their mean clamped term is closer to diffuse_mean of their mean normal than to
+    // the clamped term of that mean.
+    const Vec3 l = normalize(Vec3{1, 0, 0.3});
+    Vec3 mean_n;
+    double truth = 0;
+    const int k = 2000;
+    for (int i = 0; i < k; ++i) {
+        const double a = M_PI * ((i + 0.5) / k - 0.5);
+        const Vec3 ni{std::sin(a), -std::cos(a), 0};
+        mean_n += ni / k, truth += std::max(0.0, dot(ni, l)) / k;
+    }
+    const double len = length(mean_n), nl = dot(mean_n / len, l);
+    EXPECT_LT(std::abs(diffuse_mean(nl, len) - truth), std::abs(len * std::max(0.0, nl) - truth));
 }
 
 }  // namespace

@@ -107,12 +107,36 @@ void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bo
     }
 }
 
-void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, bool normals, Sheet& s) const {
+void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, bool normals, const Ray& r,
+                                     double tmin, Sheet& s) const {
     CoverageHit h[Blend::kMaxPairs];
     bool found[Blend::kMaxPairs];
     l.table->coverage_many(b.ia, b.ib, b.n, h, found, normals);
-    for (int i = 0; i < b.n; ++i)
-        if (found[i]) s.add(b.w[i], h[i], lerp(to_vec(b.ca[i]), to_vec(b.cb[i]), h[i].t) * l.frame.cell());
+    // A pair answers with its first crossing; a ray that starts inside the box (a shadow ray
+    // leaving a surface among the fur) can have that crossing behind it, and the pair then
+    // answers with its last crossing, the first one of the reversed pair (as point-sampled
+    // lattices do, HitTableShape::line_hits): a hair whose line through the box is crossed
+    // behind and ahead of the ray's start still blocks it.
+    Blend back;
+    const double dd = dot(r.d, r.d);
+    for (int i = 0; i < b.n; ++i) {
+        if (!found[i]) continue;
+        const Vec3 p = lerp(to_vec(b.ca[i]), to_vec(b.cb[i]), h[i].t) * l.frame.cell();
+        if (dot(p - r.o, r.d) / dd > tmin) {
+            s.add(b.w[i], h[i], p);
+        } else {
+            back.ia[back.n] = b.ib[i], back.ib[back.n] = b.ia[i];
+            back.ca[back.n] = b.cb[i], back.cb[back.n] = b.ca[i], back.w[back.n] = b.w[i];
+            ++back.n;
+        }
+    }
+    if (back.n == 0) return;
+    l.table->coverage_many(back.ia, back.ib, back.n, h, found, normals);
+    for (int i = 0; i < back.n; ++i) {
+        if (!found[i]) continue;
+        const Vec3 p = lerp(to_vec(back.ca[i]), to_vec(back.cb[i]), h[i].t) * l.frame.cell();
+        if (dot(p - r.o, r.d) / dd > tmin) s.add(back.w[i], h[i], p);
+    }
 }
 
 bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
@@ -143,7 +167,7 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
         levels_[i].table->prefetch_coverage(b[i - first].ia, b[i - first].ib, b[i - first].n);
     }
     Sheet s;
-    for (std::size_t i = first; i <= last; ++i) add_blend(levels_[i], b[i - first], normal, s);
+    for (std::size_t i = first; i <= last; ++i) add_blend(levels_[i], b[i - first], normal, r, tmin, s);
     if (s.alpha <= 1e-6) return false;
     const Vec3 p = s.p / s.alpha;
     const double t = dot(p - r.o, r.d) / dd;

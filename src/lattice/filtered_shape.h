@@ -38,8 +38,10 @@ const RayFootprint& ray_footprint();
 
 // A level's cell is made this many footprints wide: the box over a cell, widened by the smooth
 // filter's linear blend, then matches a pixel's box best (Plate 4 at 512^2: 0.7, 0.85, 1.0 and
-// 1.2 gave 35.9, 36.0, 35.8 and 34.9 dB against the 256-spp exact image).
-inline constexpr double kCellPerFootprint = 0.85;
+// 1.2 gave 35.9, 36.0, 35.8 and 34.9 dB against the 256-spp exact image, with shadow rays
+// that missed the hairs they started in). Retuned once those were fixed, on six fur scenes
+// (docs/filtering.md): 0.78 against 0.85, -0.01 to +0.25 dB on each; 0.7 lost 0.3 dB on one.
+inline constexpr double kCellPerFootprint = 0.78;
 // The level (real; 0 is the lattice of cell cell0, each next one halves it) for a footprint of
 // this width, in the same units.
 double lod_level(double cell0, double width);
@@ -120,8 +122,9 @@ private:
     // intersect, with or without the sheet's normal.
     bool sheet(const Ray& r, double tmin, double tmax, bool normal, Crossing& hit) const;
     void blend(const Level& l, const Ray& r, double weight, bool smooth, Blend& b) const;
-    // Looks the blend's pairs up and adds them to the sheet.
-    void add_blend(const Level& l, const Blend& b, bool normals, Sheet& s) const;
+    // Looks the blend's pairs up and adds those that r meets after tmin to the sheet.
+    void add_blend(const Level& l, const Blend& b, bool normals, const Ray& r, double tmin,
+                   Sheet& s) const;
 };
 
 }  // namespace lat
