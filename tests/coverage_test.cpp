@@ -172,15 +172,30 @@ TEST(Coverage, ManyLookupsFindExactlyTheStoredPairs) {
     EXPECT_GT(found_pairs, 100);
 }
 
+// The hook's coverage table behind the smooth filter, with the bytes the table reads.
+struct SmoothHook {
+    RasterizeResult rasterized;
+    ByteBuffer payload;
+    std::unique_ptr<FilteredLatticeShape> shape;
+};
+
+SmoothHook smooth_hook() {
+    const Encoding& e = find_encoding("coverage");
+    SmoothHook h{rasterize(kContext), {}, nullptr};
+    h.payload = e.build(h.rasterized.raw, kContext, {});
+    std::shared_ptr<const LatticeTable> table =
+        e.open(h.payload.data(), h.payload.size(), h.rasterized.hits, kContext);
+    h.shape = std::make_unique<FilteredLatticeShape>(std::vector<FilterLevel>{{table, kContext}},
+                                                     LatticeFilter::kSmooth,
+                                                     e.error_bound(kContext, {}));
+    return h;
+}
+
 // Shadow rays ask for the coverage alone (RayFootprint::coverage_only): the same sheets, where
 // they lie and how much they cover, as for camera rays.
 TEST(Coverage, ShadowRaysGetTheSameSheetsWithoutNormals) {
-    const Encoding& e = find_encoding("coverage");
-    const RasterizeResult r = rasterize(kContext);
-    const ByteBuffer payload = e.build(r.raw, kContext, {});
-    std::shared_ptr<const LatticeTable> table = e.open(payload.data(), payload.size(), r.hits, kContext);
-    const FilteredLatticeShape shape({{table, kContext}}, LatticeFilter::kSmooth,
-                                     e.error_bound(kContext, {}));
+    const SmoothHook hook_lattice = smooth_hook();
+    const FilteredLatticeShape& shape = *hook_lattice.shape;
     std::mt19937_64 rng(7);
     const Bounds3 box = shape.bounds();
     std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -211,12 +226,8 @@ TEST(Coverage, ShadowRaysGetTheSameSheetsWithoutNormals) {
 // behind it, and the sheet is made of their last crossings (the reversed pairs), so that the
 // primitive still blocks it. Before, the sheet lay behind the start and the ray went through.
 TEST(Coverage, ARayStartingBetweenTwoCrossingsIsStillBlocked) {
-    const Encoding& e = find_encoding("coverage");
-    const RasterizeResult r = rasterize(kContext);
-    const ByteBuffer payload = e.build(r.raw, kContext, {});
-    std::shared_ptr<const LatticeTable> table = e.open(payload.data(), payload.size(), r.hits, kContext);
-    const FilteredLatticeShape shape({{table, kContext}}, LatticeFilter::kSmooth,
-                                     e.error_bound(kContext, {}));
+    const SmoothHook hook_lattice = smooth_hook();
+    const FilteredLatticeShape& shape = *hook_lattice.shape;
     std::mt19937_64 rng(11);
     const Bounds3 box = shape.bounds();
     std::uniform_real_distribution<double> u(0.0, 1.0);
