@@ -255,7 +255,8 @@ Command add_render_command(CLI::App& parent) {
         // A filter needs coverage: unless an encoding was asked for, it takes the one with it;
         // an encoding without coverage asked for alone means its point-sampled table.
         const bool encoding_given = app->get_option("--encoding")->count() > 0;
-        if (encoding_given && app->get_option("--filter")->count() == 0 && !find_encoding(args->spec.encoding).coverage)
+        const bool filter_given = app->get_option("--filter")->count() > 0;
+        if (encoding_given && !filter_given && !find_encoding(args->spec.encoding).coverage)
             args->filter = "none";
         if (kFilters.at(args->filter) != LatticeFilter::kNone && !encoding_given)
             args->spec.encoding = "coverage";

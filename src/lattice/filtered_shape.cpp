@@ -117,26 +117,25 @@ void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, bool normal
     // answers with its last crossing, the first one of the reversed pair (as point-sampled
     // lattices do, HitTableShape::line_hits): a hair whose line through the box is crossed
     // behind and ahead of the ray's start still blocks it.
-    Blend back;
     const double dd = dot(r.d, r.d);
+    // Adds pair i of `bl` (looked up as h) if r meets its crossing after tmin.
+    auto add_if_ahead = [&](const Blend& bl, int i, const CoverageHit& hi) {
+        const Vec3 p = lerp(to_vec(bl.ca[i]), to_vec(bl.cb[i]), hi.t) * l.frame.cell();
+        if (dot(p - r.o, r.d) / dd <= tmin) return false;
+        s.add(bl.w[i], hi, p);
+        return true;
+    };
+    Blend back;
     for (int i = 0; i < b.n; ++i) {
-        if (!found[i]) continue;
-        const Vec3 p = lerp(to_vec(b.ca[i]), to_vec(b.cb[i]), h[i].t) * l.frame.cell();
-        if (dot(p - r.o, r.d) / dd > tmin) {
-            s.add(b.w[i], h[i], p);
-        } else {
-            back.ia[back.n] = b.ib[i], back.ib[back.n] = b.ia[i];
-            back.ca[back.n] = b.cb[i], back.cb[back.n] = b.ca[i], back.w[back.n] = b.w[i];
-            ++back.n;
-        }
+        if (!found[i] || add_if_ahead(b, i, h[i])) continue;
+        back.ia[back.n] = b.ib[i], back.ib[back.n] = b.ia[i];
+        back.ca[back.n] = b.cb[i], back.cb[back.n] = b.ca[i], back.w[back.n] = b.w[i];
+        ++back.n;
     }
     if (back.n == 0) return;
     l.table->coverage_many(back.ia, back.ib, back.n, h, found, normals);
-    for (int i = 0; i < back.n; ++i) {
-        if (!found[i]) continue;
-        const Vec3 p = lerp(to_vec(back.ca[i]), to_vec(back.cb[i]), h[i].t) * l.frame.cell();
-        if (dot(p - r.o, r.d) / dd > tmin) s.add(back.w[i], h[i], p);
-    }
+    for (int i = 0; i < back.n; ++i)
+        if (found[i]) add_if_ahead(back, i, h[i]);
 }
 
 bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
