@@ -3,9 +3,11 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -14,9 +16,17 @@
 namespace lat {
 namespace {
 
+// std::nextafter(f, INFINITY), without libm's call (every shadow ray takes one).
+float next_up(float f) {
+    if (!(f < INFINITY)) return f;  // +infinity, NaN
+    if (f == 0) return std::numeric_limits<float>::denorm_min();
+    const auto bits = std::bit_cast<std::uint32_t>(f);
+    return std::bit_cast<float>(f > 0 ? bits + 1 : bits - 1);  // toward +infinity
+}
+
 float float_above(double t) {
     const auto f = static_cast<float>(t);
-    return static_cast<double>(f) > t ? f : std::nextafter(f, INFINITY);
+    return static_cast<double>(f) > t ? f : next_up(f);
 }
 
 // Partial crossings in ray order, ties by object: the same for any traversal order.
@@ -27,8 +37,9 @@ bool in_ray_order(const AccelHit& a, const AccelHit& b) {
 // Per-query state. Embree hands our callbacks the RTCIntersectContext; ours extends it with
 // the double-precision ray and the best hit so far (the documented way to pass query data).
 struct QueryContext {
-    QueryContext(const EmbreeAccel::Impl& m, const Ray& r, double t0, double t1, AccelHit& h)
-        : accel(&m), ray(r), tmin(t0), tmax(t1), hit(&h) {
+    // h: where the closest hit goes; null for occlusion, which needs none.
+    QueryContext(const EmbreeAccel::Impl& m, const Ray& r, double t0, double t1, AccelHit* h)
+        : accel(&m), ray(r), tmin(t0), tmax(t1), hit(h) {
         rtcInitIntersectContext(&rtc);
     }
 
@@ -411,7 +422,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
     const bool traceable = embree_can_trace(r, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
-    QueryContext ctx(m, r, tmin, tmax, hit);
+    QueryContext ctx(m, r, tmin, tmax, &hit);
 
     if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax);
 
@@ -434,7 +445,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     const bool traceable = embree_can_trace(r, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
-    QueryContext ctx(m, r, tmin, tmax, hit);
+    QueryContext ctx(m, r, tmin, tmax, &hit);
     ctx.self = self;
     ctx.partial = &partial;
     ctx.stop = stop;
@@ -466,8 +477,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     const bool traceable = embree_can_trace(r, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
-    AccelHit unused;
-    QueryContext ctx(m, r, tmin, tmax, unused);
+    QueryContext ctx(m, r, tmin, tmax, nullptr);
     ctx.self = self;
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];

@@ -26,6 +26,13 @@ bool HalfSpaceShape::intersect(const Ray& r, double tmin, double tmax, Crossing&
     return true;
 }
 
+bool HalfSpaceShape::occluded(const Ray& r, double tmin, double tmax) const {
+    const double dn = dot(r.d, n_);
+    if (dn == 0.0) return false;
+    const double t = dot(p_ - r.o, n_) / dn;
+    return t > tmin && t < tmax;
+}
+
 void HalfSpaceShape::spans(const Ray& r, SpanList& out) const {
     const double dn = dot(r.d, n_);
     const double g0 = dot(r.o - p_, n_);

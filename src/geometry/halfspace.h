@@ -10,6 +10,8 @@ public:
 
     Bounds3 bounds() const override;
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
+    // A floor is tested outside the accelerator by every shadow ray: no Crossing to fill.
+    bool occluded(const Ray& r, double tmin, double tmax) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray&, const Crossing&) const override { return n_; }
     bool inside(Vec3 x) const override { return dot(x - p_, n_) <= 0.0; }
