@@ -41,12 +41,18 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
       point_(levels.back().table, levels.back().ctx,
              levels.back().ctx.cell * kSnapReach + table_error) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
+    // One level's frame culls: the coarsest level's reach would keep every ray its filter
+    // reaches, but the next level's, half as far, keeps nearly all of its coverage (the tent's
+    // weight falls to 0 at its support's edge; 8.5e-6 of it lost in
+    // Coverage.CullingAtTheFinerLevelKeepsNearlyAllTheCoverage) and costs far less: with the
+    // coarsest level's, every ray met its fatter boxes, though most rays read finer levels.
+    // Smooth, 1 spp: Plates 4 and 5 render 16 % and 20 % faster, the furry bunny and grass
+    // 32 % and 40 %, with the same PSNR against exact ground truth to 0.02 dB.
+    cull_level_ = std::min<std::size_t>(1, levels.size() - 1);
     for (std::size_t i = 0; i < levels.size(); ++i) {
         const FilterLevel& l = levels[i];
-        // Only the coarsest level's frame culls (its reach is the largest). The finer levels'
-        // own reach, tested before snapping (their cull capsules), rejected a quarter of Plate
-        // 4's visits but cost as many instructions as it saved: no faster.
-        const double reach = i == 0 ? reach_cells(filter) * l.ctx.cell + table_error : kInfinity;
+        const double reach =
+            i == cull_level_ ? reach_cells(filter) * l.ctx.cell + table_error : kInfinity;
         levels_.push_back({l.table, LatticeFrame(l.ctx, reach), BoundaryGrid(l.ctx.cells)});
     }
 }

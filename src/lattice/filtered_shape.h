@@ -77,13 +77,13 @@ public:
     // The mean of unit normals: of length 1 or less (see intersect).
     Vec3 normal(const Ray&, const Crossing& c) const override { return c.stored.n; }
     bool inside(Vec3 p) const override { return point_.inside(p); }
-    // Culled by the coarsest level's frame, whose reach is the largest.
-    std::size_t cull_count() const override { return levels_.front().frame.cull_count(); }
+    // Culled by the frame of level cull_level_ (see the constructor).
+    std::size_t cull_count() const override { return cull_frame().cull_count(); }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf) const override {
-        return levels_.front().frame.cull_bounds(i, xf);
+        return cull_frame().cull_bounds(i, xf);
     }
     bool cull_meets(std::size_t i, const Ray& r) const override {
-        return levels_.front().frame.cull_meets(i, r);
+        return cull_frame().cull_meets(i, r);
     }
     double surface_tolerance() const override { return 2.0 * levels_.front().frame.cell(); }
 
@@ -116,9 +116,11 @@ private:
         }
     };
     std::vector<Level> levels_;
+    std::size_t cull_level_ = 0;
     LatticeFilter filter_;
     HitTableShape point_;  // the finest level, point-sampled
 
+    const LatticeFrame& cull_frame() const { return levels_[cull_level_].frame; }
     // intersect, with or without the sheet's normal.
     bool sheet(const Ray& r, double tmin, double tmax, bool normal, Crossing& hit) const;
     void blend(const Level& l, const Ray& r, double weight, bool smooth, Blend& b) const;
