@@ -230,6 +230,7 @@ struct EmbreeAccel::Impl {
 
     void record(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Crossing& c,
                 unsigned geom, unsigned prim, unsigned inst) const {
+        assert(ctx->hit);  // closest-hit queries only (occlusion queries have none)
         ctx->found = true;
         *ctx->hit = {c.t, obj, c};
         rh->ray.tfar = float_above(c.t);
@@ -267,6 +268,7 @@ struct EmbreeAccel::Impl {
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
+        assert(ctx->hit);  // rtcIntersect1 runs only for intersect and intersect_layers
         const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
         const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
         Crossing c;

@@ -17,19 +17,20 @@ Bounds3 HalfSpaceShape::bounds() const {
     return b;
 }
 
-bool HalfSpaceShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+double HalfSpaceShape::crossing_t(const Ray& r) const {
     const double dn = dot(r.d, n_);
-    if (dn == 0.0) return false;
-    const double t = dot(p_ - r.o, n_) / dn;
-    if (!(t > tmin && t < tmax)) return false;
+    return dn == 0.0 ? std::nan("") : dot(p_ - r.o, n_) / dn;
+}
+
+bool HalfSpaceShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    const double t = crossing_t(r);
+    if (!(t > tmin && t < tmax)) return false;  // also NaN: parallel
     hit = {t, 0, 0};
     return true;
 }
 
 bool HalfSpaceShape::occluded(const Ray& r, double tmin, double tmax) const {
-    const double dn = dot(r.d, n_);
-    if (dn == 0.0) return false;
-    const double t = dot(p_ - r.o, n_) / dn;
+    const double t = crossing_t(r);
     return t > tmin && t < tmax;
 }
 

@@ -18,6 +18,8 @@ public:
 
 private:
     Vec3 p_, n_;
+    // The parameter where the ray's line crosses the plane; NaN when it runs parallel.
+    double crossing_t(const Ray& r) const;
 };
 
 }  // namespace lat
