@@ -10,13 +10,15 @@ const Encoding kCoverageEncoding{
     .name = "coverage",
     .summary = "prefiltered: per ordered pair its hit and its coverage (share of the rays "
                "snapping to it that meet the primitive, their mean hit), for --filter",
-    // Ordered pairs are indexed densely: N^2 occupancy bits, 512 MB at this many points.
+    // Slots hold 16-bit point coordinates (pair_index.h); ordered pairs filed in tiles by face
+    // pair take about as many occupancy bits as N^2 (pairs_eq2 and the tiles' padding).
     .max_points = 0xFFFFull,
     // While building: the rasterized hit (20 bytes), about 1.5 coverage samples of 20 bytes, and
     // the record (14 bytes), per stored hit.
     .bytes_per_hit = 64.0,
     .needs_hits = true,
     .coverage = true,
+    .layout = 2,  // 2: pairs filed by face pair in tiles (pair_index.h); 1: a * N + b
     .build = &CoverageTable::build,
     .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                const TableContext& ctx) -> std::unique_ptr<LatticeTable> {

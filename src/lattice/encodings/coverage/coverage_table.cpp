@@ -12,7 +12,10 @@
 namespace lat {
 namespace {
 
-constexpr std::uint64_t kMagic = 0x3152'4556'4F43ull;  // "COVER1"
+constexpr std::uint64_t kMagic = 0x3252'4556'4F43ull;  // "COVER2"
+// The layout before (pairs indexed a * N + b, with a rank directory): refused with a word on
+// what to do (the table cache never meets one: Encoding::layout is in its file names).
+constexpr std::uint64_t kOldMagic = 0x3152'4556'4F43ull;  // "COVER1"
 constexpr std::size_t kRecordBytes = CoverageTable::kRecordBytes;
 constexpr double kTScale = 65534.0;
 constexpr double kAlphaScale = 65535.0;
@@ -22,22 +25,23 @@ struct Header {
     std::uint32_t points, rays;  // boundary points; sub-rays per pair
     std::uint64_t occupied;      // records
     std::uint64_t center_hits;   // records whose own segment hits (the table's entries)
-    std::uint64_t reserved[4];
+    std::uint64_t slots;         // PairIndex::slots() of the lattice
+    std::uint64_t reserved[3];
 };
 static_assert(sizeof(Header) == 64);
 
 std::uint64_t padded8(std::uint64_t bytes) { return (bytes + 7) / 8 * 8; }
 
+// The payload: the header, an occupancy bit per slot, the records in slot order.
 struct Sections {
-    std::uint64_t nwords, occ, counts, records, total;
+    std::uint64_t nwords, occ, records, total;
 };
 
-Sections sections(std::uint64_t points, std::uint64_t occupied) {
+Sections sections(std::uint64_t slots, std::uint64_t occupied) {
     Sections s{};
-    s.nwords = words_for_bits(points * points);
+    s.nwords = words_for_bits(slots);
     s.occ = sizeof(Header);
-    s.counts = s.occ + s.nwords * 8;
-    s.records = s.counts + padded8(RankIndex::count_entries(s.nwords) * 4);
+    s.records = s.occ + s.nwords * 8;
     s.total = s.records + padded8(occupied * kRecordBytes);
     return s;
 }
@@ -88,13 +92,19 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
         e->f[kMeanNu] = c.nu, e->f[kMeanNv] = c.nv;
         e->f[kAlpha] = static_cast<std::uint16_t>(std::lround(double(c.alpha) * kAlphaScale));
     }
-    std::inplace_merge(entries.begin(), entries.begin() + static_cast<std::ptrdiff_t>(centers),
-                       entries.end(), [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
+    // Filed by slot; a stored pair is a valid one (rasterizing skips the others).
+    const PairIndex index(ctx.cells);
+    for (Entry& e : entries) {
+        e.pair = index.slot(static_cast<std::uint32_t>(e.pair / n), static_cast<std::uint32_t>(e.pair % n));
+        if (e.pair == PairIndex::kNone) throw std::logic_error("coverage: a stored pair is not valid");
+    }
+    std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
 
-    const Sections s = sections(n, entries.size());
+    const Sections s = sections(index.slots(), entries.size());
     ByteBuffer out(s.total);
     std::memset(out.data(), 0, s.total);
-    const Header h{kMagic, static_cast<std::uint32_t>(n), kCoverageRays, entries.size(), centers, {}};
+    const Header h{kMagic, static_cast<std::uint32_t>(n), kCoverageRays, entries.size(), centers,
+                   index.slots(), {}};
     std::memcpy(out.data(), &h, sizeof h);
     auto* occ = reinterpret_cast<std::uint64_t*>(out.data() + s.occ);
     std::uint8_t* rec = out.data() + s.records;
@@ -103,48 +113,41 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
         std::memcpy(rec, e.f.data(), kRecordBytes);
         rec += kRecordBytes;
     }
-    RankIndex::build(occ, s.nwords, reinterpret_cast<std::uint32_t*>(out.data() + s.counts));
     return out;
 }
 
 CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                              const TableContext& ctx)
-    : entries_(entries), size_(size) {
+    : index_(ctx.cells), entries_(entries), size_(size) {
     auto fail = [](const char* why) {
         throw std::runtime_error(std::string("coverage payload: ") + why);
     };
     if (size < sizeof(Header)) fail("shorter than its header");
     Header h;
     std::memcpy(&h, payload, sizeof h);
+    if (h.magic == kOldMagic) fail("an older layout (COVER1); rebuild the table");
     if (h.magic != kMagic) fail("bad tag");
-    const BoundaryGrid grid(ctx.cells);
-    if (h.points != grid.count()) fail("boundary point count differs from the lattice's");
+    if (h.points != index_.grid().count()) fail("boundary point count differs from the lattice's");
+    if (h.slots != index_.slots()) fail("slot count differs from the lattice's");
     if (h.rays != kCoverageRays) fail("sampled with a different number of sub-rays");
     if (h.center_hits != entries || h.occupied < entries || h.occupied > (std::uint64_t{1} << 40))
         fail("record counts inconsistent with the header");
-    const Sections s = sections(h.points, h.occupied);
+    const Sections s = sections(h.slots, h.occupied);
     if (s.total != size) fail("size does not match its counts");
     const auto* occ = reinterpret_cast<const std::uint64_t*>(payload + s.occ);
-    const auto* counts = reinterpret_cast<const std::uint32_t*>(payload + s.counts);
-    if (!RankIndex::valid(occ, s.nwords, counts)) fail("rank directory does not match");
-    if (counts[(s.nwords + RankIndex::kBlockWords - 1) / RankIndex::kBlockWords] != h.occupied)
+    build_lines(occ);
+    if (lines_[s.nwords / PairIndex::kTileWords].base != h.occupied)
         fail("occupancy does not match the record count");
-    // Pairs beyond N^2 in the last word would index records of no pair.
-    if (h.points && (static_cast<std::uint64_t>(h.points) * h.points) % 64 &&
-        (occ[s.nwords - 1] >> ((static_cast<std::uint64_t>(h.points) * h.points) % 64)))
-        fail("occupancy bits past the last pair");
-    points_ = h.points;
-    occupied_ = h.occupied;
-    const std::uint64_t nlines = (s.nwords + RankLine::kWords - 1) / RankLine::kWords;
-    lines_ = std::make_unique<RankLine[]>(nlines);
-    size_ += nlines * sizeof(RankLine);
-    std::uint64_t below = 0;
+    // A set bit where no pair is filed would be a record no lookup reaches.
     for (std::uint64_t w = 0; w < s.nwords; ++w) {
-        RankLine& l = lines_[w / RankLine::kWords];
-        if (w % RankLine::kWords == 0) l.base = below;
-        l.bits[w % RankLine::kWords] = occ[w];
-        below += static_cast<std::uint64_t>(std::popcount(occ[w]));
+        if (!occ[w] || (w % PairIndex::kTileWords == 0 && index_.plain_tile(w / PairIndex::kTileWords)))
+            continue;
+        std::uint32_t a = 0, b = 0;
+        for (std::uint64_t bits = occ[w]; bits; bits &= bits - 1)
+            if (!index_.pair_at(w * 64 + static_cast<unsigned>(std::countr_zero(bits)), a, b))
+                fail("occupancy bits where no pair is filed");
     }
+    occupied_ = h.occupied;
     records_ = payload + s.records;
     std::uint64_t centers = 0;
     for (std::uint64_t i = 0; i < occupied_; ++i) {
@@ -159,9 +162,25 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
     if (centers != entries) fail("hit count does not match the header");
 }
 
+// One line per tile and a last one past them, whose base is the count of all set bits.
+void CoverageTable::build_lines(const std::uint64_t* occ) {
+    const std::uint64_t tiles = index_.slots() / PairIndex::kTileSlots;
+    lines_ = std::make_unique<RankLine[]>(tiles + 1);
+    size_ += (tiles + 1) * sizeof(RankLine);
+    std::uint64_t below = 0;
+    for (std::uint64_t t = 0; t <= tiles; ++t) {
+        RankLine& l = lines_[t];
+        l.base = below;
+        for (int k = 0; k < PairIndex::kTileWords; ++k) {
+            l.bits[k] = t < tiles ? occ[t * PairIndex::kTileWords + static_cast<std::uint64_t>(k)] : 0;
+            below += static_cast<std::uint64_t>(std::popcount(l.bits[k]));
+        }
+    }
+}
+
 const std::uint8_t* CoverageTable::record(std::uint32_t a, std::uint32_t b) const {
-    const std::uint64_t i = pair_index(a, b);
-    return i == ~0ull ? nullptr : record_at(i);
+    const std::uint64_t i = index_.slot(a, b);
+    return i == PairIndex::kNone ? nullptr : record_at(i);
 }
 
 bool CoverageTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
@@ -195,10 +214,12 @@ void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b
     const std::uint8_t* rec[kMax];
     for (int base = 0; base < n; base += kMax) {
         const int m = std::min(kMax, n - base);
-        for (int i = 0; i < m; ++i) idx[i] = pair_index(a[base + i], b[base + i]);
-        prefetch_coverage(a + base, b + base, m);
         for (int i = 0; i < m; ++i) {
-            rec[i] = idx[i] != ~0ull ? record_at(idx[i]) : nullptr;
+            idx[i] = index_.slot(a[base + i], b[base + i]);
+            if (idx[i] != PairIndex::kNone) __builtin_prefetch(line_of(idx[i]));
+        }
+        for (int i = 0; i < m; ++i) {
+            rec[i] = idx[i] != PairIndex::kNone ? record_at(idx[i]) : nullptr;
             if (rec[i]) __builtin_prefetch(rec[i]);
         }
         for (int i = 0; i < m; ++i) {
@@ -210,8 +231,8 @@ void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b
 
 void CoverageTable::prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const {
     for (int i = 0; i < n; ++i) {
-        const std::uint64_t idx = pair_index(a[i], b[i]);
-        if (idx != ~0ull) __builtin_prefetch(line_of(idx));
+        const std::uint64_t idx = index_.slot(a[i], b[i]);
+        if (idx != PairIndex::kNone) __builtin_prefetch(line_of(idx));
     }
 }
 

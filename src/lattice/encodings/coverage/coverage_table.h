@@ -3,16 +3,16 @@
 // hit of the pair's own segment, as every table does (lookup: what point sampling, CSG, inside
 // tests and certification use), and the pair's coverage (lattice/coverage.h): the share of the
 // sub-rays snapping to the pair that meet the primitive and their mean hit, which filtered
-// rendering uses. Pairs are indexed densely, a * N + b for N boundary points, by occupancy bits
-// and a rank directory (read through rank lines built at open); a record is seven 16-bit fields
-// (alpha in 1/65535).
+// rendering uses. Pairs are filed in slots where neighbours in ray space are neighbours in
+// memory (pair_index.h), with occupancy bits read through rank lines built at open, and records
+// in slot order; a record is seven 16-bit fields (alpha in 1/65535).
 #include <bit>
 #include <cstdint>
 #include <memory>
 
 #include "lattice/bits/bit_array.h"
-#include "lattice/boundary_grid.h"
 #include "lattice/encoding.h"
+#include "lattice/encodings/coverage/pair_index.h"
 #include "lattice/table.h"
 
 namespace lat {
@@ -39,17 +39,16 @@ public:
     static constexpr std::uint16_t kNoHit = 0xFFFF;  // kT of a pair whose own segment misses
 
 private:
-    // The occupancy bits as rendering reads them: a cache line holds the rank of its first bit
-    // and the 448 bits that follow, so that finding a pair's record takes one line besides the
-    // record (the file's occupancy words and rank directory, apart, took two: each a cache miss
-    // in tables of hundreds of MB). Built from the file's (checked) ones at open.
+    // The occupancy bits as rendering reads them: a cache line holds the rank of a tile's
+    // first slot and the tile's 256 bits, so that finding a pair's record takes one line
+    // besides the record, and a blend's pairs, in one or two tiles, one or two lines. Built
+    // from the file's (checked) occupancy words at open.
     struct alignas(64) RankLine {
-        static constexpr std::uint64_t kWords = 7, kBits = kWords * 64;
-        std::uint64_t base;  // set bits before this line's first
-        std::uint64_t bits[kWords];
+        std::uint64_t base;  // set bits before this tile's first
+        std::uint64_t bits[PairIndex::kTileWords];
     };
     static_assert(sizeof(RankLine) == 64);
-    std::uint32_t points_ = 0;
+    PairIndex index_;
     std::uint64_t occupied_ = 0;
     std::unique_ptr<RankLine[]> lines_;
     const std::uint8_t* records_ = nullptr;
@@ -59,11 +58,12 @@ private:
     std::uint64_t partial_ = 0;
     double alpha_sum_ = 0;
 
+    void build_lines(const std::uint64_t* occ);
     const std::uint8_t* record(std::uint32_t a, std::uint32_t b) const;
-    // The record of dense pair index i (below points_^2), or null when the pair is not stored.
-    const std::uint8_t* record_at(std::uint64_t i) const {
-        const RankLine& l = lines_[i / RankLine::kBits];
-        const auto off = static_cast<unsigned>(i % RankLine::kBits);
+    // The record of slot s (below index_.slots()), or null when the pair is not stored.
+    const std::uint8_t* record_at(std::uint64_t s) const {
+        const RankLine& l = lines_[s / PairIndex::kTileSlots];
+        const auto off = static_cast<unsigned>(s % PairIndex::kTileSlots);
         const unsigned w = off >> 6, bit = off & 63;
         const std::uint64_t word = l.bits[w];
         if (!((word >> bit) & 1)) return nullptr;
@@ -72,11 +72,7 @@ private:
         for (unsigned k = 0; k < w; ++k) r += static_cast<std::uint64_t>(std::popcount(l.bits[k]));
         return records_ + r * kRecordBytes;
     }
-    const RankLine* line_of(std::uint64_t i) const { return &lines_[i / RankLine::kBits]; }
-    // The dense index of pair (a, b), or ~0 when a point is out of range.
-    std::uint64_t pair_index(std::uint32_t a, std::uint32_t b) const {
-        return a < points_ && b < points_ ? static_cast<std::uint64_t>(a) * points_ + b : ~0ull;
-    }
+    const RankLine* line_of(std::uint64_t s) const { return &lines_[s / PairIndex::kTileSlots]; }
     static void decode(const std::uint8_t* r, CoverageHit& hit, bool normal);
 };
 

@@ -1,0 +1,81 @@
+#include "lattice/encodings/coverage/pair_index.h"
+
+#include <cassert>
+
+namespace lat {
+
+PairIndex::PairIndex(const std::array<int, 3>& cells) : grid_(cells) {
+    assert(grid_.count() <= 0xFFFFu);
+    points_.resize(grid_.count());
+    for (std::uint32_t id = 0; id < grid_.count(); ++id) {
+        const GridPoint p = grid_.point(id);
+        points_[id] = {{static_cast<std::uint16_t>(p.x), static_cast<std::uint16_t>(p.y),
+                        static_cast<std::uint16_t>(p.z)},
+                       grid_.faces(p)};
+    }
+    for (int f = 0; f < 6; ++f)
+        for (int g = 0; g < 6; ++g) {
+            Block& k = blocks_[f * 6 + g];
+            k.first_tile = tiles_;
+            if (f == g) continue;  // no pair is filed on one face: an empty block
+            std::uint64_t n = 1;
+            for (int i = 0; i < 4; ++i) {
+                const int face = i < 2 ? f : g;
+                k.extent[i] = cells[static_cast<std::size_t>(kAxes[face][i % 2])] + 1;
+                k.tiles[i] = static_cast<std::uint32_t>((k.extent[i] + kSide - 1) / kSide);
+                n *= k.tiles[i];
+            }
+            tiles_ += n;
+        }
+}
+
+bool PairIndex::locate(std::uint64_t tile, int& block, std::uint32_t t[4]) const {
+    if (tile >= tiles_) return false;
+    // The last block starting at or before the tile (the empty ones start where the next does).
+    block = 35;
+    while (blocks_[block].first_tile > tile || blocks_[block].tiles[0] == 0) --block;
+    std::uint64_t r = tile - blocks_[block].first_tile;
+    for (int i = 3; i >= 0; --i) {
+        t[i] = static_cast<std::uint32_t>(r % blocks_[block].tiles[i]);
+        r /= blocks_[block].tiles[i];
+    }
+    return true;
+}
+
+bool PairIndex::pair_at(std::uint64_t s, std::uint32_t& a, std::uint32_t& b) const {
+    int block = 0;
+    std::uint32_t t[4];
+    if (!locate(s / kTileSlots, block, t)) return false;
+    const Block& k = blocks_[block];
+    const auto inner = static_cast<unsigned>(s % kTileSlots);
+    const int f = block / 6, g = block % 6;
+    GridPoint p[2];
+    for (int i = 0; i < 4; ++i) {
+        const int c = static_cast<int>(t[i]) * kSide + static_cast<int>(((inner >> i) & 1) | ((inner >> (i + 3)) & 2));
+        if (c >= k.extent[i]) return false;  // the tile's padding
+        const int face = i < 2 ? f : g;
+        p[i / 2][kAxes[face][i % 2]] = c;
+    }
+    for (int e = 0; e < 2; ++e) {
+        const int face = e == 0 ? f : g;
+        p[e][BoundaryGrid::face_axis(face)] = grid_.face_level(face);
+    }
+    a = grid_.id(p[0]);
+    b = grid_.id(p[1]);
+    int ff = 0, gg = 0;
+    return a != b && filed_faces(grid_.faces(p[0]), grid_.faces(p[1]), ff, gg) && ff == f && gg == g;
+}
+
+bool PairIndex::plain_tile(std::uint64_t tile) const {
+    int block = 0;
+    std::uint32_t t[4];
+    if (!locate(tile, block, t)) return false;
+    // Its points are inside their faces (filed under them, no other choice) and short of the
+    // padding: coordinates 1 to extent - 2.
+    for (int i = 0; i < 4; ++i)
+        if (t[i] == 0 || static_cast<int>(t[i]) * kSide + kSide > blocks_[block].extent[i] - 1)
+            return false;
+    return true;
+}
+
+}  // namespace lat
