@@ -1,6 +1,8 @@
 #include "lattice/encodings/coverage/coverage_table.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -23,28 +25,34 @@ constexpr double kAlphaScale = 65535.0;
 struct Header {
     std::uint64_t magic;
     std::uint32_t points, rays;  // boundary points; sub-rays per pair
-    std::uint64_t occupied;      // records
+    std::uint64_t occupied;      // records of stored pairs
     std::uint64_t center_hits;   // records whose own segment hits (the table's entries)
     std::uint64_t slots;         // PairIndex::slots() of the lattice
-    std::uint64_t reserved[3];
+    std::uint64_t groups;        // groups of 16 slots kept
+    std::uint64_t reserved[2];
 };
 static_assert(sizeof(Header) == 64);
 
 std::uint64_t padded8(std::uint64_t bytes) { return (bytes + 7) / 8 * 8; }
 
-// The payload: the header, an occupancy bit per slot, the records in slot order.
+// The payload: the header, a 16-bit word per tile (a bit per group kept), the kept groups'
+// records (16 a group, in slot order).
 struct Sections {
-    std::uint64_t nwords, occ, records, total;
+    std::uint64_t tiles, kept, groups, total;
 };
 
-Sections sections(std::uint64_t slots, std::uint64_t occupied) {
+Sections sections(std::uint64_t slots, std::uint64_t groups) {
     Sections s{};
-    s.nwords = words_for_bits(slots);
-    s.occ = sizeof(Header);
-    s.records = s.occ + s.nwords * 8;
-    s.total = s.records + padded8(occupied * kRecordBytes);
+    s.tiles = slots / PairIndex::kTileSlots;
+    s.kept = sizeof(Header);
+    s.groups = s.kept + padded8(s.tiles * 2);
+    s.total = s.groups + padded8(groups * 16 * kRecordBytes);
     return s;
 }
+
+// An empty slot's record in a kept group: no hit and no coverage, which no stored pair has
+// (it would not have been stored).
+constexpr std::array<std::uint16_t, CoverageTable::kFields> kEmpty{CoverageTable::kNoHit, 0, 0, 0, 0, 0, 0};
 
 std::uint16_t field(const std::uint8_t* rec, int f) {
     std::uint16_t v;
@@ -99,19 +107,26 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
         if (e.pair == PairIndex::kNone) throw std::logic_error("coverage: a stored pair is not valid");
     }
     std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
+    std::uint64_t groups = 0;
+    for (std::size_t i = 0; i < entries.size(); ++i)
+        groups += i == 0 || entries[i].pair / 16 != entries[i - 1].pair / 16;
 
-    const Sections s = sections(index.slots(), entries.size());
+    const Sections s = sections(index.slots(), groups);
     ByteBuffer out(s.total);
     std::memset(out.data(), 0, s.total);
     const Header h{kMagic, static_cast<std::uint32_t>(n), kCoverageRays, entries.size(), centers,
-                   index.slots(), {}};
+                   index.slots(), groups, {}};
     std::memcpy(out.data(), &h, sizeof h);
-    auto* occ = reinterpret_cast<std::uint64_t*>(out.data() + s.occ);
-    std::uint8_t* rec = out.data() + s.records;
-    for (const Entry& e : entries) {
-        occ[e.pair >> 6] |= std::uint64_t{1} << (e.pair & 63);
-        std::memcpy(rec, e.f.data(), kRecordBytes);
-        rec += kRecordBytes;
+    auto* kept = reinterpret_cast<std::uint16_t*>(out.data() + s.kept);
+    std::uint8_t* group = out.data() + s.groups;
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        const std::uint64_t g = entries[i].pair / 16;
+        if (i > 0 && g != entries[i - 1].pair / 16) group += 16 * kRecordBytes;
+        if (i == 0 || g != entries[i - 1].pair / 16) {
+            kept[g / 16] = static_cast<std::uint16_t>(kept[g / 16] | (1u << (g % 16)));
+            for (int k = 0; k < 16; ++k) std::memcpy(group + k * kRecordBytes, kEmpty.data(), kRecordBytes);
+        }
+        std::memcpy(group + (entries[i].pair % 16) * kRecordBytes, entries[i].f.data(), kRecordBytes);
     }
     return out;
 }
@@ -132,50 +147,73 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
     if (h.rays != kCoverageRays) fail("sampled with a different number of sub-rays");
     if (h.center_hits != entries || h.occupied < entries || h.occupied > (std::uint64_t{1} << 40))
         fail("record counts inconsistent with the header");
-    const Sections s = sections(h.slots, h.occupied);
+    // Every kept group holds a record; the directory numbers groups in 32 bits.
+    if (h.groups > h.occupied || h.groups >= (std::uint64_t{1} << 32))
+        fail("group count inconsistent with the header");
+    const Sections s = sections(h.slots, h.groups);
     if (s.total != size) fail("size does not match its counts");
-    const auto* occ = reinterpret_cast<const std::uint64_t*>(payload + s.occ);
-    build_lines(occ);
-    if (lines_[s.nwords / PairIndex::kTileWords].base != h.occupied)
-        fail("occupancy does not match the record count");
-    // A set bit where no pair is filed would be a record no lookup reaches.
-    for (std::uint64_t w = 0; w < s.nwords; ++w) {
-        if (!occ[w] || (w % PairIndex::kTileWords == 0 && index_.plain_tile(w / PairIndex::kTileWords)))
-            continue;
-        std::uint32_t a = 0, b = 0;
-        for (std::uint64_t bits = occ[w]; bits; bits &= bits - 1)
-            if (!index_.pair_at(w * 64 + static_cast<unsigned>(std::countr_zero(bits)), a, b))
-                fail("occupancy bits where no pair is filed");
-    }
     occupied_ = h.occupied;
-    records_ = payload + s.records;
-    std::uint64_t centers = 0;
-    for (std::uint64_t i = 0; i < occupied_; ++i) {
-        const std::uint8_t* r = records_ + i * kRecordBytes;
-        const std::uint16_t t = field(r, kT), alpha = field(r, kAlpha);
-        if ((t != kNoHit && t > kTScale) || field(r, kMeanT) > kTScale || (t == kNoHit && alpha == 0))
-            fail("a record out of range");
-        centers += t != kNoHit;
-        partial_ += alpha > 0 && alpha < kAlphaScale;
-        alpha_sum_ += alpha / kAlphaScale;
-    }
-    if (centers != entries) fail("hit count does not match the header");
+    kept_groups_ = h.groups;
+    check_groups(reinterpret_cast<const std::uint16_t*>(payload + s.kept), s.tiles);
+    groups_ = payload + s.groups;
+    check_records();
 }
 
-// One line per tile and a last one past them, whose base is the count of all set bits.
-void CoverageTable::build_lines(const std::uint64_t* occ) {
-    const std::uint64_t tiles = index_.slots() / PairIndex::kTileSlots;
-    lines_ = std::make_unique<RankLine[]>(tiles + 1);
-    size_ += (tiles + 1) * sizeof(RankLine);
+// The directory, from the file's bits per tile; their count must be the header's.
+void CoverageTable::check_groups(const std::uint16_t* kept, std::uint64_t tiles) {
+    tiles_ = std::make_unique<TileEntry[]>(tiles);
+    size_ += tiles * sizeof(TileEntry);
     std::uint64_t below = 0;
-    for (std::uint64_t t = 0; t <= tiles; ++t) {
-        RankLine& l = lines_[t];
-        l.base = below;
-        for (int k = 0; k < PairIndex::kTileWords; ++k) {
-            l.bits[k] = t < tiles ? occ[t * PairIndex::kTileWords + static_cast<std::uint64_t>(k)] : 0;
-            below += static_cast<std::uint64_t>(std::popcount(l.bits[k]));
+    for (std::uint64_t t = 0; t < tiles; ++t) {
+        tiles_[t] = {static_cast<std::uint32_t>(below), kept[t], 0};
+        below += static_cast<unsigned>(std::popcount(kept[t]));
+        if (below > kept_groups_) break;
+    }
+    if (below != kept_groups_)
+        throw std::runtime_error("coverage payload: kept groups do not match the header's count");
+}
+
+// Each record stored or empty; stored ones in range, on a slot where a pair is filed, as many
+// as the header says; no kept group empty.
+void CoverageTable::check_records() {
+    auto fail = [](const char* why) {
+        throw std::runtime_error(std::string("coverage payload: ") + why);
+    };
+    const std::uint64_t tiles = index_.slots() / PairIndex::kTileSlots;
+    std::uint64_t count = 0, centers = 0;
+    for (std::uint64_t t = 0; t < tiles; ++t) {
+        if (!tiles_[t].kept) continue;
+        const bool plain = index_.plain_tile(t);
+        for (unsigned g = 0; g < 16; ++g) {
+            if (!((tiles_[t].kept >> g) & 1u)) continue;
+            int in_group = 0;
+            for (unsigned k = 0; k < 16; ++k) {
+                const std::uint64_t slot = t * PairIndex::kTileSlots + g * 16 + k;
+                const std::uint8_t* r = record_at(slot);
+                if (!stored(r)) {
+                    if (std::memcmp(r, kEmpty.data(), kRecordBytes) != 0) fail("a record out of range");
+                    continue;
+                }
+                const std::uint16_t tt = field(r, kT), alpha = field(r, kAlpha);
+                if ((tt != kNoHit && tt > kTScale) || field(r, kMeanT) > kTScale)
+                    fail("a record out of range");
+                std::uint32_t a = 0, b = 0;
+                if (!plain && !index_.pair_at(slot, a, b)) fail("a record where no pair is filed");
+                ++in_group;
+                centers += tt != kNoHit;
+                partial_ += alpha > 0 && alpha < kAlphaScale;
+                alpha_sum_ += alpha / kAlphaScale;
+            }
+            if (!in_group) fail("a kept group without records");
+            count += static_cast<unsigned>(in_group);
         }
     }
+    if (count != occupied_) fail("records do not match the header's count");
+    if (centers != entries_) fail("hit count does not match the header");
+}
+
+bool CoverageTable::stored(const std::uint8_t* r) {
+    return field(r, kT) != kNoHit || field(r, kAlpha) != 0;
 }
 
 const std::uint8_t* CoverageTable::record(std::uint32_t a, std::uint32_t b) const {
@@ -206,20 +244,15 @@ bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit)
 
 void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
                                   CoverageHit* out, bool* found, bool normals) const {
-    // Three passes, each prefetching what the next reads, so that the cache misses of the pairs
-    // (rank line, record: two a pair in a table of hundreds of MB) overlap instead of following
-    // one another.
+    // Two passes: the records are found from the directory (mostly in cache) and prefetched,
+    // then read, so that their cache misses overlap instead of following one another.
     constexpr int kMax = 16;
-    std::uint64_t idx[kMax];
     const std::uint8_t* rec[kMax];
     for (int base = 0; base < n; base += kMax) {
         const int m = std::min(kMax, n - base);
         for (int i = 0; i < m; ++i) {
-            idx[i] = index_.slot(a[base + i], b[base + i]);
-            if (idx[i] != PairIndex::kNone) __builtin_prefetch(line_of(idx[i]));
-        }
-        for (int i = 0; i < m; ++i) {
-            rec[i] = idx[i] != PairIndex::kNone ? record_at(idx[i]) : nullptr;
+            const std::uint64_t slot = index_.slot(a[base + i], b[base + i]);
+            rec[i] = slot != PairIndex::kNone ? record_at(slot) : nullptr;
             if (rec[i]) __builtin_prefetch(rec[i]);
         }
         for (int i = 0; i < m; ++i) {
@@ -231,17 +264,20 @@ void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b
 
 void CoverageTable::prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const {
     for (int i = 0; i < n; ++i) {
-        const std::uint64_t idx = index_.slot(a[i], b[i]);
-        if (idx != PairIndex::kNone) __builtin_prefetch(line_of(idx));
+        const std::uint64_t slot = index_.slot(a[i], b[i]);
+        if (slot == PairIndex::kNone) continue;
+        if (const std::uint8_t* r = record_at(slot)) __builtin_prefetch(r);
     }
 }
 
 std::string CoverageTable::details() const {
     char buf[256];
     std::snprintf(buf, sizeof buf,
-                  "%llu records, %d sub-rays a pair; coverage: %llu pairs partly covered "
-                  "(0 < alpha < 1), %.0f pairs' worth in all, %.3f records per hit",
-                  static_cast<unsigned long long>(occupied_), kCoverageRays,
+                  "%llu records (in %llu groups of 16 slots), %d sub-rays a pair; coverage: %llu "
+                  "pairs partly covered (0 < alpha < 1), %.0f pairs' worth in all, %.3f records "
+                  "per hit",
+                  static_cast<unsigned long long>(occupied_),
+                  static_cast<unsigned long long>(kept_groups_), kCoverageRays,
                   static_cast<unsigned long long>(partial_), alpha_sum_,
                   entries_ ? double(occupied_) / double(entries_) : 0.0);
     return buf;

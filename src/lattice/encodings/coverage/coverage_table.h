@@ -3,14 +3,19 @@
 // hit of the pair's own segment, as every table does (lookup: what point sampling, CSG, inside
 // tests and certification use), and the pair's coverage (lattice/coverage.h): the share of the
 // sub-rays snapping to the pair that meet the primitive and their mean hit, which filtered
-// rendering uses. Pairs are filed in slots where neighbours in ray space are neighbours in
-// memory (pair_index.h), with occupancy bits read through rank lines built at open, and records
-// in slot order; a record is seven 16-bit fields (alpha in 1/65535).
+// rendering uses. A record is seven 16-bit fields (alpha in 1/65535).
+//
+// Pairs are filed in slots where neighbours in ray space are neighbours in memory (pair_index.h:
+// tiles of 256 slots, each 16 consecutive slots a 2 x 2 x 2 x 2 cell of the 4-D grid of entry
+// and exit points). Records are kept densely for every group of 16 slots that holds any (an
+// empty slot's record says so), the groups in slot order; a directory built at open gives
+// each tile its first group and which of its 16 groups are kept. A pair's record is then found
+// from the directory alone (a few MB, mostly in cache): one cache miss a pair, not two (an
+// occupancy line, then the record, as the rank lines of a * N + b indexing needed).
 #include <bit>
 #include <cstdint>
 #include <memory>
 
-#include "lattice/bits/bit_array.h"
 #include "lattice/encoding.h"
 #include "lattice/encodings/coverage/pair_index.h"
 #include "lattice/table.h"
@@ -39,40 +44,39 @@ public:
     static constexpr std::uint16_t kNoHit = 0xFFFF;  // kT of a pair whose own segment misses
 
 private:
-    // The occupancy bits as rendering reads them: a cache line holds the rank of a tile's
-    // first slot and the tile's 256 bits, so that finding a pair's record takes one line
-    // besides the record, and a blend's pairs, in one or two tiles, one or two lines. Built
-    // from the file's (checked) occupancy words at open.
-    struct alignas(64) RankLine {
-        std::uint64_t base;  // set bits before this tile's first
-        std::uint64_t bits[PairIndex::kTileWords];
+    // A tile's entry in the directory: its first kept group and a bit per kept group.
+    struct TileEntry {
+        std::uint32_t first;
+        std::uint16_t kept;
+        std::uint16_t unused;
     };
-    static_assert(sizeof(RankLine) == 64);
+    static constexpr int kGroupSlots = 16;
+    static constexpr std::size_t kGroupBytes = kGroupSlots * kRecordBytes;
     PairIndex index_;
-    std::uint64_t occupied_ = 0;
-    std::unique_ptr<RankLine[]> lines_;
-    const std::uint8_t* records_ = nullptr;
+    std::unique_ptr<TileEntry[]> tiles_;
+    const std::uint8_t* groups_ = nullptr;
+    std::uint64_t occupied_ = 0, kept_groups_ = 0;
     std::uint64_t entries_;
-    std::size_t size_;  // the payload's and the rank lines'
+    std::size_t size_;  // the payload's and the directory's
     // Coverage statistics for `inspect`, gathered when the records are checked at open.
     std::uint64_t partial_ = 0;
     double alpha_sum_ = 0;
 
-    void build_lines(const std::uint64_t* occ);
+    void check_groups(const std::uint16_t* kept, std::uint64_t groups);
+    void check_records();
     const std::uint8_t* record(std::uint32_t a, std::uint32_t b) const;
-    // The record of slot s (below index_.slots()), or null when the pair is not stored.
+    // The record of slot s (below index_.slots()) when its group is kept, else null; it may
+    // still be an empty slot's (stored() says).
     const std::uint8_t* record_at(std::uint64_t s) const {
-        const RankLine& l = lines_[s / PairIndex::kTileSlots];
-        const auto off = static_cast<unsigned>(s % PairIndex::kTileSlots);
-        const unsigned w = off >> 6, bit = off & 63;
-        const std::uint64_t word = l.bits[w];
-        if (!((word >> bit) & 1)) return nullptr;
-        std::uint64_t r = l.base + static_cast<std::uint64_t>(
-                                       std::popcount(word & ((std::uint64_t{1} << bit) - 1)));
-        for (unsigned k = 0; k < w; ++k) r += static_cast<std::uint64_t>(std::popcount(l.bits[k]));
-        return records_ + r * kRecordBytes;
+        const TileEntry& e = tiles_[s / PairIndex::kTileSlots];
+        const auto inner = static_cast<unsigned>(s % PairIndex::kTileSlots);
+        const unsigned g = inner / kGroupSlots;
+        if (!((e.kept >> g) & 1u)) return nullptr;
+        const std::uint64_t k = e.first + static_cast<unsigned>(std::popcount(
+                                              static_cast<unsigned>(e.kept) & ((1u << g) - 1)));
+        return groups_ + k * kGroupBytes + (inner % kGroupSlots) * kRecordBytes;
     }
-    const RankLine* line_of(std::uint64_t s) const { return &lines_[s / PairIndex::kTileSlots]; }
+    static bool stored(const std::uint8_t* r);
     static void decode(const std::uint8_t* r, CoverageHit& hit, bool normal);
 };
 
