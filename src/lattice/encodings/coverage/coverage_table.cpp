@@ -8,6 +8,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "lattice/bits/bit_array.h"
+
 #include "lattice/coverage.h"
 #include "lattice/octahedral.h"
 
@@ -35,17 +37,17 @@ static_assert(sizeof(Header) == 64);
 
 std::uint64_t padded8(std::uint64_t bytes) { return (bytes + 7) / 8 * 8; }
 
-// The payload: the header, a 16-bit word per tile (a bit per group kept), the kept groups'
-// records (16 a group, in slot order).
+// The payload: the header, a bit per group of 16 slots (kept or not), the kept groups' records
+// (16 a group, in slot order).
 struct Sections {
-    std::uint64_t tiles, kept, groups, total;
+    std::uint64_t nwords, kept, groups, total;
 };
 
 Sections sections(std::uint64_t slots, std::uint64_t groups) {
     Sections s{};
-    s.tiles = slots / PairIndex::kTileSlots;
+    s.nwords = words_for_bits(slots / 16);
     s.kept = sizeof(Header);
-    s.groups = s.kept + padded8(s.tiles * 2);
+    s.groups = s.kept + s.nwords * 8;
     s.total = s.groups + padded8(groups * 16 * kRecordBytes);
     return s;
 }
@@ -117,13 +119,13 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
     const Header h{kMagic, static_cast<std::uint32_t>(n), kCoverageRays, entries.size(), centers,
                    index.slots(), groups, {}};
     std::memcpy(out.data(), &h, sizeof h);
-    auto* kept = reinterpret_cast<std::uint16_t*>(out.data() + s.kept);
+    auto* kept = reinterpret_cast<std::uint64_t*>(out.data() + s.kept);
     std::uint8_t* group = out.data() + s.groups;
     for (std::size_t i = 0; i < entries.size(); ++i) {
         const std::uint64_t g = entries[i].pair / 16;
         if (i > 0 && g != entries[i - 1].pair / 16) group += 16 * kRecordBytes;
         if (i == 0 || g != entries[i - 1].pair / 16) {
-            kept[g / 16] = static_cast<std::uint16_t>(kept[g / 16] | (1u << (g % 16)));
+            kept[g / 64] |= std::uint64_t{1} << (g % 64);
             for (int k = 0; k < 16; ++k) std::memcpy(group + k * kRecordBytes, kEmpty.data(), kRecordBytes);
         }
         std::memcpy(group + (entries[i].pair % 16) * kRecordBytes, entries[i].f.data(), kRecordBytes);
@@ -154,38 +156,44 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
     if (s.total != size) fail("size does not match its counts");
     occupied_ = h.occupied;
     kept_groups_ = h.groups;
-    check_groups(reinterpret_cast<const std::uint16_t*>(payload + s.kept), s.tiles);
+    const auto* kept = reinterpret_cast<const std::uint64_t*>(payload + s.kept);
+    if (build_lines(kept, s.nwords) != h.groups) fail("kept groups do not match the header's count");
+    // Bits past the last group would keep groups of no slot.
+    if ((h.slots / 16) % 64 && kept[s.nwords - 1] >> ((h.slots / 16) % 64))
+        fail("kept-group bits past the last group");
     groups_ = payload + s.groups;
-    check_records();
+    check_records(kept);
 }
 
-// The directory, from the file's bits per tile; their count must be the header's.
-void CoverageTable::check_groups(const std::uint16_t* kept, std::uint64_t tiles) {
-    tiles_ = std::make_unique<TileEntry[]>(tiles);
-    size_ += tiles * sizeof(TileEntry);
+// Returns the set bits in all.
+std::uint64_t CoverageTable::build_lines(const std::uint64_t* kept, std::uint64_t nwords) {
+    const std::uint64_t nlines = (nwords + RankLine::kWords - 1) / RankLine::kWords;
+    lines_ = std::make_unique<RankLine[]>(nlines);
+    size_ += nlines * sizeof(RankLine);
     std::uint64_t below = 0;
-    for (std::uint64_t t = 0; t < tiles; ++t) {
-        tiles_[t] = {static_cast<std::uint32_t>(below), kept[t], 0};
-        below += static_cast<unsigned>(std::popcount(kept[t]));
-        if (below > kept_groups_) break;
+    for (std::uint64_t w = 0; w < nlines * RankLine::kWords; ++w) {
+        RankLine& l = lines_[w / RankLine::kWords];
+        if (w % RankLine::kWords == 0) l.base = below;
+        l.bits[w % RankLine::kWords] = w < nwords ? kept[w] : 0;
+        below += static_cast<std::uint64_t>(std::popcount(l.bits[w % RankLine::kWords]));
     }
-    if (below != kept_groups_)
-        throw std::runtime_error("coverage payload: kept groups do not match the header's count");
+    return below;
 }
 
 // Each record stored or empty; stored ones in range, on a slot where a pair is filed, as many
 // as the header says; no kept group empty.
-void CoverageTable::check_records() {
+void CoverageTable::check_records(const std::uint64_t* kept) {
     auto fail = [](const char* why) {
         throw std::runtime_error(std::string("coverage payload: ") + why);
     };
     const std::uint64_t tiles = index_.slots() / PairIndex::kTileSlots;
     std::uint64_t count = 0, centers = 0;
     for (std::uint64_t t = 0; t < tiles; ++t) {
-        if (!tiles_[t].kept) continue;
+        const auto in_tile = static_cast<unsigned>((kept[t / 4] >> (t % 4 * 16)) & 0xFFFF);
+        if (!in_tile) continue;
         const bool plain = index_.plain_tile(t);
         for (unsigned g = 0; g < 16; ++g) {
-            if (!((tiles_[t].kept >> g) & 1u)) continue;
+            if (!((in_tile >> g) & 1u)) continue;
             int in_group = 0;
             for (unsigned k = 0; k < 16; ++k) {
                 const std::uint64_t slot = t * PairIndex::kTileSlots + g * 16 + k;
@@ -244,8 +252,8 @@ bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit)
 
 void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
                                   CoverageHit* out, bool* found, bool normals) const {
-    // Two passes: the records are found from the directory (mostly in cache) and prefetched,
-    // then read, so that their cache misses overlap instead of following one another.
+    // Two passes: the records are found through the rank lines (often in cache) and
+    // prefetched, then read, so that their cache misses overlap instead of following one another.
     constexpr int kMax = 16;
     const std::uint8_t* rec[kMax];
     for (int base = 0; base < n; base += kMax) {
