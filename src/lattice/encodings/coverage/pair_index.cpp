@@ -6,12 +6,26 @@ namespace lat {
 
 PairIndex::PairIndex(const std::array<int, 3>& cells) : grid_(cells) {
     assert(grid_.count() <= 0xFFFFu);
+    // A face's grid of tiles: tiles along u times along v, as the blocks take them.
+    std::uint32_t tiles_v[6] = {0, 0, 0, 0, 0, 0};
+    for (int f = 0; f < 6; ++f) {
+        const auto side = [&](int j) {
+            return static_cast<std::uint32_t>((cells[static_cast<std::size_t>(kAxes[f][j])] + kSide) / kSide);
+        };
+        tiles_v[f] = side(1);
+        face_slots_[f] = std::uint64_t{side(0)} * side(1) * kTileSlots;
+    }
     points_.resize(grid_.count());
     for (std::uint32_t id = 0; id < grid_.count(); ++id) {
         const GridPoint p = grid_.point(id);
-        points_[id] = {{static_cast<std::uint16_t>(p.x), static_cast<std::uint16_t>(p.y),
-                        static_cast<std::uint16_t>(p.z)},
-                       grid_.faces(p)};
+        Point& q = points_[id];
+        q.faces = grid_.faces(p);
+        for (int f = 0; f < 6; ++f) {
+            const int u = p[kAxes[f][0]], v = p[kAxes[f][1]];
+            const std::uint32_t tile = static_cast<std::uint32_t>(u / kSide) * tiles_v[f] +
+                                       static_cast<std::uint32_t>(v / kSide);
+            q.at[f] = tile << 8 | kSpread[u % kSide] | kSpread[v % kSide] << 1;
+        }
     }
     for (int f = 0; f < 6; ++f)
         for (int g = 0; g < 6; ++g) {

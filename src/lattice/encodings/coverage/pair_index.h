@@ -38,22 +38,17 @@ public:
     std::uint64_t slots() const { return tiles_ * kTileSlots; }
 
     // The pair's slot, or kNone when it is not a valid pair (a point out of range, a == b, or
-    // both on a single face).
+    // both on a single face). The tile index is linear in the two points' tiles in their
+    // faces and the Morton bits are theirs ORed, so it is a sum of per-point terms.
     std::uint64_t slot(std::uint32_t a, std::uint32_t b) const {
         if (a >= points_.size() || b >= points_.size() || a == b) return kNone;
         const Point& pa = points_[a];
         const Point& pb = points_[b];
         int f = 0, g = 0;
         if (!filed_faces(pa.faces, pb.faces, f, g)) return kNone;
-        const Block& k = blocks_[f * 6 + g];
-        const int c[4] = {pa.c[kAxes[f][0]], pa.c[kAxes[f][1]], pb.c[kAxes[g][0]], pb.c[kAxes[g][1]]};
-        std::uint64_t tile = 0;
-        unsigned inner = 0;
-        for (int i = 0; i < 4; ++i) {
-            tile = tile * k.tiles[i] + static_cast<unsigned>(c[i]) / kSide;
-            inner |= kSpread[c[i] % kSide] << i;
-        }
-        return (k.first_tile + tile) * kTileSlots + inner;
+        const std::uint32_t va = pa.at[f], vb = pb.at[g];
+        return blocks_[f * 6 + g].first_tile * kTileSlots + std::uint64_t{va >> 8} * face_slots_[g] +
+               (va & 0xFF) + std::uint64_t{vb >> 8} * kTileSlots + ((vb & 0xFF) << 2);
     }
 
     // The pair filed at slot s, or false when no valid pair is.
@@ -79,10 +74,11 @@ public:
     }
 
 private:
-    // A point's coordinates and faces, for slot(): 8 bytes, so that the points of a lattice
-    // (at most 0xFFFF) stay in cache.
+    // A point's faces, and on each of them its tile in the face's grid of tiles (bits 8 up)
+    // and its Morton bits as an entry point (bits 0, 1, 4, 5; as an exit point they are shifted
+    // by 2): 28 bytes, so that the points of a lattice (at most 0xFFFF) mostly stay in cache.
     struct Point {
-        std::uint16_t c[3];
+        std::uint32_t at[6];
         std::uint8_t faces;
     };
     // A face pair's tiles: the first one's index, their count along each coordinate, and the
@@ -100,6 +96,7 @@ private:
     BoundaryGrid grid_;
     std::vector<Point> points_;
     Block blocks_[36];
+    std::uint64_t face_slots_[6] = {0, 0, 0, 0, 0, 0};  // slots of a face's grid of tiles
     std::uint64_t tiles_ = 0;
 
     // The block and tile coordinates of a tile; false past the last tile.
