@@ -20,41 +20,43 @@ constexpr std::uint64_t kMagic = 0x3252'4556'4F43ull;  // "COVER2"
 // The layout before (pairs indexed a * N + b, with a rank directory): refused with a word on
 // what to do (the table cache never meets one: Encoding::layout is in its file names).
 constexpr std::uint64_t kOldMagic = 0x3152'4556'4F43ull;  // "COVER1"
-constexpr std::size_t kRecordBytes = CoverageTable::kRecordBytes;
+constexpr std::size_t kHitBytes = CoverageTable::kHitBytes, kCoverBytes = CoverageTable::kCoverBytes;
+constexpr int kGroupSlots = CoverageTable::kGroupSlots;
 constexpr double kTScale = 65534.0;
 constexpr double kAlphaScale = 65535.0;
+// A coverage record's fields.
+enum { kCoverT, kCoverNu, kCoverNv, kCoverAlpha };
 
 struct Header {
     std::uint64_t magic;
     std::uint32_t points, rays;  // boundary points; sub-rays per pair
-    std::uint64_t occupied;      // records of stored pairs
-    std::uint64_t center_hits;   // records whose own segment hits (the table's entries)
+    std::uint64_t occupied;      // stored pairs
+    std::uint64_t center_hits;   // those whose own segment hits (the table's entries)
     std::uint64_t slots;         // PairIndex::slots() of the lattice
     std::uint64_t groups;        // groups of 16 slots kept
     std::uint64_t reserved[2];
 };
 static_assert(sizeof(Header) == 64);
 
-std::uint64_t padded8(std::uint64_t bytes) { return (bytes + 7) / 8 * 8; }
+std::uint64_t padded(std::uint64_t bytes, std::uint64_t to) { return (bytes + to - 1) / to * to; }
 
-// The payload: the header, a bit per group of 16 slots (kept or not), the kept groups' records
-// (16 a group, in slot order).
+// The payload: the header, a bit per group of 16 slots (kept or not), the kept groups'
+// coverage records, then their hit records (16 a group, in slot order). The coverage records
+// start on a cache line (a payload starts 128 bytes into its file, read or mapped at a page),
+// so that a group's are two whole lines.
 struct Sections {
-    std::uint64_t nwords, kept, groups, total;
+    std::uint64_t nwords, kept, covers, hits, total;
 };
 
 Sections sections(std::uint64_t slots, std::uint64_t groups) {
     Sections s{};
-    s.nwords = words_for_bits(slots / 16);
+    s.nwords = words_for_bits(slots / kGroupSlots);
     s.kept = sizeof(Header);
-    s.groups = s.kept + s.nwords * 8;
-    s.total = s.groups + padded8(groups * 16 * kRecordBytes);
+    s.covers = padded(s.kept + s.nwords * 8, 64);
+    s.hits = s.covers + groups * kGroupSlots * kCoverBytes;
+    s.total = padded(s.hits + groups * kGroupSlots * kHitBytes, 8);
     return s;
 }
-
-// An empty slot's record in a kept group: no hit and no coverage, which no stored pair has
-// (it would not have been stored).
-constexpr std::array<std::uint16_t, CoverageTable::kFields> kEmpty{CoverageTable::kNoHit, 0, 0, 0, 0, 0, 0};
 
 std::uint16_t field(const std::uint8_t* rec, int f) {
     std::uint16_t v;
@@ -111,7 +113,7 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
     std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
     std::uint64_t groups = 0;
     for (std::size_t i = 0; i < entries.size(); ++i)
-        groups += i == 0 || entries[i].pair / 16 != entries[i - 1].pair / 16;
+        groups += i == 0 || entries[i].pair / kGroupSlots != entries[i - 1].pair / kGroupSlots;
 
     const Sections s = sections(index.slots(), groups);
     ByteBuffer out(s.total);
@@ -120,15 +122,21 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
                    index.slots(), groups, {}};
     std::memcpy(out.data(), &h, sizeof h);
     auto* kept = reinterpret_cast<std::uint64_t*>(out.data() + s.kept);
-    std::uint8_t* group = out.data() + s.groups;
+    std::uint64_t k = 0;  // the group being written, among the kept ones
     for (std::size_t i = 0; i < entries.size(); ++i) {
-        const std::uint64_t g = entries[i].pair / 16;
-        if (i > 0 && g != entries[i - 1].pair / 16) group += 16 * kRecordBytes;
-        if (i == 0 || g != entries[i - 1].pair / 16) {
+        const std::uint64_t g = entries[i].pair / kGroupSlots;
+        const bool first = i == 0 || g != entries[i - 1].pair / kGroupSlots;
+        if (first && i > 0) ++k;
+        std::uint8_t* hit = out.data() + s.hits + k * kGroupSlots * kHitBytes;
+        if (first) {
             kept[g / 64] |= std::uint64_t{1} << (g % 64);
-            for (int k = 0; k < 16; ++k) std::memcpy(group + k * kRecordBytes, kEmpty.data(), kRecordBytes);
+            // The empty slots' hit records say no hit (their coverage records, all 0, no alpha).
+            for (int j = 0; j < kGroupSlots; ++j) std::memcpy(hit + j * kHitBytes, &kNoHit, 2);
         }
-        std::memcpy(group + (entries[i].pair % 16) * kRecordBytes, entries[i].f.data(), kRecordBytes);
+        const std::uint64_t j = entries[i].pair % kGroupSlots;
+        std::memcpy(hit + j * kHitBytes, entries[i].f.data(), kHitBytes);
+        std::memcpy(out.data() + s.covers + (k * kGroupSlots + j) * kCoverBytes,
+                    entries[i].f.data() + kMeanT, kCoverBytes);
     }
     return out;
 }
@@ -149,9 +157,7 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
     if (h.rays != kCoverageRays) fail("sampled with a different number of sub-rays");
     if (h.center_hits != entries || h.occupied < entries || h.occupied > (std::uint64_t{1} << 40))
         fail("record counts inconsistent with the header");
-    // Every kept group holds a record; the directory numbers groups in 32 bits.
-    if (h.groups > h.occupied || h.groups >= (std::uint64_t{1} << 32))
-        fail("group count inconsistent with the header");
+    if (h.groups > h.occupied) fail("more kept groups than stored pairs");
     const Sections s = sections(h.slots, h.groups);
     if (s.total != size) fail("size does not match its counts");
     occupied_ = h.occupied;
@@ -159,9 +165,10 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
     const auto* kept = reinterpret_cast<const std::uint64_t*>(payload + s.kept);
     if (build_lines(kept, s.nwords) != h.groups) fail("kept groups do not match the header's count");
     // Bits past the last group would keep groups of no slot.
-    if ((h.slots / 16) % 64 && kept[s.nwords - 1] >> ((h.slots / 16) % 64))
+    if ((h.slots / kGroupSlots) % 64 && kept[s.nwords - 1] >> ((h.slots / kGroupSlots) % 64))
         fail("kept-group bits past the last group");
-    groups_ = payload + s.groups;
+    covers_ = payload + s.covers;
+    hits_ = payload + s.hits;
     check_records(kept);
 }
 
@@ -180,14 +187,15 @@ std::uint64_t CoverageTable::build_lines(const std::uint64_t* kept, std::uint64_
     return below;
 }
 
-// Each record stored or empty; stored ones in range, on a slot where a pair is filed, as many
-// as the header says; no kept group empty.
+// Each slot of a kept group stored or empty; stored pairs' records in range, on a slot where a
+// pair is filed, as many as the header says; no kept group empty.
 void CoverageTable::check_records(const std::uint64_t* kept) {
     auto fail = [](const char* why) {
         throw std::runtime_error(std::string("coverage payload: ") + why);
     };
+    constexpr std::uint8_t kNoCover[kCoverBytes] = {};
     const std::uint64_t tiles = index_.slots() / PairIndex::kTileSlots;
-    std::uint64_t count = 0, centers = 0;
+    std::uint64_t count = 0, centers = 0, group = 0;
     for (std::uint64_t t = 0; t < tiles; ++t) {
         const auto in_tile = static_cast<unsigned>((kept[t / 4] >> (t % 4 * 16)) & 0xFFFF);
         if (!in_tile) continue;
@@ -195,18 +203,20 @@ void CoverageTable::check_records(const std::uint64_t* kept) {
         for (unsigned g = 0; g < 16; ++g) {
             if (!((in_tile >> g) & 1u)) continue;
             int in_group = 0;
-            for (unsigned k = 0; k < 16; ++k) {
-                const std::uint64_t slot = t * PairIndex::kTileSlots + g * 16 + k;
-                const std::uint8_t* r = record_at(slot);
-                if (!stored(r)) {
-                    if (std::memcmp(r, kEmpty.data(), kRecordBytes) != 0) fail("a record out of range");
+            for (unsigned j = 0; j < kGroupSlots; ++j) {
+                const Place p{group, j, true};
+                const std::uint8_t *c = cover_at(p), *h = hit_at(p);
+                const std::uint16_t tt = field(h, kT), alpha = field(c, kCoverAlpha);
+                if (tt == kNoHit && alpha == 0) {
+                    if (field(h, kNu) || field(h, kNv) || std::memcmp(c, kNoCover, kCoverBytes))
+                        fail("an empty slot's records not empty");
                     continue;
                 }
-                const std::uint16_t tt = field(r, kT), alpha = field(r, kAlpha);
-                if ((tt != kNoHit && tt > kTScale) || field(r, kMeanT) > kTScale)
+                if ((tt != kNoHit && tt > kTScale) || field(c, kCoverT) > kTScale)
                     fail("a record out of range");
                 std::uint32_t a = 0, b = 0;
-                if (!plain && !index_.pair_at(slot, a, b)) fail("a record where no pair is filed");
+                if (!plain && !index_.pair_at(t * PairIndex::kTileSlots + g * kGroupSlots + j, a, b))
+                    fail("a record where no pair is filed");
                 ++in_group;
                 centers += tt != kNoHit;
                 partial_ += alpha > 0 && alpha < kAlphaScale;
@@ -214,39 +224,38 @@ void CoverageTable::check_records(const std::uint64_t* kept) {
             }
             if (!in_group) fail("a kept group without records");
             count += static_cast<unsigned>(in_group);
+            ++group;
         }
     }
     if (count != occupied_) fail("records do not match the header's count");
     if (centers != entries_) fail("hit count does not match the header");
 }
 
-bool CoverageTable::stored(const std::uint8_t* r) {
-    return field(r, kT) != kNoHit || field(r, kAlpha) != 0;
-}
-
-const std::uint8_t* CoverageTable::record(std::uint32_t a, std::uint32_t b) const {
-    const std::uint64_t i = index_.slot(a, b);
-    return i == PairIndex::kNone ? nullptr : record_at(i);
+CoverageTable::Place CoverageTable::place(std::uint32_t a, std::uint32_t b) const {
+    const std::uint64_t s = index_.slot(a, b);
+    return s == PairIndex::kNone ? Place{0, 0, false} : place_of(s);
 }
 
 bool CoverageTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
-    const std::uint8_t* r = record(a, b);
-    if (!r || field(r, kT) == kNoHit) return false;
-    hit.t = field(r, kT) / kTScale;
-    hit.normal = oct_decode({field(r, kNu), field(r, kNv)}, kRawNormalBits);
+    const Place p = place(a, b);
+    if (!p.kept) return false;
+    const std::uint8_t* h = hit_at(p);
+    if (field(h, kT) == kNoHit) return false;
+    hit.t = field(h, kT) / kTScale;
+    hit.normal = oct_decode({field(h, kNu), field(h, kNv)}, kRawNormalBits);
     return true;
 }
 
-void CoverageTable::decode(const std::uint8_t* r, CoverageHit& hit, bool normal) {
-    hit.alpha = field(r, kAlpha) / kAlphaScale;
-    hit.t = field(r, kMeanT) / kTScale;
-    if (normal) hit.normal = oct_decode({field(r, kMeanNu), field(r, kMeanNv)}, kRawNormalBits);
+void CoverageTable::decode(const std::uint8_t* c, CoverageHit& hit, bool normal) {
+    hit.alpha = field(c, kCoverAlpha) / kAlphaScale;
+    hit.t = field(c, kCoverT) / kTScale;
+    if (normal) hit.normal = oct_decode({field(c, kCoverNu), field(c, kCoverNv)}, kRawNormalBits);
 }
 
 bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const {
-    const std::uint8_t* r = record(a, b);
-    if (!r || field(r, kAlpha) == 0) return false;
-    decode(r, hit, true);
+    const Place p = place(a, b);
+    if (!p.kept || field(cover_at(p), kCoverAlpha) == 0) return false;
+    decode(cover_at(p), hit, true);
     return true;
 }
 
@@ -259,23 +268,20 @@ void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b
     for (int base = 0; base < n; base += kMax) {
         const int m = std::min(kMax, n - base);
         for (int i = 0; i < m; ++i) {
-            const std::uint64_t slot = index_.slot(a[base + i], b[base + i]);
-            rec[i] = slot != PairIndex::kNone ? record_at(slot) : nullptr;
+            const Place p = place(a[base + i], b[base + i]);
+            rec[i] = p.kept ? cover_at(p) : nullptr;
             if (rec[i]) __builtin_prefetch(rec[i]);
         }
         for (int i = 0; i < m; ++i) {
-            found[base + i] = rec[i] && field(rec[i], kAlpha) != 0;
+            found[base + i] = rec[i] && field(rec[i], kCoverAlpha) != 0;
             if (found[base + i]) decode(rec[i], out[base + i], normals);
         }
     }
 }
 
 void CoverageTable::prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const {
-    for (int i = 0; i < n; ++i) {
-        const std::uint64_t slot = index_.slot(a[i], b[i]);
-        if (slot == PairIndex::kNone) continue;
-        if (const std::uint8_t* r = record_at(slot)) __builtin_prefetch(r);
-    }
+    for (int i = 0; i < n; ++i)
+        if (const Place p = place(a[i], b[i]); p.kept) __builtin_prefetch(cover_at(p));
 }
 
 std::string CoverageTable::details() const {

@@ -3,16 +3,18 @@
 // hit of the pair's own segment, as every table does (lookup: what point sampling, CSG, inside
 // tests and certification use), and the pair's coverage (lattice/coverage.h): the share of the
 // sub-rays snapping to the pair that meet the primitive and their mean hit, which filtered
-// rendering uses. A record is seven 16-bit fields (alpha in 1/65535).
+// rendering uses. Each is a record of 16-bit fields: the hit's t and normal (6 bytes), the
+// coverage's mean t, mean normal and alpha in 1/65535 (8 bytes).
 //
 // Pairs are filed in slots where neighbours in ray space are neighbours in memory (pair_index.h:
 // tiles of 256 slots, each 16 consecutive slots a 2 x 2 x 2 x 2 cell of the 4-D grid of entry
-// and exit points). Records are kept densely for every group of 16 slots that holds any (an
-// empty slot's record says so), the groups in slot order, with a bit per group saying whether
-// it is kept. Read through rank lines built at open (a line: the rank of its first bit and 448
-// bits, 1 MB at sigma^-1 = 4 for Plate 4's hair, 1/14 of the lines of one bit per pair), a
-// pair's record is found from a line that is often in cache, then read: about one cache miss
-// a pair instead of two.
+// and exit points). Records are kept densely for every group of 16 slots that holds a stored
+// pair (an empty slot's records say so), with a bit per group saying whether it is kept; the
+// groups' coverage records (128 bytes a group: two cache lines) apart from their hits, which
+// filtered rendering does not read. Read through rank lines built at open (a line: the rank
+// of its first bit and 448 bits; 1 MB at sigma^-1 = 4 for Plate 4's hair, where one bit per
+// pair took 16 MB), a pair's record is found from a line that is often in cache: about one
+// cache miss a pair instead of two.
 #include <bit>
 #include <cstdint>
 #include <memory>
@@ -39,10 +41,11 @@ public:
     std::uint64_t entries() const override { return entries_; }
     std::uint64_t bytes() const override { return size_; }
 
-    // The record fields, in this order.
+    // The fields of a pair, in this order: its hit record, then its coverage record.
     enum Field { kT, kNu, kNv, kMeanT, kMeanNu, kMeanNv, kAlpha, kFields };
-    static constexpr std::size_t kRecordBytes = kFields * 2;
+    static constexpr std::size_t kHitBytes = kMeanT * 2, kCoverBytes = (kFields - kMeanT) * 2;
     static constexpr std::uint16_t kNoHit = 0xFFFF;  // kT of a pair whose own segment misses
+    static constexpr int kGroupSlots = 16;
 
 private:
     // A line of the kept-group bits: the rank of its first bit and the 448 that follow.
@@ -52,11 +55,16 @@ private:
         std::uint64_t bits[kWords];
     };
     static_assert(sizeof(RankLine) == 64);
-    static constexpr int kGroupSlots = 16;
-    static constexpr std::size_t kGroupBytes = kGroupSlots * kRecordBytes;
+    // Where a slot's records are: its group's rank among the kept ones, and its place in it.
+    struct Place {
+        std::uint64_t group;
+        unsigned slot;
+        bool kept;
+    };
     PairIndex index_;
     std::unique_ptr<RankLine[]> lines_;
-    const std::uint8_t* groups_ = nullptr;
+    const std::uint8_t* covers_ = nullptr;  // kGroupSlots coverage records a kept group
+    const std::uint8_t* hits_ = nullptr;    // kGroupSlots hit records a kept group
     std::uint64_t occupied_ = 0, kept_groups_ = 0;
     std::uint64_t entries_;
     std::size_t size_;  // the payload's and the rank lines'
@@ -66,23 +74,26 @@ private:
 
     std::uint64_t build_lines(const std::uint64_t* kept, std::uint64_t nwords);
     void check_records(const std::uint64_t* kept);
-    const std::uint8_t* record(std::uint32_t a, std::uint32_t b) const;
-    // The record of slot s (below index_.slots()) when its group is kept, else null; it may
-    // still be an empty slot's (stored() says).
-    const std::uint8_t* record_at(std::uint64_t s) const {
+    Place place(std::uint32_t a, std::uint32_t b) const;
+    Place place_of(std::uint64_t s) const {
         const std::uint64_t g = s / kGroupSlots;
         const RankLine& l = lines_[g / RankLine::kBits];
         const auto off = static_cast<unsigned>(g % RankLine::kBits);
         const unsigned w = off >> 6, bit = off & 63;
         const std::uint64_t word = l.bits[w];
-        if (!((word >> bit) & 1)) return nullptr;
+        if (!((word >> bit) & 1)) return {0, 0, false};
         std::uint64_t r = l.base + static_cast<std::uint64_t>(
                                        std::popcount(word & ((std::uint64_t{1} << bit) - 1)));
         for (unsigned k = 0; k < w; ++k) r += static_cast<std::uint64_t>(std::popcount(l.bits[k]));
-        return groups_ + r * kGroupBytes + (s % kGroupSlots) * kRecordBytes;
+        return {r, static_cast<unsigned>(s % kGroupSlots), true};
     }
-    static bool stored(const std::uint8_t* r);
-    static void decode(const std::uint8_t* r, CoverageHit& hit, bool normal);
+    const std::uint8_t* cover_at(const Place& p) const {
+        return covers_ + (p.group * kGroupSlots + p.slot) * kCoverBytes;
+    }
+    const std::uint8_t* hit_at(const Place& p) const {
+        return hits_ + (p.group * kGroupSlots + p.slot) * kHitBytes;
+    }
+    static void decode(const std::uint8_t* cover, CoverageHit& hit, bool normal);
 };
 
 }  // namespace lat
