@@ -39,15 +39,20 @@ TEST_P(PairIndexOf, FilesTheValidPairsOneToOne) {
             ASSERT_EQ(x, a);
             ASSERT_EQ(y, b);
         }
-    // No other slot decodes to a pair; a plain tile's slots all do.
+    // No other slot decodes to a pair; filed() says the same, a tile at a time or a slot.
     for (std::uint64_t s = 0; s < index.slots(); ++s) {
         std::uint32_t x = 0, y = 0;
         ASSERT_EQ(index.pair_at(s, x, y), used[s] != 0) << s;
-        if (s % PairIndex::kTileSlots == 0 && index.plain_tile(s / PairIndex::kTileSlots)) {
-            for (int k = 0; k < PairIndex::kTileSlots; ++k) {
-                ASSERT_TRUE(used[s + static_cast<unsigned>(k)]) << s << " + " << k;
-            }
-        }
+        std::array<std::uint64_t, PairIndex::kTileSlots / 64> one{};
+        one[s % PairIndex::kTileSlots / 64] = std::uint64_t{1} << (s % 64);
+        ASSERT_EQ(index.filed(s / PairIndex::kTileSlots, one), used[s] != 0) << s;
+    }
+    for (std::uint64_t t = 0; t < index.slots() / PairIndex::kTileSlots; ++t) {
+        std::array<std::uint64_t, PairIndex::kTileSlots / 64> all{};
+        for (int k = 0; k < PairIndex::kTileSlots; ++k)
+            if (used[t * PairIndex::kTileSlots + static_cast<unsigned>(k)])
+                all[static_cast<unsigned>(k) / 64] |= std::uint64_t{1} << (k % 64);
+        EXPECT_TRUE(index.filed(t, all)) << t;
     }
     EXPECT_EQ(index.slot(grid.count(), 0), PairIndex::kNone);
     EXPECT_EQ(index.slot(0, grid.count()), PairIndex::kNone);

@@ -9,7 +9,6 @@
 #include <stdexcept>
 
 #include "lattice/bits/bit_array.h"
-
 #include "lattice/coverage.h"
 #include "lattice/octahedral.h"
 
@@ -194,12 +193,13 @@ void CoverageTable::check_records(const std::uint64_t* kept) {
         throw std::runtime_error(std::string("coverage payload: ") + why);
     };
     constexpr std::uint8_t kNoCover[kCoverBytes] = {};
+    static_assert(PairIndex::kTileSlots == 16 * kGroupSlots);  // a tile's bits: 16 of a word
     const std::uint64_t tiles = index_.slots() / PairIndex::kTileSlots;
     std::uint64_t count = 0, centers = 0, group = 0;
     for (std::uint64_t t = 0; t < tiles; ++t) {
         const auto in_tile = static_cast<unsigned>((kept[t / 4] >> (t % 4 * 16)) & 0xFFFF);
         if (!in_tile) continue;
-        const bool plain = index_.plain_tile(t);
+        std::array<std::uint64_t, PairIndex::kTileSlots / 64> stored{};
         for (unsigned g = 0; g < 16; ++g) {
             if (!((in_tile >> g) & 1u)) continue;
             int in_group = 0;
@@ -214,9 +214,8 @@ void CoverageTable::check_records(const std::uint64_t* kept) {
                 }
                 if ((tt != kNoHit && tt > kTScale) || field(c, kCoverT) > kTScale)
                     fail("a record out of range");
-                std::uint32_t a = 0, b = 0;
-                if (!plain && !index_.pair_at(t * PairIndex::kTileSlots + g * kGroupSlots + j, a, b))
-                    fail("a record where no pair is filed");
+                const unsigned inner = g * kGroupSlots + j;
+                stored[inner / 64] |= std::uint64_t{1} << (inner % 64);
                 ++in_group;
                 centers += tt != kNoHit;
                 partial_ += alpha > 0 && alpha < kAlphaScale;
@@ -226,6 +225,7 @@ void CoverageTable::check_records(const std::uint64_t* kept) {
             count += static_cast<unsigned>(in_group);
             ++group;
         }
+        if (!index_.filed(t, stored)) fail("a record where no pair is filed");
     }
     if (count != occupied_) fail("records do not match the header's count");
     if (centers != entries_) fail("hit count does not match the header");

@@ -45,7 +45,7 @@ public:
     enum Field { kT, kNu, kNv, kMeanT, kMeanNu, kMeanNv, kAlpha, kFields };
     static constexpr std::size_t kHitBytes = kMeanT * 2, kCoverBytes = (kFields - kMeanT) * 2;
     static constexpr std::uint16_t kNoHit = 0xFFFF;  // kT of a pair whose own segment misses
-    static constexpr int kGroupSlots = 16;
+    static constexpr int kGroupSlots = PairIndex::kCellSlots;
 
 private:
     // A line of the kept-group bits: the rank of its first bit and the 448 that follow.

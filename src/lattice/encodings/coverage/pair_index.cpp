@@ -1,5 +1,6 @@
 #include "lattice/encodings/coverage/pair_index.h"
 
+#include <bit>
 #include <cassert>
 
 namespace lat {
@@ -59,13 +60,17 @@ bool PairIndex::locate(std::uint64_t tile, int& block, std::uint32_t t[4]) const
 bool PairIndex::pair_at(std::uint64_t s, std::uint32_t& a, std::uint32_t& b) const {
     int block = 0;
     std::uint32_t t[4];
-    if (!locate(s / kTileSlots, block, t)) return false;
+    return locate(s / kTileSlots, block, t) &&
+           pair_in(block, t, static_cast<unsigned>(s % kTileSlots), a, b);
+}
+
+bool PairIndex::pair_in(int block, const std::uint32_t t[4], unsigned inner, std::uint32_t& a,
+                        std::uint32_t& b) const {
     const Block& k = blocks_[block];
-    const auto inner = static_cast<unsigned>(s % kTileSlots);
     const int f = block / 6, g = block % 6;
     GridPoint p[2];
     for (int i = 0; i < 4; ++i) {
-        const int c = static_cast<int>(t[i]) * kSide + static_cast<int>(((inner >> i) & 1) | ((inner >> (i + 3)) & 2));
+        const int c = coordinate(t, inner, i);
         if (c >= k.extent[i]) return false;  // the tile's padding
         const int face = i < 2 ? f : g;
         p[i / 2][kAxes[face][i % 2]] = c;
@@ -80,15 +85,27 @@ bool PairIndex::pair_at(std::uint64_t s, std::uint32_t& a, std::uint32_t& b) con
     return a != b && filed_faces(grid_.faces(p[0]), grid_.faces(p[1]), ff, gg) && ff == f && gg == g;
 }
 
-bool PairIndex::plain_tile(std::uint64_t tile) const {
+bool PairIndex::filed(std::uint64_t tile, const std::array<std::uint64_t, kTileSlots / 64>& slots) const {
     int block = 0;
     std::uint32_t t[4];
     if (!locate(tile, block, t)) return false;
-    // Its points are inside their faces (filed under them, no other choice) and short of the
-    // padding: coordinates 1 to extent - 2.
+    // A slot whose coordinates are all 1 to extent - 2 holds points inside their faces, filed
+    // under them (no other choice), short of the padding.
+    bool inner_only = true;
     for (int i = 0; i < 4; ++i)
-        if (t[i] == 0 || static_cast<int>(t[i]) * kSide + kSide > blocks_[block].extent[i] - 1)
-            return false;
+        inner_only = inner_only && t[i] > 0 && coordinate(t, 0xFF, i) < blocks_[block].extent[i] - 1;
+    if (inner_only) return true;
+    for (unsigned w = 0; w < slots.size(); ++w)
+        for (std::uint64_t bits = slots[w]; bits; bits &= bits - 1) {
+            const unsigned inner = w * 64 + static_cast<unsigned>(std::countr_zero(bits));
+            bool inside = true;
+            for (int i = 0; i < 4; ++i) {
+                const int c = coordinate(t, inner, i);
+                inside = inside && c > 0 && c < blocks_[block].extent[i] - 1;
+            }
+            std::uint32_t a = 0, b = 0;
+            if (!inside && !pair_in(block, t, inner, a, b)) return false;
+        }
     return true;
 }
 

@@ -28,7 +28,8 @@ public:
     static constexpr std::uint64_t kNone = ~std::uint64_t{0};
     static constexpr int kSide = 4;            // tile side along each coordinate
     static constexpr int kTileSlots = 256;     // kSide^4
-    static constexpr int kTileWords = kTileSlots / 64;
+    // 16 consecutive slots from a multiple of 16 are a 2 x 2 x 2 x 2 cell of the 4-D grid.
+    static constexpr int kCellSlots = 16;
 
     // Cells positive, at most 0xFFFF boundary points (the coverage encoding's max_points).
     explicit PairIndex(const std::array<int, 3>& cells);
@@ -53,9 +54,10 @@ public:
 
     // The pair filed at slot s, or false when no valid pair is.
     bool pair_at(std::uint64_t s, std::uint32_t& a, std::uint32_t& b) const;
-    // Whether every slot of the tile holds a valid pair: the tiles away from the faces' edges
-    // and from their padding (most of them), which opening a table need not check slot by slot.
-    bool plain_tile(std::uint64_t tile) const;
+    // Whether a pair is filed in every slot of the tile whose bit is set (bit k: slot
+    // tile * kTileSlots + k), for opening a table: quick for the slots inside their faces and
+    // short of the padding (most of them), slot by slot only on the faces' edges.
+    bool filed(std::uint64_t tile, const std::array<std::uint64_t, kTileSlots / 64>& slots) const;
 
     // The faces (f of a, g of b) a valid pair is filed under: a's lowest face and b's lowest
     // other than it, or, when b lies on that face alone, b's face and a's next one. False for
@@ -101,6 +103,13 @@ private:
 
     // The block and tile coordinates of a tile; false past the last tile.
     bool locate(std::uint64_t tile, int& block, std::uint32_t t[4]) const;
+    // pair_at for a located tile and a slot in it.
+    bool pair_in(int block, const std::uint32_t t[4], unsigned inner, std::uint32_t& a,
+                 std::uint32_t& b) const;
+    // Coordinate i (0 to 3) of a slot of the tile, from its Morton bits.
+    static int coordinate(const std::uint32_t t[4], unsigned inner, int i) {
+        return static_cast<int>(t[i]) * kSide + static_cast<int>(((inner >> i) & 1) | ((inner >> (i + 3)) & 2));
+    }
 };
 
 }  // namespace lat
