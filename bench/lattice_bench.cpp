@@ -136,7 +136,7 @@ const int lookups_registered = register_lookups();
 
 // Blends of the smooth filter, as FilteredLatticeShape::blend makes them: the 5 pairs on a
 // path through one cell of the 4-D (entry u, v; exit u, v) grid of two faces, each step moving
-// one coordinate by one; prefetched, then looked up together (coverage_many). Cells drawn at
+// one coordinate by one; located, then read (locate_coverage, coverage_at). Cells drawn at
 // random among those whose blend finds at least one stored pair (rays near the hair), over the
 // Plate 4 hair's coverage tables, taken from the table cache ($LATTICE_CACHE_DIR if set: the
 // tables at sigma^-1 = 4 take a minute or two to build).
@@ -200,8 +200,9 @@ void BM_Blend(benchmark::State& state, bool chained) {
         const auto& bl = b.blends[i & (b.blends.size() - 1)];
         lat::CoverageHit h[5];
         bool found[5];
-        b.table->prefetch_coverage(bl.data(), bl.data() + 5, 5);
-        b.table->coverage_many(bl.data(), bl.data() + 5, 5, h, found, true);
+        std::uint64_t ref[5];
+        b.table->locate_coverage(bl.data(), bl.data() + 5, 5, ref);
+        b.table->coverage_at(ref, 5, h, found, true);
         const auto n = static_cast<std::size_t>(std::count(found, found + 5, true));
         found_pairs += n;
         // n <= 5 and the alphas are at most 1: the step is 1 either way.

@@ -259,29 +259,25 @@ bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit)
     return true;
 }
 
-void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
-                                  CoverageHit* out, bool* found, bool normals) const {
-    // Two passes: the records are found through the rank lines (often in cache) and
-    // prefetched, then read, so that their cache misses overlap instead of following one another.
-    constexpr int kMax = 16;
-    const std::uint8_t* rec[kMax];
-    for (int base = 0; base < n; base += kMax) {
-        const int m = std::min(kMax, n - base);
-        for (int i = 0; i < m; ++i) {
-            const Place p = place(a[base + i], b[base + i]);
-            rec[i] = p.kept ? cover_at(p) : nullptr;
-            if (rec[i]) __builtin_prefetch(rec[i]);
-        }
-        for (int i = 0; i < m; ++i) {
-            found[base + i] = rec[i] && field(rec[i], kCoverAlpha) != 0;
-            if (found[base + i]) decode(rec[i], out[base + i], normals);
-        }
+void CoverageTable::locate_coverage(const std::uint32_t* a, const std::uint32_t* b, int n,
+                                    std::uint64_t* ref) const {
+    // The records are found through the rank lines (often in cache) and prefetched, so that
+    // their cache misses overlap instead of following one another.
+    for (int i = 0; i < n; ++i) {
+        const Place p = place(a[i], b[i]);
+        const std::uint8_t* c = p.kept ? cover_at(p) : nullptr;
+        if (c) __builtin_prefetch(c);
+        ref[i] = reinterpret_cast<std::uintptr_t>(c);
     }
 }
 
-void CoverageTable::prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const {
-    for (int i = 0; i < n; ++i)
-        if (const Place p = place(a[i], b[i]); p.kept) __builtin_prefetch(cover_at(p));
+void CoverageTable::coverage_at(const std::uint64_t* ref, int n, CoverageHit* out, bool* found,
+                                bool normals) const {
+    for (int i = 0; i < n; ++i) {
+        const auto* c = reinterpret_cast<const std::uint8_t*>(static_cast<std::uintptr_t>(ref[i]));
+        found[i] = c && field(c, kCoverAlpha) != 0;
+        if (found[i]) decode(c, out[i], normals);
+    }
 }
 
 std::string CoverageTable::details() const {

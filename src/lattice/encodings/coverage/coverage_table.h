@@ -33,9 +33,11 @@ public:
 
     bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const override;
     bool coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const override;
-    void coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n, CoverageHit* out,
-                       bool* found, bool normals) const override;
-    void prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const override;
+    // A handle is the address of the pair's coverage record, 0 when it has none.
+    void locate_coverage(const std::uint32_t* a, const std::uint32_t* b, int n,
+                         std::uint64_t* ref) const override;
+    void coverage_at(const std::uint64_t* ref, int n, CoverageHit* out, bool* found,
+                     bool normals) const override;
     std::string encoding() const override { return "coverage"; }
     std::string details() const override;
     std::uint64_t entries() const override { return entries_; }
