@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 
 #include "hook_primitive.h"
@@ -139,6 +140,26 @@ TEST(PairIndex, TableAnswersEveryPairAsItsInputs) {
             EXPECT_EQ(many.t, c.t);
             EXPECT_EQ(many.normal, c.normal);
         }
+}
+
+// A table of the layout before (tag COVER1, pairs indexed a * N + b) is refused, not misread
+// (the table cache never opens one: the layout is part of the file names it looks for).
+TEST(PairIndex, OlderLayoutIsRefused) {
+    const TableContext& ctx = test::kHookContext;
+    const Encoding& e = find_encoding("coverage");
+    RasterizeOptions opt;
+    opt.keep_hits = true;
+    const RasterizeResult raster = rasterize(ctx, opt);
+    ByteBuffer payload = e.build(raster.raw, ctx, {});
+    ASSERT_EQ(std::memcmp(payload.data(), "COVER2", 6), 0);
+    payload.data()[5] = '1';
+    try {
+        e.open(payload.data(), payload.size(), raster.hits, ctx);
+        FAIL() << "opened";
+    } catch (const std::runtime_error& err) {
+        EXPECT_NE(std::string(err.what()).find("older layout (COVER1)"), std::string::npos) << err.what();
+    }
+    EXPECT_GT(e.layout, 1);
 }
 
 }  // namespace
