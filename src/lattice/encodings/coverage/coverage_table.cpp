@@ -73,18 +73,19 @@ struct Entry {
     std::array<std::uint16_t, CoverageTable::kFields> f;
 };
 
-}  // namespace
-
-ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, const EncodeOptions&) {
-    const BoundaryGrid grid(ctx.cells);
-    const std::uint64_t n = grid.count();
+// The records of a table: the rasterized hits and the coverage samples merged by pair, filed
+// by slot (a stored pair is a valid one: rasterizing skips the others), in slot order.
+std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
+                                   const PairIndex& index) {
+    constexpr std::uint16_t kNoHit = CoverageTable::kNoHit;
+    const std::uint64_t n = index.grid().count();
     std::vector<Entry> entries;
     entries.reserve(hits.size());
     for (const auto& chunk : hits.chunks)
         for (const RawHit& h : chunk)
             entries.push_back({h.a * n + h.b, {quantise_t(h.t), h.nu, h.nv, 0, 0, 0, 0}});
-    std::sort(entries.begin(), entries.end(),
-              [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
+    const auto by_pair = [](const Entry& x, const Entry& y) { return x.pair < y.pair; };
+    std::sort(entries.begin(), entries.end(), by_pair);
     const std::size_t centers = entries.size();
     // Coverage samples come sorted by pair: merge them into the hits, adding the pairs whose
     // own segment misses.
@@ -99,25 +100,32 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
             entries.push_back({pair, {kNoHit, 0, 0, 0, 0, 0, 0}});
             e = &entries.back();
         }
-        e->f[kMeanT] = quantise_t(c.t);
-        e->f[kMeanNu] = c.nu, e->f[kMeanNv] = c.nv;
-        e->f[kAlpha] = static_cast<std::uint16_t>(std::lround(double(c.alpha) * kAlphaScale));
+        e->f[CoverageTable::kMeanT] = quantise_t(c.t);
+        e->f[CoverageTable::kMeanNu] = c.nu, e->f[CoverageTable::kMeanNv] = c.nv;
+        e->f[CoverageTable::kAlpha] = static_cast<std::uint16_t>(std::lround(double(c.alpha) * kAlphaScale));
     }
-    // Filed by slot; a stored pair is a valid one (rasterizing skips the others).
-    const PairIndex index(ctx.cells);
     for (Entry& e : entries) {
         e.pair = index.slot(static_cast<std::uint32_t>(e.pair / n), static_cast<std::uint32_t>(e.pair % n));
         if (e.pair == PairIndex::kNone) throw std::logic_error("coverage: a stored pair is not valid");
     }
-    std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
-    std::uint64_t groups = 0;
-    for (std::size_t i = 0; i < entries.size(); ++i)
-        groups += i == 0 || entries[i].pair / kGroupSlots != entries[i - 1].pair / kGroupSlots;
+    std::sort(entries.begin(), entries.end(), by_pair);
+    return entries;
+}
 
+}  // namespace
+
+ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, const EncodeOptions&) {
+    const PairIndex index(ctx.cells);
+    const std::vector<Entry> entries = entries_by_slot(hits, ctx, index);
+    std::uint64_t groups = 0, centers = 0;
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        groups += i == 0 || entries[i].pair / kGroupSlots != entries[i - 1].pair / kGroupSlots;
+        centers += entries[i].f[kT] != kNoHit;
+    }
     const Sections s = sections(index.slots(), groups);
     ByteBuffer out(s.total);
     std::memset(out.data(), 0, s.total);
-    const Header h{kMagic, static_cast<std::uint32_t>(n), kCoverageRays, entries.size(), centers,
+    const Header h{kMagic, index.grid().count(), kCoverageRays, entries.size(), centers,
                    index.slots(), groups, {}};
     std::memcpy(out.data(), &h, sizeof h);
     auto* kept = reinterpret_cast<std::uint64_t*>(out.data() + s.kept);
