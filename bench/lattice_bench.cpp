@@ -3,6 +3,9 @@
 #include <benchmark/benchmark.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <array>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -10,9 +13,10 @@
 #include <string>
 
 #include "lattice/boundary_grid.h"
+#include "lattice/cache/table_build.h"
+#include "lattice/cache/table_cache.h"
 #include "lattice/encoding.h"
 #include "render/renderer.h"
-#include "lattice/cache/table_build.h"
 #include "render/scene_lattices.h"
 #include "scene/scene_loader.h"
 
@@ -129,6 +133,85 @@ int register_lookups() {
     return 0;
 }
 const int lookups_registered = register_lookups();
+
+// Blends of the smooth filter, as FilteredLatticeShape::blend makes them: the 5 pairs on a
+// path through one cell of the 4-D (entry u, v; exit u, v) grid of two faces, each step moving
+// one coordinate by one; located, then read (locate_coverage, coverage_at). Cells drawn at
+// random among those whose blend finds at least one stored pair (rays near the hair), over the
+// Plate 4 hair's coverage tables, taken from the table cache ($LATTICE_CACHE_DIR if set: the
+// tables at sigma^-1 = 4 take a minute or two to build).
+struct BlendTable {
+    std::shared_ptr<const lat::LatticeTable> table;
+    std::vector<std::array<std::uint32_t, 10>> blends;  // a[5], then b[5]
+};
+
+BlendTable& blend_table(int k) {
+    static std::map<int, BlendTable> cache;
+    if (auto it = cache.find(k); it != cache.end()) return it->second;
+    static const lat::Scene scene = lat::load_scene(example("plate4-fuzzy-sphere-1000"));
+    lat::TableSpec spec;
+    spec.sigma_inv = k;
+    spec.encoding = "coverage";
+    const lat::TablePlan plan = lat::plan_table(scene.primitives.at(0), spec, scene.file);
+    const char* env = std::getenv("LATTICE_CACHE_DIR");
+    const lat::TableCache tables(env && *env ? env : cache_dir(), true);
+    BlendTable& b = cache[k];
+    b.table = tables.get(plan, false).table;
+    const lat::BoundaryGrid grid(plan.context.cells);
+    const auto& n = plan.context.cells;
+    std::mt19937 rng(7);
+    while (b.blends.size() < (1u << 18)) {
+        const int f = static_cast<int>(rng() % 6), g = static_cast<int>(rng() % 6);
+        if (f == g) continue;
+        int c[2][3];
+        int axis[4];
+        for (int e = 0; e < 2; ++e) {
+            const int face = e ? g : f, ax = face / 2;
+            c[e][ax] = face % 2 ? n[static_cast<std::size_t>(ax)] : 0;
+            for (int j = 1; j <= 2; ++j) {
+                const int a = (ax + j) % 3;
+                c[e][a] = static_cast<int>(rng() % static_cast<unsigned>(n[static_cast<std::size_t>(a)]));
+                axis[2 * e + j - 1] = a;
+            }
+        }
+        int order[4] = {0, 1, 2, 3};
+        std::shuffle(order, order + 4, rng);
+        std::array<std::uint32_t, 10> bl{};
+        for (int step = 0; step <= 4; ++step) {
+            bl[static_cast<std::size_t>(step)] = grid.id({c[0][0], c[0][1], c[0][2]});
+            bl[static_cast<std::size_t>(5 + step)] = grid.id({c[1][0], c[1][1], c[1][2]});
+            if (step < 4) ++c[order[step] / 2][axis[order[step]]];
+        }
+        lat::CoverageHit h[5];
+        bool found[5];
+        b.table->coverage_many(bl.data(), bl.data() + 5, 5, h, found, false);
+        if (std::count(found, found + 5, true)) b.blends.push_back(bl);
+    }
+    return b;
+}
+
+// chained: each blend's index depends on the previous one's answer (a ray's next visit waits
+// for its last one, whose sheet decides where its traversal goes), so that the processor cannot
+// overlap one blend's cache misses with the next one's: latency, not throughput.
+void BM_Blend(benchmark::State& state, bool chained) {
+    BlendTable& b = blend_table(static_cast<int>(state.range(0)));
+    std::size_t i = 0, found_pairs = 0;
+    for (auto _ : state) {
+        const auto& bl = b.blends[i & (b.blends.size() - 1)];
+        lat::CoverageHit h[5];
+        bool found[5];
+        std::uint64_t ref[5];
+        b.table->locate_coverage(bl.data(), bl.data() + 5, 5, ref);
+        b.table->coverage_at(ref, 5, h, found, true);
+        const auto n = static_cast<std::size_t>(std::count(found, found + 5, true));
+        found_pairs += n;
+        // n <= 5 and the alphas are at most 1: the step is 1 either way.
+        i += chained ? 1 + (n > 5 || h[0].alpha > 1.5 || h[4].alpha > 1.5) : 1;
+    }
+    state.counters["found_per_blend"] = double(found_pairs) / double(state.iterations());
+}
+BENCHMARK_CAPTURE(BM_Blend, independent, false)->Arg(1)->Arg(2)->Arg(4)->ArgName("sigma_inv")->Unit(benchmark::kNanosecond);
+BENCHMARK_CAPTURE(BM_Blend, chained, true)->Arg(1)->Arg(2)->Arg(4)->ArgName("sigma_inv")->Unit(benchmark::kNanosecond);
 
 struct Prepared {
     lat::Scene scene;

@@ -138,8 +138,8 @@ TEST(Coverage, TheTableAnswersTheCoverage) {
     EXPECT_NE(table->details().find("partly covered"), std::string::npos);
 }
 
-// The lookups the smooth filter makes (coverage_many, through the rank lines built at open)
-// find exactly the stored pairs, with or without their normals.
+// The lookups the smooth filter makes (coverage_many: locate_coverage, then coverage_at, as the
+// filtered shape calls them) find exactly the stored pairs, with or without their normals.
 TEST(Coverage, ManyLookupsFindExactlyTheStoredPairs) {
     const Encoding& e = find_encoding("coverage");
     const RasterizeResult r = rasterize(kContext);

@@ -40,6 +40,9 @@ struct Encoding {
     // Stores each pair's coverage besides its hit (LatticeTable::coverage): the tables that
     // filtered rendering (--filter) can use.
     bool coverage = false;
+    // The payload's layout, bumped when it changes. It is part of a table's fingerprint, so
+    // that a cached table of another layout is rebuilt (its file name differs), not misread.
+    int layout = 1;
 
     // The payload. `hits` are the rasterized hits when needs_hits (else empty); ctx.primitive
     // is set. Must not depend on the thread count.

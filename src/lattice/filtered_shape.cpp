@@ -132,7 +132,7 @@ void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, bool normal
                                      double tmin, Sheet& s) const {
     CoverageHit h[Blend::kMaxPairs];
     bool found[Blend::kMaxPairs];
-    l.table->coverage_many(b.ia, b.ib, b.n, h, found, normals);
+    l.table->coverage_at(b.ref, b.n, h, found, normals);
     // A pair answers with its first crossing; a ray that starts inside the box (a shadow ray
     // leaving a surface among the fur) can have that crossing behind it, and the pair then
     // answers with its last crossing, the first one of the reversed pair (as point-sampled
@@ -178,13 +178,14 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     // it blends them all the way (Plate 4: 33.6 dB, in the band only 32.6 dB).
     const bool smooth = filter_ == LatticeFilter::kSmooth;
     const double w_hi = lod_blend(level - double(lo), smooth ? kLodBlendBand : 1.0);
-    // The levels of weight above 0: their pairs are found first and their lookups started
+    // The levels of weight above 0: their pairs are found first and located in their tables
     // together, so that the cache misses of the two tables overlap.
     const std::size_t first = w_hi < 1 ? lo : lo + 1, last = w_hi > 0 ? lo + 1 : lo;
     Blend b[2];
     for (std::size_t i = first; i <= last; ++i) {
         blend(levels_[i], r, i == lo ? 1 - w_hi : w_hi, smooth, b[i - first]);
-        levels_[i].table->prefetch_coverage(b[i - first].ia, b[i - first].ib, b[i - first].n);
+        Blend& bi = b[i - first];
+        levels_[i].table->locate_coverage(bi.ia, bi.ib, bi.n, bi.ref);
     }
     Sheet s;
     for (std::size_t i = first; i <= last; ++i) add_blend(levels_[i], b[i - first], normal, r, tmin, s);

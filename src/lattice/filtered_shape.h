@@ -108,6 +108,7 @@ private:
         static constexpr int kMaxPairs = 5;
         int n = 0;
         std::uint32_t ia[kMaxPairs], ib[kMaxPairs];
+        std::uint64_t ref[kMaxPairs];  // the pairs located in the table (locate_coverage)
         GridPoint ca[kMaxPairs], cb[kMaxPairs];
         double w[kMaxPairs];
         void add(const BoundaryGrid& g, const GridPoint& a, const GridPoint& b, double weight) {

@@ -126,12 +126,28 @@ public:
     // when only alpha and t are wanted (shadow rays' transmittance): the normals may be left
     // unset.
     virtual void coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
-                               CoverageHit* out, bool* found, bool /*normals*/) const {
-        for (int i = 0; i < n; ++i) found[i] = coverage(a[i], b[i], out[i]);
+                               CoverageHit* out, bool* found, bool normals) const {
+        std::uint64_t ref[16];
+        for (int base = 0; base < n; base += 16) {
+            const int m = n - base < 16 ? n - base : 16;
+            locate_coverage(a + base, b + base, m, ref);
+            coverage_at(ref, m, out + base, found + base, normals);
+        }
     }
-    // A hint that coverage_many will soon be asked for these pairs: the table may start
-    // fetching what locates them, so that the lookups of several tables overlap.
-    virtual void prefetch_coverage(const std::uint32_t*, const std::uint32_t*, int) const {}
+    // coverage_many in two steps, so that the lookups of several tables overlap and pairs are
+    // found once: locate_coverage finds the n pairs (ref[i], a handle of the table's, valid
+    // while it is) and may start loading what coverage_at, later, reads. By default a handle
+    // is the pair itself.
+    virtual void locate_coverage(const std::uint32_t* a, const std::uint32_t* b, int n,
+                                 std::uint64_t* ref) const {
+        for (int i = 0; i < n; ++i) ref[i] = std::uint64_t{a[i]} << 32 | b[i];
+    }
+    virtual void coverage_at(const std::uint64_t* ref, int n, CoverageHit* out, bool* found,
+                             bool /*normals*/) const {
+        for (int i = 0; i < n; ++i)
+            found[i] = coverage(static_cast<std::uint32_t>(ref[i] >> 32),
+                                static_cast<std::uint32_t>(ref[i]), out[i]);
+    }
 
     virtual std::string encoding() const = 0;
     // Encoding-specific facts for `lattice inspect` (widths, counts), one line; may be empty.

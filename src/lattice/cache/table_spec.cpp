@@ -46,19 +46,22 @@ TablePlan plan_table(const Primitive& p, const TableSpec& spec, const std::strin
         const long long n = static_cast<long long>(p.lattice->cells[a]) * spec.sigma_inv;
         h.cells[a] = static_cast<int>(std::min<long long>(n, 0x7FFFFFFF));
     }
-    h.fingerprint = Fingerprint()
-                        .add(p.fingerprint)
-                        .add(h.sigma)
-                        .add(h.cells[0])
-                        .add(h.cells[1])
-                        .add(h.cells[2])
-                        .add(spec.sigma_inv)
-                        .add(h.encoding)
-                        .add(spec.options.max_point_error)
-                        .add(spec.options.max_normal_error_deg)
-                        .add(normals_name(spec.options.normals))
-                        .add(kRasterizerVersion)
-                        .value();
+    Fingerprint f;
+    f.add(p.fingerprint)
+        .add(h.sigma)
+        .add(h.cells[0])
+        .add(h.cells[1])
+        .add(h.cells[2])
+        .add(spec.sigma_inv)
+        .add(h.encoding)
+        .add(spec.options.max_point_error)
+        .add(spec.options.max_normal_error_deg)
+        .add(normals_name(spec.options.normals))
+        .add(kRasterizerVersion);
+    // Layout 1 is left out: the tables of the encodings whose payload never changed keep their
+    // names.
+    if (plan.encoding->layout != 1) f.add(plan.encoding->layout);
+    h.fingerprint = f.value();
     h.metadata = nlohmann::json{{"primitive", p.name},
                                 {"definition", nlohmann::json::parse(p.definition)},
                                 {"scene", scene_file}}

@@ -10,13 +10,16 @@ const Encoding kCoverageEncoding{
     .name = "coverage",
     .summary = "prefiltered: per ordered pair its hit and its coverage (share of the rays "
                "snapping to it that meet the primitive, their mean hit), for --filter",
-    // Ordered pairs are indexed densely: N^2 occupancy bits, 512 MB at this many points.
+    // A point's tile on a face then fits the 24 bits pair_index.h gives it, and the slots
+    // (about N^2: the valid pairs and the tiles' padding) stay few enough to index.
     .max_points = 0xFFFFull,
     // While building: the rasterized hit (20 bytes), about 1.5 coverage samples of 20 bytes, and
-    // the record (14 bytes), per stored hit.
-    .bytes_per_hit = 64.0,
+    // the records (14 bytes, up to twice that with the empty slots of their groups), per stored
+    // hit.
+    .bytes_per_hit = 72.0,
     .needs_hits = true,
     .coverage = true,
+    .layout = 2,  // 2: pairs filed by face pair in tiles (pair_index.h); 1: a * N + b
     .build = &CoverageTable::build,
     .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                const TableContext& ctx) -> std::unique_ptr<LatticeTable> {

@@ -1,44 +1,59 @@
 #include "lattice/encodings/coverage/coverage_table.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
 
+#include "lattice/bits/bit_array.h"
 #include "lattice/coverage.h"
 #include "lattice/octahedral.h"
 
 namespace lat {
 namespace {
 
-constexpr std::uint64_t kMagic = 0x3152'4556'4F43ull;  // "COVER1"
-constexpr std::size_t kRecordBytes = CoverageTable::kRecordBytes;
+constexpr std::uint64_t kMagic = 0x3252'4556'4F43ull;  // "COVER2"
+// The layout before (pairs indexed a * N + b, with a rank directory): refused with a word on
+// what to do (the table cache never meets one: Encoding::layout is in its file names).
+constexpr std::uint64_t kOldMagic = 0x3152'4556'4F43ull;  // "COVER1"
+constexpr std::size_t kHitBytes = CoverageTable::kHitBytes, kCoverBytes = CoverageTable::kCoverBytes;
+constexpr int kGroupSlots = CoverageTable::kGroupSlots;
 constexpr double kTScale = 65534.0;
 constexpr double kAlphaScale = 65535.0;
+// A coverage record's fields.
+enum { kCoverT, kCoverNu, kCoverNv, kCoverAlpha };
 
 struct Header {
     std::uint64_t magic;
     std::uint32_t points, rays;  // boundary points; sub-rays per pair
-    std::uint64_t occupied;      // records
-    std::uint64_t center_hits;   // records whose own segment hits (the table's entries)
-    std::uint64_t reserved[4];
+    std::uint64_t occupied;      // stored pairs
+    std::uint64_t center_hits;   // those whose own segment hits (the table's entries)
+    std::uint64_t slots;         // PairIndex::slots() of the lattice
+    std::uint64_t groups;        // groups of 16 slots kept
+    std::uint64_t reserved[2];
 };
 static_assert(sizeof(Header) == 64);
 
-std::uint64_t padded8(std::uint64_t bytes) { return (bytes + 7) / 8 * 8; }
+std::uint64_t padded(std::uint64_t bytes, std::uint64_t to) { return (bytes + to - 1) / to * to; }
 
+// The payload: the header, a bit per group of 16 slots (kept or not), the kept groups'
+// coverage records, then their hit records (16 a group, in slot order). The coverage records
+// start on a cache line (a payload starts 128 bytes into its file, read or mapped at a page),
+// so that a group's are two whole lines.
 struct Sections {
-    std::uint64_t nwords, occ, counts, records, total;
+    std::uint64_t nwords, kept, covers, hits, total;
 };
 
-Sections sections(std::uint64_t points, std::uint64_t occupied) {
+Sections sections(std::uint64_t slots, std::uint64_t groups) {
     Sections s{};
-    s.nwords = words_for_bits(points * points);
-    s.occ = sizeof(Header);
-    s.counts = s.occ + s.nwords * 8;
-    s.records = s.counts + padded8(RankIndex::count_entries(s.nwords) * 4);
-    s.total = s.records + padded8(occupied * kRecordBytes);
+    s.nwords = words_for_bits(slots / kGroupSlots);
+    s.kept = sizeof(Header);
+    s.covers = padded(s.kept + s.nwords * 8, 64);
+    s.hits = s.covers + groups * kGroupSlots * kCoverBytes;
+    s.total = padded(s.hits + groups * kGroupSlots * kHitBytes, 8);
     return s;
 }
 
@@ -58,18 +73,19 @@ struct Entry {
     std::array<std::uint16_t, CoverageTable::kFields> f;
 };
 
-}  // namespace
-
-ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, const EncodeOptions&) {
-    const BoundaryGrid grid(ctx.cells);
-    const std::uint64_t n = grid.count();
+// The records of a table: the rasterized hits and the coverage samples merged by pair, filed
+// by slot (a stored pair is a valid one: rasterizing skips the others), in slot order.
+std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
+                                   const PairIndex& index) {
+    constexpr std::uint16_t kNoHit = CoverageTable::kNoHit;
+    const std::uint64_t n = index.grid().count();
     std::vector<Entry> entries;
     entries.reserve(hits.size());
     for (const auto& chunk : hits.chunks)
         for (const RawHit& h : chunk)
             entries.push_back({h.a * n + h.b, {quantise_t(h.t), h.nu, h.nv, 0, 0, 0, 0}});
-    std::sort(entries.begin(), entries.end(),
-              [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
+    const auto by_pair = [](const Entry& x, const Entry& y) { return x.pair < y.pair; };
+    std::sort(entries.begin(), entries.end(), by_pair);
     const std::size_t centers = entries.size();
     // Coverage samples come sorted by pair: merge them into the hits, adding the pairs whose
     // own segment misses.
@@ -84,143 +100,202 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
             entries.push_back({pair, {kNoHit, 0, 0, 0, 0, 0, 0}});
             e = &entries.back();
         }
-        e->f[kMeanT] = quantise_t(c.t);
-        e->f[kMeanNu] = c.nu, e->f[kMeanNv] = c.nv;
-        e->f[kAlpha] = static_cast<std::uint16_t>(std::lround(double(c.alpha) * kAlphaScale));
+        e->f[CoverageTable::kMeanT] = quantise_t(c.t);
+        e->f[CoverageTable::kMeanNu] = c.nu, e->f[CoverageTable::kMeanNv] = c.nv;
+        e->f[CoverageTable::kAlpha] = static_cast<std::uint16_t>(std::lround(double(c.alpha) * kAlphaScale));
     }
-    std::inplace_merge(entries.begin(), entries.begin() + static_cast<std::ptrdiff_t>(centers),
-                       entries.end(), [](const Entry& x, const Entry& y) { return x.pair < y.pair; });
+    for (Entry& e : entries) {
+        e.pair = index.slot(static_cast<std::uint32_t>(e.pair / n), static_cast<std::uint32_t>(e.pair % n));
+        if (e.pair == PairIndex::kNone) throw std::logic_error("coverage: a stored pair is not valid");
+    }
+    std::sort(entries.begin(), entries.end(), by_pair);
+    return entries;
+}
 
-    const Sections s = sections(n, entries.size());
+}  // namespace
+
+ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, const EncodeOptions&) {
+    const PairIndex index(ctx.cells);
+    const std::vector<Entry> entries = entries_by_slot(hits, ctx, index);
+    std::uint64_t groups = 0, centers = 0;
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        groups += i == 0 || entries[i].pair / kGroupSlots != entries[i - 1].pair / kGroupSlots;
+        centers += entries[i].f[kT] != kNoHit;
+    }
+    const Sections s = sections(index.slots(), groups);
     ByteBuffer out(s.total);
     std::memset(out.data(), 0, s.total);
-    const Header h{kMagic, static_cast<std::uint32_t>(n), kCoverageRays, entries.size(), centers, {}};
+    const Header h{kMagic, index.grid().count(), kCoverageRays, entries.size(), centers,
+                   index.slots(), groups, {}};
     std::memcpy(out.data(), &h, sizeof h);
-    auto* occ = reinterpret_cast<std::uint64_t*>(out.data() + s.occ);
-    std::uint8_t* rec = out.data() + s.records;
-    for (const Entry& e : entries) {
-        occ[e.pair >> 6] |= std::uint64_t{1} << (e.pair & 63);
-        std::memcpy(rec, e.f.data(), kRecordBytes);
-        rec += kRecordBytes;
+    auto* kept = reinterpret_cast<std::uint64_t*>(out.data() + s.kept);
+    std::uint64_t k = 0;  // the group being written, among the kept ones
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        const std::uint64_t g = entries[i].pair / kGroupSlots;
+        const bool first = i == 0 || g != entries[i - 1].pair / kGroupSlots;
+        if (first && i > 0) ++k;
+        std::uint8_t* hit = out.data() + s.hits + k * kGroupSlots * kHitBytes;
+        if (first) {
+            kept[g / 64] |= std::uint64_t{1} << (g % 64);
+            // The empty slots' hit records say no hit (their coverage records, all 0, no alpha).
+            for (int j = 0; j < kGroupSlots; ++j) std::memcpy(hit + j * kHitBytes, &kNoHit, 2);
+        }
+        const std::uint64_t j = entries[i].pair % kGroupSlots;
+        std::memcpy(hit + j * kHitBytes, entries[i].f.data(), kHitBytes);
+        std::memcpy(out.data() + s.covers + (k * kGroupSlots + j) * kCoverBytes,
+                    entries[i].f.data() + kMeanT, kCoverBytes);
     }
-    RankIndex::build(occ, s.nwords, reinterpret_cast<std::uint32_t*>(out.data() + s.counts));
     return out;
 }
 
 CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                              const TableContext& ctx)
-    : entries_(entries), size_(size) {
+    : index_(ctx.cells), entries_(entries), size_(size) {
     auto fail = [](const char* why) {
         throw std::runtime_error(std::string("coverage payload: ") + why);
     };
     if (size < sizeof(Header)) fail("shorter than its header");
     Header h;
     std::memcpy(&h, payload, sizeof h);
+    if (h.magic == kOldMagic) fail("an older layout (COVER1); rebuild the table");
     if (h.magic != kMagic) fail("bad tag");
-    const BoundaryGrid grid(ctx.cells);
-    if (h.points != grid.count()) fail("boundary point count differs from the lattice's");
+    if (h.points != index_.grid().count()) fail("boundary point count differs from the lattice's");
+    if (h.slots != index_.slots()) fail("slot count differs from the lattice's");
     if (h.rays != kCoverageRays) fail("sampled with a different number of sub-rays");
     if (h.center_hits != entries || h.occupied < entries || h.occupied > (std::uint64_t{1} << 40))
         fail("record counts inconsistent with the header");
-    const Sections s = sections(h.points, h.occupied);
+    if (h.groups > h.occupied) fail("more kept groups than stored pairs");
+    const Sections s = sections(h.slots, h.groups);
     if (s.total != size) fail("size does not match its counts");
-    const auto* occ = reinterpret_cast<const std::uint64_t*>(payload + s.occ);
-    const auto* counts = reinterpret_cast<const std::uint32_t*>(payload + s.counts);
-    if (!RankIndex::valid(occ, s.nwords, counts)) fail("rank directory does not match");
-    if (counts[(s.nwords + RankIndex::kBlockWords - 1) / RankIndex::kBlockWords] != h.occupied)
-        fail("occupancy does not match the record count");
-    // Pairs beyond N^2 in the last word would index records of no pair.
-    if (h.points && (static_cast<std::uint64_t>(h.points) * h.points) % 64 &&
-        (occ[s.nwords - 1] >> ((static_cast<std::uint64_t>(h.points) * h.points) % 64)))
-        fail("occupancy bits past the last pair");
-    points_ = h.points;
     occupied_ = h.occupied;
-    const std::uint64_t nlines = (s.nwords + RankLine::kWords - 1) / RankLine::kWords;
+    kept_groups_ = h.groups;
+    const auto* kept = reinterpret_cast<const std::uint64_t*>(payload + s.kept);
+    if (build_lines(kept, s.nwords) != h.groups) fail("kept groups do not match the header's count");
+    // Bits past the last group would keep groups of no slot.
+    if ((h.slots / kGroupSlots) % 64 && kept[s.nwords - 1] >> ((h.slots / kGroupSlots) % 64))
+        fail("kept-group bits past the last group");
+    covers_ = payload + s.covers;
+    hits_ = payload + s.hits;
+    check_records(kept);
+}
+
+// Returns the set bits in all.
+std::uint64_t CoverageTable::build_lines(const std::uint64_t* kept, std::uint64_t nwords) {
+    const std::uint64_t nlines = (nwords + RankLine::kWords - 1) / RankLine::kWords;
     lines_ = std::make_unique<RankLine[]>(nlines);
     size_ += nlines * sizeof(RankLine);
     std::uint64_t below = 0;
-    for (std::uint64_t w = 0; w < s.nwords; ++w) {
+    for (std::uint64_t w = 0; w < nlines * RankLine::kWords; ++w) {
         RankLine& l = lines_[w / RankLine::kWords];
         if (w % RankLine::kWords == 0) l.base = below;
-        l.bits[w % RankLine::kWords] = occ[w];
-        below += static_cast<std::uint64_t>(std::popcount(occ[w]));
+        l.bits[w % RankLine::kWords] = w < nwords ? kept[w] : 0;
+        below += static_cast<std::uint64_t>(std::popcount(l.bits[w % RankLine::kWords]));
     }
-    records_ = payload + s.records;
-    std::uint64_t centers = 0;
-    for (std::uint64_t i = 0; i < occupied_; ++i) {
-        const std::uint8_t* r = records_ + i * kRecordBytes;
-        const std::uint16_t t = field(r, kT), alpha = field(r, kAlpha);
-        if ((t != kNoHit && t > kTScale) || field(r, kMeanT) > kTScale || (t == kNoHit && alpha == 0))
-            fail("a record out of range");
-        centers += t != kNoHit;
-        partial_ += alpha > 0 && alpha < kAlphaScale;
-        alpha_sum_ += alpha / kAlphaScale;
-    }
-    if (centers != entries) fail("hit count does not match the header");
+    return below;
 }
 
-const std::uint8_t* CoverageTable::record(std::uint32_t a, std::uint32_t b) const {
-    const std::uint64_t i = pair_index(a, b);
-    return i == ~0ull ? nullptr : record_at(i);
+// Each slot of a kept group stored or empty; stored pairs' records in range, on a slot where a
+// pair is filed, as many as the header says; no kept group empty.
+void CoverageTable::check_records(const std::uint64_t* kept) {
+    auto fail = [](const char* why) {
+        throw std::runtime_error(std::string("coverage payload: ") + why);
+    };
+    constexpr std::uint8_t kNoCover[kCoverBytes] = {};
+    static_assert(PairIndex::kTileSlots == 16 * kGroupSlots);  // a tile's bits: 16 of a word
+    const std::uint64_t tiles = index_.slots() / PairIndex::kTileSlots;
+    std::uint64_t count = 0, centers = 0, group = 0;
+    for (std::uint64_t t = 0; t < tiles; ++t) {
+        const auto in_tile = static_cast<unsigned>((kept[t / 4] >> (t % 4 * 16)) & 0xFFFF);
+        if (!in_tile) continue;
+        std::array<std::uint64_t, PairIndex::kTileSlots / 64> stored{};
+        for (unsigned g = 0; g < 16; ++g) {
+            if (!((in_tile >> g) & 1u)) continue;
+            int in_group = 0;
+            for (unsigned j = 0; j < kGroupSlots; ++j) {
+                const Place p{group, j, true};
+                const std::uint8_t *c = cover_at(p), *h = hit_at(p);
+                const std::uint16_t tt = field(h, kT), alpha = field(c, kCoverAlpha);
+                if (tt == kNoHit && alpha == 0) {
+                    if (field(h, kNu) || field(h, kNv) || std::memcmp(c, kNoCover, kCoverBytes))
+                        fail("an empty slot's records not empty");
+                    continue;
+                }
+                if ((tt != kNoHit && tt > kTScale) || field(c, kCoverT) > kTScale)
+                    fail("a record out of range");
+                const unsigned inner = g * kGroupSlots + j;
+                stored[inner / 64] |= std::uint64_t{1} << (inner % 64);
+                ++in_group;
+                centers += tt != kNoHit;
+                partial_ += alpha > 0 && alpha < kAlphaScale;
+                alpha_sum_ += alpha / kAlphaScale;
+            }
+            if (!in_group) fail("a kept group without records");
+            count += static_cast<unsigned>(in_group);
+            ++group;
+        }
+        if (!index_.filed(t, stored)) fail("a record where no pair is filed");
+    }
+    if (count != occupied_) fail("records do not match the header's count");
+    if (centers != entries_) fail("hit count does not match the header");
+}
+
+CoverageTable::Place CoverageTable::place(std::uint32_t a, std::uint32_t b) const {
+    const std::uint64_t s = index_.slot(a, b);
+    return s == PairIndex::kNone ? Place{0, 0, false} : place_of(s);
 }
 
 bool CoverageTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
-    const std::uint8_t* r = record(a, b);
-    if (!r || field(r, kT) == kNoHit) return false;
-    hit.t = field(r, kT) / kTScale;
-    hit.normal = oct_decode({field(r, kNu), field(r, kNv)}, kRawNormalBits);
+    const Place p = place(a, b);
+    if (!p.kept) return false;
+    const std::uint8_t* h = hit_at(p);
+    if (field(h, kT) == kNoHit) return false;
+    hit.t = field(h, kT) / kTScale;
+    hit.normal = oct_decode({field(h, kNu), field(h, kNv)}, kRawNormalBits);
     return true;
 }
 
-void CoverageTable::decode(const std::uint8_t* r, CoverageHit& hit, bool normal) {
-    hit.alpha = field(r, kAlpha) / kAlphaScale;
-    hit.t = field(r, kMeanT) / kTScale;
-    if (normal) hit.normal = oct_decode({field(r, kMeanNu), field(r, kMeanNv)}, kRawNormalBits);
+void CoverageTable::decode(const std::uint8_t* c, CoverageHit& hit, bool normal) {
+    hit.alpha = field(c, kCoverAlpha) / kAlphaScale;
+    hit.t = field(c, kCoverT) / kTScale;
+    if (normal) hit.normal = oct_decode({field(c, kCoverNu), field(c, kCoverNv)}, kRawNormalBits);
 }
 
 bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const {
-    const std::uint8_t* r = record(a, b);
-    if (!r || field(r, kAlpha) == 0) return false;
-    decode(r, hit, true);
+    const Place p = place(a, b);
+    if (!p.kept || field(cover_at(p), kCoverAlpha) == 0) return false;
+    decode(cover_at(p), hit, true);
     return true;
 }
 
-void CoverageTable::coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n,
-                                  CoverageHit* out, bool* found, bool normals) const {
-    // Three passes, each prefetching what the next reads, so that the cache misses of the pairs
-    // (rank line, record: two a pair in a table of hundreds of MB) overlap instead of following
-    // one another.
-    constexpr int kMax = 16;
-    std::uint64_t idx[kMax];
-    const std::uint8_t* rec[kMax];
-    for (int base = 0; base < n; base += kMax) {
-        const int m = std::min(kMax, n - base);
-        for (int i = 0; i < m; ++i) idx[i] = pair_index(a[base + i], b[base + i]);
-        prefetch_coverage(a + base, b + base, m);
-        for (int i = 0; i < m; ++i) {
-            rec[i] = idx[i] != ~0ull ? record_at(idx[i]) : nullptr;
-            if (rec[i]) __builtin_prefetch(rec[i]);
-        }
-        for (int i = 0; i < m; ++i) {
-            found[base + i] = rec[i] && field(rec[i], kAlpha) != 0;
-            if (found[base + i]) decode(rec[i], out[base + i], normals);
-        }
+void CoverageTable::locate_coverage(const std::uint32_t* a, const std::uint32_t* b, int n,
+                                    std::uint64_t* ref) const {
+    // The records are found through the rank lines (often in cache) and prefetched, so that
+    // their cache misses overlap instead of following one another.
+    for (int i = 0; i < n; ++i) {
+        const Place p = place(a[i], b[i]);
+        const std::uint8_t* c = p.kept ? cover_at(p) : nullptr;
+        if (c) __builtin_prefetch(c);
+        ref[i] = reinterpret_cast<std::uintptr_t>(c);
     }
 }
 
-void CoverageTable::prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const {
+void CoverageTable::coverage_at(const std::uint64_t* ref, int n, CoverageHit* out, bool* found,
+                                bool normals) const {
     for (int i = 0; i < n; ++i) {
-        const std::uint64_t idx = pair_index(a[i], b[i]);
-        if (idx != ~0ull) __builtin_prefetch(line_of(idx));
+        const auto* c = reinterpret_cast<const std::uint8_t*>(static_cast<std::uintptr_t>(ref[i]));
+        found[i] = c && field(c, kCoverAlpha) != 0;
+        if (found[i]) decode(c, out[i], normals);
     }
 }
 
 std::string CoverageTable::details() const {
     char buf[256];
     std::snprintf(buf, sizeof buf,
-                  "%llu records, %d sub-rays a pair; coverage: %llu pairs partly covered "
-                  "(0 < alpha < 1), %.0f pairs' worth in all, %.3f records per hit",
-                  static_cast<unsigned long long>(occupied_), kCoverageRays,
+                  "%llu records (in %llu groups of 16 slots), %d sub-rays a pair; coverage: %llu "
+                  "pairs partly covered (0 < alpha < 1), %.0f pairs' worth in all, %.3f records "
+                  "per hit",
+                  static_cast<unsigned long long>(occupied_),
+                  static_cast<unsigned long long>(kept_groups_), kCoverageRays,
                   static_cast<unsigned long long>(partial_), alpha_sum_,
                   entries_ ? double(occupied_) / double(entries_) : 0.0);
     return buf;

@@ -3,16 +3,24 @@
 // hit of the pair's own segment, as every table does (lookup: what point sampling, CSG, inside
 // tests and certification use), and the pair's coverage (lattice/coverage.h): the share of the
 // sub-rays snapping to the pair that meet the primitive and their mean hit, which filtered
-// rendering uses. Pairs are indexed densely, a * N + b for N boundary points, by occupancy bits
-// and a rank directory (read through rank lines built at open); a record is seven 16-bit fields
-// (alpha in 1/65535).
+// rendering uses. Each is a record of 16-bit fields: the hit's t and normal (6 bytes), the
+// coverage's mean t, mean normal and alpha in 1/65535 (8 bytes).
+//
+// Pairs are filed in slots where neighbours in ray space are neighbours in memory (pair_index.h:
+// tiles of 256 slots, each 16 consecutive slots a 2 x 2 x 2 x 2 cell of the 4-D grid of entry
+// and exit points). Records are kept densely for every group of 16 slots that holds a stored
+// pair (an empty slot's records say so), with a bit per group saying whether it is kept; the
+// groups' coverage records (128 bytes a group: two cache lines) apart from their hits, which
+// filtered rendering does not read. Read through rank lines built at open (a line: the rank
+// of its first bit and 448 bits; 1 MB at sigma^-1 = 4 for Plate 4's hair, where one bit per
+// pair took 16 MB), a pair's record is found from a line that is often in cache: about one
+// cache miss a pair instead of two.
 #include <bit>
 #include <cstdint>
 #include <memory>
 
-#include "lattice/bits/bit_array.h"
-#include "lattice/boundary_grid.h"
 #include "lattice/encoding.h"
+#include "lattice/encodings/coverage/pair_index.h"
 #include "lattice/table.h"
 
 namespace lat {
@@ -25,59 +33,69 @@ public:
 
     bool lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const override;
     bool coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const override;
-    void coverage_many(const std::uint32_t* a, const std::uint32_t* b, int n, CoverageHit* out,
-                       bool* found, bool normals) const override;
-    void prefetch_coverage(const std::uint32_t* a, const std::uint32_t* b, int n) const override;
+    // A handle is the address of the pair's coverage record, 0 when it has none.
+    void locate_coverage(const std::uint32_t* a, const std::uint32_t* b, int n,
+                         std::uint64_t* ref) const override;
+    void coverage_at(const std::uint64_t* ref, int n, CoverageHit* out, bool* found,
+                     bool normals) const override;
     std::string encoding() const override { return "coverage"; }
     std::string details() const override;
     std::uint64_t entries() const override { return entries_; }
     std::uint64_t bytes() const override { return size_; }
 
-    // The record fields, in this order.
+    // The fields of a pair, in this order: its hit record, then its coverage record.
     enum Field { kT, kNu, kNv, kMeanT, kMeanNu, kMeanNv, kAlpha, kFields };
-    static constexpr std::size_t kRecordBytes = kFields * 2;
+    static constexpr std::size_t kHitBytes = kMeanT * 2, kCoverBytes = (kFields - kMeanT) * 2;
     static constexpr std::uint16_t kNoHit = 0xFFFF;  // kT of a pair whose own segment misses
+    static constexpr int kGroupSlots = PairIndex::kCellSlots;
 
 private:
-    // The occupancy bits as rendering reads them: a cache line holds the rank of its first bit
-    // and the 448 bits that follow, so that finding a pair's record takes one line besides the
-    // record (the file's occupancy words and rank directory, apart, took two: each a cache miss
-    // in tables of hundreds of MB). Built from the file's (checked) ones at open.
+    // A line of the kept-group bits: the rank of its first bit and the 448 that follow.
     struct alignas(64) RankLine {
         static constexpr std::uint64_t kWords = 7, kBits = kWords * 64;
-        std::uint64_t base;  // set bits before this line's first
+        std::uint64_t base;  // kept groups before this line's first
         std::uint64_t bits[kWords];
     };
     static_assert(sizeof(RankLine) == 64);
-    std::uint32_t points_ = 0;
-    std::uint64_t occupied_ = 0;
+    // Where a slot's records are: its group's rank among the kept ones, and its place in it.
+    struct Place {
+        std::uint64_t group;
+        unsigned slot;
+        bool kept;
+    };
+    PairIndex index_;
     std::unique_ptr<RankLine[]> lines_;
-    const std::uint8_t* records_ = nullptr;
+    const std::uint8_t* covers_ = nullptr;  // kGroupSlots coverage records a kept group
+    const std::uint8_t* hits_ = nullptr;    // kGroupSlots hit records a kept group
+    std::uint64_t occupied_ = 0, kept_groups_ = 0;
     std::uint64_t entries_;
     std::size_t size_;  // the payload's and the rank lines'
     // Coverage statistics for `inspect`, gathered when the records are checked at open.
     std::uint64_t partial_ = 0;
     double alpha_sum_ = 0;
 
-    const std::uint8_t* record(std::uint32_t a, std::uint32_t b) const;
-    // The record of dense pair index i (below points_^2), or null when the pair is not stored.
-    const std::uint8_t* record_at(std::uint64_t i) const {
-        const RankLine& l = lines_[i / RankLine::kBits];
-        const auto off = static_cast<unsigned>(i % RankLine::kBits);
+    std::uint64_t build_lines(const std::uint64_t* kept, std::uint64_t nwords);
+    void check_records(const std::uint64_t* kept);
+    Place place(std::uint32_t a, std::uint32_t b) const;
+    Place place_of(std::uint64_t s) const {
+        const std::uint64_t g = s / kGroupSlots;
+        const RankLine& l = lines_[g / RankLine::kBits];
+        const auto off = static_cast<unsigned>(g % RankLine::kBits);
         const unsigned w = off >> 6, bit = off & 63;
         const std::uint64_t word = l.bits[w];
-        if (!((word >> bit) & 1)) return nullptr;
+        if (!((word >> bit) & 1)) return {0, 0, false};
         std::uint64_t r = l.base + static_cast<std::uint64_t>(
                                        std::popcount(word & ((std::uint64_t{1} << bit) - 1)));
         for (unsigned k = 0; k < w; ++k) r += static_cast<std::uint64_t>(std::popcount(l.bits[k]));
-        return records_ + r * kRecordBytes;
+        return {r, static_cast<unsigned>(s % kGroupSlots), true};
     }
-    const RankLine* line_of(std::uint64_t i) const { return &lines_[i / RankLine::kBits]; }
-    // The dense index of pair (a, b), or ~0 when a point is out of range.
-    std::uint64_t pair_index(std::uint32_t a, std::uint32_t b) const {
-        return a < points_ && b < points_ ? static_cast<std::uint64_t>(a) * points_ + b : ~0ull;
+    const std::uint8_t* cover_at(const Place& p) const {
+        return covers_ + (p.group * kGroupSlots + p.slot) * kCoverBytes;
     }
-    static void decode(const std::uint8_t* r, CoverageHit& hit, bool normal);
+    const std::uint8_t* hit_at(const Place& p) const {
+        return hits_ + (p.group * kGroupSlots + p.slot) * kHitBytes;
+    }
+    static void decode(const std::uint8_t* cover, CoverageHit& hit, bool normal);
 };
 
 }  // namespace lat
