@@ -101,7 +101,7 @@ def main():
     ap.add_argument("--only", default="")
     ap.add_argument("--gt-spp", type=int, default=256)
     a = ap.parse_args()
-    os.makedirs(a.work, exist_ok=True)
+    os.makedirs(os.path.join(a.work, "cache"), exist_ok=True)
     os.makedirs(a.results, exist_ok=True)
     names = [n for n in SCENES if not a.only or any(o in n for o in a.only.split(","))]
     results = {"runs": a.runs, "gt_spp": a.gt_spp,
