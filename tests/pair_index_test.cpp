@@ -96,16 +96,28 @@ TEST(PairIndex, NeighboursInRaySpaceAreNearInMemory) {
     EXPECT_GE(same_tile * 4, steps * 3);
 }
 
+// The hook's coverage table as built, with what it was built from.
+struct HookTable {
+    RasterizeResult raster;
+    ByteBuffer payload;
+};
+HookTable hook_table() {
+    RasterizeOptions opt;
+    opt.keep_hits = true;
+    HookTable h{rasterize(test::kHookContext, opt), {}};
+    h.payload = find_encoding("coverage").build(h.raster.raw, test::kHookContext, {});
+    return h;
+}
+
 // Every pair of the hook's table, through the index: its own hit as rasterized and its
 // coverage as sampled, quantised as the table keeps them; the other pairs not found.
 TEST(PairIndex, TableAnswersEveryPairAsItsInputs) {
     const TableContext& ctx = test::kHookContext;
     const Encoding& e = find_encoding("coverage");
-    RasterizeOptions opt;
-    opt.keep_hits = true;
-    const RasterizeResult raster = rasterize(ctx, opt);
-    const ByteBuffer payload = e.build(raster.raw, ctx, {});
-    const std::unique_ptr<LatticeTable> table = e.open(payload.data(), payload.size(), raster.hits, ctx);
+    const HookTable hook = hook_table();
+    const RasterizeResult& raster = hook.raster;
+    const std::unique_ptr<LatticeTable> table =
+        e.open(hook.payload.data(), hook.payload.size(), raster.hits, ctx);
     std::map<std::pair<std::uint32_t, std::uint32_t>, RawHit> hits;
     for (const RawHit& h : raster.raw.flatten()) hits[{h.a, h.b}] = h;
     std::map<std::pair<std::uint32_t, std::uint32_t>, CoverageSample> cover;
@@ -147,10 +159,9 @@ TEST(PairIndex, TableAnswersEveryPairAsItsInputs) {
 TEST(PairIndex, OlderLayoutIsRefused) {
     const TableContext& ctx = test::kHookContext;
     const Encoding& e = find_encoding("coverage");
-    RasterizeOptions opt;
-    opt.keep_hits = true;
-    const RasterizeResult raster = rasterize(ctx, opt);
-    ByteBuffer payload = e.build(raster.raw, ctx, {});
+    HookTable hook = hook_table();
+    const RasterizeResult& raster = hook.raster;
+    ByteBuffer& payload = hook.payload;
     ASSERT_EQ(std::memcmp(payload.data(), "COVER2", 6), 0);
     payload.data()[5] = '1';
     try {
