@@ -201,18 +201,29 @@ struct CullLoss {
     double lost = 0;
     int turned_away = 0;
 };
-CullLoss cull_loss(const Shape& primitive, LatticeFilter filter, bool inside, double footprint) {
-    const Encoding& e = find_encoding("coverage");
+// A primitive's coverage tables at sigma 1 and 1/2 in the hook's box, with the bytes they read.
+struct TwoLevels {
     std::vector<ByteBuffer> payloads;
     std::vector<FilterLevel> levels;
+    double error = 0;  // the finer level's Encoding::error_bound
+};
+TwoLevels two_levels(const Shape& primitive) {
+    const Encoding& e = find_encoding("coverage");
+    TwoLevels t;
+    t.payloads.reserve(2);  // the tables read the payloads in place
     for (const double cell : {1.0, 0.5}) {
         const int m = cell < 1 ? 2 : 1;
         const TableContext ctx{{4 * m, 2 * m, 4 * m}, cell, 1.0, &primitive};
         const RasterizeResult r = rasterize(ctx);
-        payloads.push_back(e.build(r.raw, ctx, {}));
-        levels.push_back({e.open(payloads.back().data(), payloads.back().size(), r.hits, ctx), ctx});
+        t.payloads.push_back(e.build(r.raw, ctx, {}));
+        t.levels.push_back(
+            {e.open(t.payloads.back().data(), t.payloads.back().size(), r.hits, ctx), ctx});
+        t.error = e.error_bound(ctx, {});
     }
-    const FilteredLatticeShape shape(levels, filter, e.error_bound(levels.back().ctx, {}));
+    return t;
+}
+CullLoss cull_loss(const TwoLevels& t, LatticeFilter filter, bool inside, double footprint) {
+    const FilteredLatticeShape shape(t.levels, filter, t.error);
     // As the accelerator (EmbreeAccel's first_visit): a cull part's box, then, where the object
     // has several parts, its test.
     auto kept = [&](const Ray& r) {
@@ -262,17 +273,19 @@ TEST(Coverage, CullingKeepsNearlyAllTheCoverage) {
     const double r = 0.08;
     const ChainShape thin({{{0.7, 1.0, 0.6}, r}, {{2.0, 1.1, 2.2}, r}, {{3.3, 0.9, 3.4}, r}},
                           {{0, 1, r}, {1, 2, r}});
-    for (const Shape* primitive : {static_cast<const Shape*>(&hook()), static_cast<const Shape*>(&thin)})
+    for (const Shape* primitive : {static_cast<const Shape*>(&hook()), static_cast<const Shape*>(&thin)}) {
+        const TwoLevels tables = two_levels(*primitive);
         for (const LatticeFilter f : {LatticeFilter::kSmooth, LatticeFilter::kBox})
             for (const bool inside : {false, true})
                 for (const double footprint : {2.0, 1e-4}) {
-                    const CullLoss l = cull_loss(*primitive, f, inside, footprint);
+                    const CullLoss l = cull_loss(tables, f, inside, footprint);
                     const double most = footprint < 1 ? 1e-5 : (f == LatticeFilter::kBox ? 3e-3 : 1e-3);
                     EXPECT_LT(l.lost, most) << (primitive == &thin ? "thin hair" : "hook") << ", filter "
                                             << int(f) << (inside ? ", rays inside" : ", lines")
                                             << ", footprint " << footprint;
                     EXPECT_GT(l.turned_away, 500);
                 }
+    }
 }
 
 // Shadow rays ask for the coverage alone (RayFootprint::coverage_only): the same sheets, where

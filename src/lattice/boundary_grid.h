@@ -28,6 +28,10 @@ inline Vec3 to_vec(const GridPoint& g) {
 // snapped segment lies within this of the ray (lattice units, with slack for rounding).
 inline constexpr double kSnapReach = 0.70711 + 1e-6;
 
+// The two axes across axis a, in the order a face across it takes them as its u and v:
+// x -> (y, z), y -> (z, x), z -> (x, y).
+inline constexpr int kFaceAxes[3][2] = {{1, 2}, {2, 0}, {0, 1}};
+
 class BoundaryGrid {
 public:
     explicit BoundaryGrid(std::array<int, 3> cells);

@@ -9,8 +9,6 @@ namespace {
 
 thread_local RayFootprint t_footprint;
 
-// The two axes of a face across axis a, in the order the blend takes them as u, v.
-constexpr int kNextAxis[3][2] = {{1, 2}, {2, 0}, {0, 1}};
 
 // How far (in cells of a level) a ray answered through a level can pass from the primitive: a
 // pair blended in has its ends within sqrt(2) cells of the ray's (smooth: a neighbouring grid
@@ -101,7 +99,7 @@ void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bo
     int axis_of[4];
     for (int e = 0; e < 2; ++e)
         for (int j = 0; j < 2; ++j) {
-            const int a = kNextAxis[ax[e]][j];
+            const int a = kFaceAxes[ax[e]][j];
             const int na = n[static_cast<std::size_t>(a)];
             const double v = std::clamp(x[e][static_cast<std::size_t>(a)], 0.0, double(na));
             // floor: v >= 0.

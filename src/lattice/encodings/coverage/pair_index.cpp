@@ -11,7 +11,7 @@ PairIndex::PairIndex(const std::array<int, 3>& cells) : grid_(cells) {
     std::uint32_t tiles_v[6] = {0, 0, 0, 0, 0, 0};
     for (int f = 0; f < 6; ++f) {
         const auto side = [&](int j) {
-            return static_cast<std::uint32_t>((cells[static_cast<std::size_t>(kAxes[f][j])] + kSide) / kSide);
+            return static_cast<std::uint32_t>((cells[static_cast<std::size_t>(face_axes(f)[j])] + kSide) / kSide);
         };
         tiles_v[f] = side(1);
         face_slots_[f] = std::uint64_t{side(0)} * side(1) * kTileSlots;
@@ -22,7 +22,7 @@ PairIndex::PairIndex(const std::array<int, 3>& cells) : grid_(cells) {
         Point& q = points_[id];
         q.faces = grid_.faces(p);
         for (int f = 0; f < 6; ++f) {
-            const int u = p[kAxes[f][0]], v = p[kAxes[f][1]];
+            const int u = p[face_axes(f)[0]], v = p[face_axes(f)[1]];
             const std::uint32_t tile = static_cast<std::uint32_t>(u / kSide) * tiles_v[f] +
                                        static_cast<std::uint32_t>(v / kSide);
             q.at[f] = tile << 8 | kSpread[u % kSide] | kSpread[v % kSide] << 1;
@@ -36,7 +36,7 @@ PairIndex::PairIndex(const std::array<int, 3>& cells) : grid_(cells) {
             std::uint64_t n = 1;
             for (int i = 0; i < 4; ++i) {
                 const int face = i < 2 ? f : g;
-                k.extent[i] = cells[static_cast<std::size_t>(kAxes[face][i % 2])] + 1;
+                k.extent[i] = cells[static_cast<std::size_t>(face_axes(face)[i % 2])] + 1;
                 k.tiles[i] = static_cast<std::uint32_t>((k.extent[i] + kSide - 1) / kSide);
                 n *= k.tiles[i];
             }
@@ -73,7 +73,7 @@ bool PairIndex::pair_in(int block, const std::uint32_t t[4], unsigned inner, std
         const int c = coordinate(t, inner, i);
         if (c >= k.extent[i]) return false;  // the tile's padding
         const int face = i < 2 ? f : g;
-        p[i / 2][kAxes[face][i % 2]] = c;
+        p[i / 2][face_axes(face)[i % 2]] = c;
     }
     for (int e = 0; e < 2; ++e) {
         const int face = e == 0 ? f : g;

@@ -90,8 +90,8 @@ private:
         std::uint32_t tiles[4] = {0, 0, 0, 0};
         int extent[4] = {0, 0, 0, 0};
     };
-    // A face's u and v axes (as FilteredLatticeShape's blend takes them).
-    static constexpr int kAxes[6][2] = {{1, 2}, {1, 2}, {2, 0}, {2, 0}, {0, 1}, {0, 1}};
+    // Face f's u and v axes (as FilteredLatticeShape's blend takes them).
+    static const int* face_axes(int f) { return kFaceAxes[BoundaryGrid::face_axis(f)]; }
     // Bits 0 and 1 of a coordinate within its tile, to bits 0 and 4 of its Morton code.
     static constexpr unsigned kSpread[4] = {0x00, 0x01, 0x10, 0x11};
 
