@@ -35,15 +35,25 @@ struct Built {
     RasterizeResult raster;
 };
 
-Built build(const std::string& encoding, int k, const EncodeOptions& opt = {}) {
-    const Primitive& p = hair_scene().primitives.at(0);
+// A table of the scene's first primitive, its lattice refined k times.
+Built build_for(const Scene& s, const std::string& encoding, int k, const EncodeOptions& opt = {}) {
+    const Primitive& p = s.primitives.at(0);
+    const LatticeSpec& l = *p.lattice;
     Built b;
-    b.ctx = {{7 * k, 7 * k, 20 * k}, 1.0 / k, 1.0, p.shape.get()};
+    b.ctx = {{l.cells[0] * k, l.cells[1] * k, l.cells[2] * k}, l.sigma / k, l.sigma, p.shape.get()};
     b.raster = rasterize(b.ctx);
     const Encoding& e = find_encoding(encoding);
     b.payload = e.build(b.raster.raw, b.ctx, opt);
     b.table = e.open(b.payload.data(), b.payload.size(), b.raster.hits, b.ctx);
     return b;
+}
+
+Built build(const std::string& encoding, int k, const EncodeOptions& opt = {}) {
+    return build_for(hair_scene(), encoding, k, opt);
+}
+
+std::uint32_t normal_mode(const Built& b) {
+    return static_cast<const DenseTable&>(*b.table).layout().normal_mode;  // 1: part codes
 }
 
 TEST(EncodingDense, CertifiedWithinTargetsOnTheHair) {
@@ -66,7 +76,7 @@ TEST(EncodingDense, OctahedralNormalsAndLooserTargets) {
     const CertifyReport ra = certify_table(*a.table, a.ctx, false);
     EXPECT_LE(ra.max_point_error, 0.01);
     EXPECT_LE(ra.max_normal_error_deg, 1.0);
-    EXPECT_EQ(static_cast<const DenseTable&>(*a.table).layout().normal_mode, 0u);
+    EXPECT_EQ(normal_mode(a), 0u);
     EncodeOptions loose;
     loose.max_point_error = 0.05;
     loose.max_normal_error_deg = 5;
@@ -76,6 +86,23 @@ TEST(EncodingDense, OctahedralNormalsAndLooserTargets) {
     EXPECT_LE(rb.max_normal_error_deg, 5.0);
     EXPECT_EQ(rb.false_hits + rb.false_misses, 0u);
     EXPECT_LT(b.payload.size(), a.payload.size());
+}
+
+TEST(EncodingDense, AutoNormalsArePartCodesOnlyWhereTheyAreCheap) {
+    // The hair's spheres and cylinders: part codes, the smaller. A torus minus a sphere: its
+    // torus's normal is a quartic's gradient, so `auto` stores octahedral codes, within the
+    // same targets; `part` still gives part codes when asked.
+    EXPECT_EQ(normal_mode(build("dense", 1)), 1u);
+    const Scene rings = load_scene(test::source_path("examples/lattice-rings.json"));
+    const Built a = build_for(rings, "dense", 1);
+    EXPECT_EQ(normal_mode(a), 0u);
+    const CertifyReport r = certify_table(*a.table, a.ctx, false);
+    EXPECT_EQ(r.false_hits + r.false_misses, 0u);
+    EXPECT_LE(r.max_point_error, 0.01);
+    EXPECT_LE(r.max_normal_error_deg, 1.0);
+    EncodeOptions part;
+    part.normals = DenseNormals::kPart;
+    EXPECT_EQ(normal_mode(build_for(rings, "dense", 1, part)), 1u);
 }
 
 TEST(EncodingDense, BothDirectionsFromOneRecord) {

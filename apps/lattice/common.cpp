@@ -44,7 +44,7 @@ void add_table_options(CLI::App& app, TableSpec& spec) {
            "--dense-normals",
            [&spec, normals](const std::string& name) { spec.options.normals = normals.at(name); },
            "dense: normals as octahedral codes (oct), as the part hit, re-evaluated (part), or "
-           "whichever is smaller (auto)")
+           "whichever is smaller (auto; octahedral where parts are quartics)")
         ->check(CLI::IsMember(normals));
 }
 

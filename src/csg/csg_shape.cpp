@@ -207,6 +207,12 @@ Vec3 CsgShape::normal(const Ray& r, const Crossing& c) const {
     return c.flipped() ? -n : n;
 }
 
+bool CsgShape::cheap_normal(const Crossing& c) const {
+    Crossing in_leaf = c;
+    in_leaf.leaf = 0;
+    return leaves_[c.leaf_index()].leaf.shape->cheap_normal(in_leaf);
+}
+
 SurfacePoint CsgShape::surface(const Ray& r, const Crossing& c) const {
     if (!c.has_stored) return {r.at(c.t), normal(r, c)};
     const Transform& xf = leaves_[c.leaf_index()].leaf.xf;

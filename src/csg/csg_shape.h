@@ -47,6 +47,7 @@ public:
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
+    bool cheap_normal(const Crossing& c) const override;
     bool names_surface(const Crossing& c) const override {
         return c.leaf_index() < leaves_.size() &&
                leaves_[c.leaf_index()].leaf.shape->names_surface({c.t, c.part, 0});

@@ -24,6 +24,7 @@ public:
 
     const Poly3& polynomial() const { return f_; }
     int degree() const { return degree_; }
+    bool cheap_normal(const Crossing&) const override { return degree_ <= 2; }
 
     Bounds3 bounds() const override { return bounds_; }
     Bounds3 placed_bounds(const Transform& xf) const override;

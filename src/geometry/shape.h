@@ -129,6 +129,10 @@ public:
     // Whether c's part (and CSG leaf) name a surface of this shape, so that normal() may be
     // asked for it: crossings read from files (lattice tables) are checked with it first.
     virtual bool names_surface(const Crossing& c) const { return c.part == 0; }
+    // Whether normal() at c is a few flops (a plane, quadric, sphere or cylinder), not the
+    // gradient of a quartic: `dense` tables store a hit's part, to re-evaluate its normal at
+    // every lookup, only where that is cheap.
+    virtual bool cheap_normal(const Crossing&) const { return true; }
 
     // Shapes made of many parts (sphere/cylinder chains) expose them so the accelerator can
     // build a hierarchy over them; by default the shape is one primitive.

@@ -17,7 +17,8 @@
 namespace lat {
 
 // How `dense` stores normals: octahedral codes, the part hit (its normal re-evaluated at the
-// decoded point), or whichever is smaller.
+// decoded point), or whichever is smaller (auto; octahedral codes where a part's normal is not
+// cheap to re-evaluate: quartic surfaces).
 enum class DenseNormals { kAuto, kOct, kPart };
 // Their option names, "auto", "oct" and "part": the one place they are spelled.
 inline constexpr std::array<std::pair<std::string_view, DenseNormals>, 3> kDenseNormalNames{
@@ -40,8 +41,9 @@ struct Encoding {
     // Stores each pair's coverage besides its hit (LatticeTable::coverage): the tables that
     // filtered rendering (--filter) can use.
     bool coverage = false;
-    // The payload's layout, bumped when it changes. It is part of a table's fingerprint, so
-    // that a cached table of another layout is rebuilt (its file name differs), not misread.
+    // The payload's layout, bumped when it changes (or when a build with the same options
+    // writes another table). It is part of a table's fingerprint, so that a cached table of
+    // another layout is rebuilt (its file name differs), not misread or kept stale.
     int layout = 1;
 
     // The payload. `hits` are the rasterized hits when needs_hits (else empty); ctx.primitive

@@ -10,6 +10,8 @@ const Encoding kDenseEncoding{
                "bit widths chosen per table for the error targets",
     .max_points = 0xFFFFFFFFull,
     .bytes_per_hit = 4.0,
+    // 2: the payload as in 1; `auto` normals now octahedral for quartic parts.
+    .layout = 2,
     .build = &DenseTable::build,
     .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                const TableContext& ctx) -> std::unique_ptr<LatticeTable> {

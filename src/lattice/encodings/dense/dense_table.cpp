@@ -98,6 +98,7 @@ private:
     std::vector<Vec3> point_;
     std::map<std::pair<std::uint16_t, std::uint16_t>, std::uint32_t> code_of_;
     std::vector<std::uint32_t> codes_;  // (part, leaf) per code
+    bool cheap_normals_ = true;         // every code's normal (Shape::cheap_normal)
     bool use_part_ = false;
     std::vector<std::uint64_t> occ_;
     std::vector<std::uint32_t> counts_;
@@ -122,7 +123,8 @@ private:
     }
 
     // Part codes: the normal re-evaluated at the decoded point; t may need more bits for it.
-    // Returns false when the part normals cannot meet the target (or there is no primitive).
+    // Returns false when the part normals cannot meet the target, when `auto` chooses and some
+    // part's normal is not cheap (Shape::cheap_normal), or when there is no primitive.
     bool choose_part_codes(std::uint32_t& part_t_bits, std::uint32_t& part_bits) {
         if (ctx_.primitive == nullptr || opt_.normals == DenseNormals::kOct) return false;
         for (const auto& chunk : raw_.chunks)
@@ -132,7 +134,9 @@ private:
                     const Crossing c = h.crossing(0);
                     codes_.push_back(c.part);
                     codes_.push_back(c.leaf);
+                    cheap_normals_ = cheap_normals_ && ctx_.primitive->cheap_normal(c);
                 }
+        if (opt_.normals == DenseNormals::kAuto && !cheap_normals_) return false;
         part_bits = 0;
         while ((1ull << part_bits) < code_of_.size()) ++part_bits;
         auto normal_at = [&](const RawHit& h, double t) {
@@ -168,7 +172,10 @@ private:
         return oct_bits;
     }
 
-    // Part codes or octahedral normals, whichever the options ask for or is smaller.
+    // Part codes or octahedral normals, whichever the options ask for; `auto`: whichever is
+    // smaller, but octahedral codes where a part's normal is a quartic's gradient (a lookup
+    // that decodes 2 x 8 bits or so is cheaper than that: csg of 7 tori, 400 instances on a
+    // ball, 6 % faster for the same image quality).
     void choose_widths() {
         const std::uint32_t t_bits = choose_t_bits();
         std::uint32_t part_t_bits = t_bits, part_bits = 0;
