@@ -12,6 +12,15 @@ covers about as many pixels as the hair and the lattice's cost per visit stays c
   csg1, 4, 12    CSG of tori stretched along the column: one torus, a 4-leaf unit (a torus
                  minus a torus, union the intersection of two tori), three such units
 
+Besides, the class of scene issue 9 is checked on (its own scenes are not ours to see):
+several hundred instances on a ball, here 400 placed evenly (a Fibonacci spiral), each turned
+at random about the ball's normal, filling most of the frame, so that the instances, not the
+ball and floor, take most of the time. Two primitives, as the issue describes them:
+
+  ball-csg7      six tilted tori (major radius 3, minor 0.35) centred in an 8^3 box, minus a
+                 sphere: 7 quartic leaves
+  ball-tuft216   a tuft of 24 strands of 5 spheres and 4 cylinders (radius 0.15): 216 parts
+
 Usage: complexity_scenes.py OUT_DIR [--size N] [--only NAME,...]; prints the written paths.
 Python 3 standard library only; the output is deterministic (fixed seeds)."""
 import argparse
@@ -95,13 +104,77 @@ def csg(leaves):
     return {"object": obj, "lattice": LATTICE}
 
 
+def ball_csg():
+    rng = random.Random(3)
+    tori = []
+    for _ in range(6):
+        a = [rng.gauss(0, 1) for _ in range(3)]
+        norm = math.sqrt(sum(x * x for x in a))
+        tori.append(torus([x / norm for x in a], 3.0, 0.35, (4, 4, 4)))
+    bite = {"type": "sphere", "center": [4, 4, 6.5], "radius": 1.8}
+    obj = {"type": "csg", "op": "difference",
+           "children": [{"type": "csg", "op": "union", "children": tori}, bite]}
+    return {"object": obj, "lattice": {"sigma": 1.0, "cells": [8, 8, 8]}}
+
+
 PRIMITIVES = {"hair19": (hair, 19)}
 PRIMITIVES.update({k: ((lambda s=s, n=n, r=r, k=k: tuft(s, n, r, seed=len(k))), s * (2 * n - 1))
                    for k, (s, n, r) in TUFTS.items()})
 PRIMITIVES.update({f"csg{q}": ((lambda q=q: csg(q)), q) for q in (1, 4, 12)})
 
 
+# name -> (primitive, parts or leaves, issue 9's target: exact / lattice at least this).
+CHECKS = {"ball-csg7": (ball_csg, 7, 5.0),
+          "ball-tuft216": ((lambda: tuft(24, 5, 0.15, seed=7)), 216, 2.0)}
+BALL_RADIUS, BALL_INSTANCES = 40.0, 400
+
+
+def ball_transforms(n, seed=5):
+    """n lattice boxes standing on a ball: local (4, 4, 0) at the surface (a little below it,
+    so that no gap shows), local z along the normal, turned at random about it."""
+    rng = random.Random(seed)
+    out = []
+    golden = math.pi * (3 - math.sqrt(5))
+    for i in range(n):
+        z = 1 - 2 * (i + 0.5) / n
+        r = math.sqrt(1 - z * z)
+        nrm = (r * math.cos(golden * i), r * math.sin(golden * i), z)
+        a = (1, 0, 0) if abs(nrm[0]) < 0.9 else (0, 1, 0)
+        e1 = cross(a, nrm)
+        e1 = [x / math.sqrt(sum(y * y for y in e1)) for x in e1]
+        e2 = cross(nrm, e1)
+        phi = rng.uniform(0, 2 * math.pi)
+        u = [math.cos(phi) * p + math.sin(phi) * q for p, q in zip(e1, e2)]
+        v = [-math.sin(phi) * p + math.cos(phi) * q for p, q in zip(e1, e2)]
+        t = [BALL_RADIUS * nrm[k] - 4 * u[k] - 4 * v[k] - 0.5 * nrm[k] for k in range(3)]
+        out.append([[round(u[k], 6), round(v[k], 6), round(nrm[k], 6), round(t[k], 6)]
+                    for k in range(3)])
+    return out
+
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def ball_scene(name, size):
+    s = json.load(open(PLATE4))
+    s["camera"] = {"eye": [0, -250, 70], "look_at": [0, 0, 0], "up": [0, 0, 1],
+                   "fov_y_deg": 28, "width": size, "height": size}
+    s["primitives"] = {name: CHECKS[name][0]()}
+    ball, floor = [o for o in s["objects"] if o["type"] != "instance"]
+    ball.update(center=[0, 0, 0], radius=BALL_RADIUS)
+    s["objects"] = [ball, floor] + [
+        {"type": "instance", "primitive": name, "transform": m, "material": "fur"}
+        for m in ball_transforms(BALL_INSTANCES)]
+    s["description"] = (f"issue 9's check class: {BALL_INSTANCES} instances of {name} "
+                        f"({CHECKS[name][1]} parts or quartic leaves) on a ball; "
+                        "bench/complexity_scenes.py")
+    return s
+
+
 def scene(name, size):
+    if name in CHECKS:
+        return ball_scene(name, size)
     s = json.load(open(PLATE4))
     s["camera"]["width"] = s["camera"]["height"] = size
     s["primitives"] = {name: PRIMITIVES[name][0]()}
@@ -120,7 +193,7 @@ def main():
     ap.add_argument("--only", default="", help="comma-separated primitive names")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
-    for name in (a.only.split(",") if a.only else PRIMITIVES):
+    for name in (a.only.split(",") if a.only else list(PRIMITIVES) + list(CHECKS)):
         path = os.path.join(a.out, name + ".json")
         with open(path, "w") as f:
             json.dump(scene(name, a.size), f, separators=(",", ":"))
