@@ -74,6 +74,22 @@ TEST(ImageIo, ToByteRoundsAndClamps) {
     EXPECT_EQ(img.rgb, (std::vector<std::uint8_t>{51, 255, 0}));
 }
 
+TEST(ImageIo, ToByteIsLroundOfTheScaledValue) {
+    // Every half step and its neighbouring doubles, and random values: as std::lround.
+    auto expected = [](double c) { return static_cast<int>(std::lround(255.0 * c)); };
+    for (int k = 0; k < 255; ++k) {
+        double c = (k + 0.5) / 255.0;
+        for (int i = 0; i < 4; ++i) c = std::nextafter(c, 0.0);
+        for (int i = 0; i < 9; ++i, c = std::nextafter(c, 1.0)) EXPECT_EQ(to_byte(c), expected(c)) << c;
+    }
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int i = 0; i < 1'000'000; ++i) {
+        const double c = u(rng);
+        ASSERT_EQ(to_byte(c), expected(c)) << c;
+    }
+}
+
 TEST(ImageIo, FormatByExtension) {
     EXPECT_EQ(image_format_for("out/a.png"), ImageFormat::png);
     EXPECT_EQ(image_format_for("A.PNG"), ImageFormat::png);

@@ -26,7 +26,11 @@ namespace lat {
 std::uint8_t to_byte(double c) {
     if (!(c > 0.0)) return 0;  // also catches NaN
     if (c >= 1.0) return 255;
-    return static_cast<std::uint8_t>(std::lround(255.0 * c));
+    // std::lround(v) (halves away from zero) without libm's call, three a pixel: v - floor(v)
+    // is exact for 0 < v < 255.
+    const double v = 255.0 * c;
+    const auto whole = static_cast<int>(v);
+    return static_cast<std::uint8_t>(v - whole >= 0.5 ? whole + 1 : whole);
 }
 
 Image8 to_image8(const ImageF& img) {
