@@ -208,6 +208,7 @@ Vec3 CsgShape::normal(const Ray& r, const Crossing& c) const {
 }
 
 bool CsgShape::cheap_normal(const Crossing& c) const {
+    assert(c.leaf_index() < leaves_.size());  // a crossing of this shape (names_surface)
     Crossing in_leaf = c;
     in_leaf.leaf = 0;
     return leaves_[c.leaf_index()].leaf.shape->cheap_normal(in_leaf);
