@@ -40,8 +40,8 @@ std::uint8_t BoundaryGrid::faces(const GridPoint& p) const {
 
 std::uint64_t BoundaryGrid::face_points(int face) const {
     const int a = face_axis(face);
-    return static_cast<std::uint64_t>(n_[static_cast<std::size_t>((a + 1) % 3)] + 1) *
-           static_cast<std::uint64_t>(n_[static_cast<std::size_t>((a + 2) % 3)] + 1);
+    return static_cast<std::uint64_t>(n_[static_cast<std::size_t>(kFaceAxes[a][0])] + 1) *
+           static_cast<std::uint64_t>(n_[static_cast<std::size_t>(kFaceAxes[a][1])] + 1);
 }
 
 std::uint64_t BoundaryGrid::pairs_eq2() const {

@@ -49,7 +49,7 @@ public:
     static bool face_is_high(int face) { return (face & 1) != 0; }
     // The face's plane coordinate along its axis.
     int face_level(int face) const { return face_is_high(face) ? n_[face_axis(face)] : 0; }
-    // Points on face f: (n_u + 1) * (n_v + 1) with u = axis+1, v = axis+2 (mod 3).
+    // Points on face f: (n_u + 1) * (n_v + 1) with u, v its kFaceAxes.
     std::uint64_t face_points(int face) const;
     // Ordered pairs of face points on different faces, counted as the paper's eq. (2) does.
     std::uint64_t pairs_eq2() const;

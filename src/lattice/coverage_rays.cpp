@@ -45,7 +45,7 @@ double PairRays::reach() const {
     constexpr double kShift = 0.70710678118654757;  // sqrt(2) / 2, the longest shift
     // The exit moves by du U + dv V from q.
     double move = 0;
-    for (std::size_t axis : {(ap_ + 1) % 3, (ap_ + 2) % 3}) {
+    for (std::size_t axis : {u_axis(), v_axis()}) {
         Vec3 u;
         u[axis] = 1;
         if (d_[aq_] != 0) u = u - d_ * (u[aq_] / d_[aq_]);

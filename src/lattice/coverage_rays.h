@@ -27,8 +27,8 @@ public:
     // the box.
     SubRay ray(double du, double dv) const {
         Vec3 shift;
-        shift[(ap_ + 1) % 3] = du;
-        shift[(ap_ + 2) % 3] = dv;
+        shift[u_axis()] = du;
+        shift[v_axis()] = dv;
         // The shifted line leaves through the plane of q's face where it meets it.
         Vec3 e = vq_ + shift;
         if (d_[aq_] != 0) e = e - d_ * (shift[aq_] / d_[aq_]);
@@ -38,8 +38,8 @@ public:
     const Vec3& from() const { return vp_; }
     const Vec3& dir() const { return d_; }  // q - p
     // The axes along which du and dv shift.
-    std::size_t u_axis() const { return (ap_ + 1) % 3; }
-    std::size_t v_axis() const { return (ap_ + 2) % 3; }
+    std::size_t u_axis() const { return static_cast<std::size_t>(kFaceAxes[ap_][0]); }
+    std::size_t v_axis() const { return static_cast<std::size_t>(kFaceAxes[ap_][1]); }
     // How far any point of a sub-ray with |du|, |dv| <= 1/2 can lie from the line p q: a
     // shifted line is |shift| <= sqrt(2)/2 from it, and clamping the exit onto the box moves it
     // by at most as much as the exit moved from q.

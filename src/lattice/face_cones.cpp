@@ -9,8 +9,8 @@ FaceLayout layout_face(const BoundaryGrid& grid, int f) {
     FaceLayout fl;
     fl.axis = BoundaryGrid::face_axis(f);
     fl.level = grid.face_level(f);
-    fl.ua = (fl.axis + 1) % 3;
-    fl.va = (fl.axis + 2) % 3;
+    fl.ua = kFaceAxes[fl.axis][0];
+    fl.va = kFaceAxes[fl.axis][1];
     fl.nu = grid.cells()[static_cast<std::size_t>(fl.ua)] + 1;
     fl.nv = grid.cells()[static_cast<std::size_t>(fl.va)] + 1;
     const std::size_t n = static_cast<std::size_t>(fl.nu) * static_cast<std::size_t>(fl.nv);

@@ -9,7 +9,6 @@ namespace {
 
 thread_local RayFootprint t_footprint;
 
-
 // How far (in cells of a level) a ray answered through a level can pass from the primitive: a
 // pair blended in has its ends within sqrt(2) cells of the ray's (smooth: a neighbouring grid
 // point in both face directions; box: kSnapReach), and a sub-ray of that pair that meets the
