@@ -83,16 +83,15 @@ std::shared_ptr<CsgShape> sample_tree() {
     return csg;
 }
 
-TEST(CsgTree, SpansAgreeWithMembershipSampling) {
-    const auto csg = sample_tree();
+// Walks random lines: membership of the solid must agree with its spans away from their ends.
+void expect_spans_match_membership(const Shape& csg) {
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> u(-2, 2);
     int checked = 0;
     for (int n = 0; n < 3000; ++n) {
         const Ray r{{u(rng), u(rng), u(rng)}, normalize(Vec3{u(rng), u(rng), u(rng)})};
         SpanList spans;
-        csg->spans(r, spans);
-        // Walk the line; membership must agree with the spans away from their ends.
+        csg.spans(r, spans);
         for (double t = -6; t <= 6; t += 0.01) {
             bool in_span = false, near_end = false;
             for (const Span& s : spans) {
@@ -100,11 +99,70 @@ TEST(CsgTree, SpansAgreeWithMembershipSampling) {
                 near_end = near_end || std::abs(t - s.in.t) < 1e-7 || std::abs(t - s.out.t) < 1e-7;
             }
             if (near_end) continue;
-            ASSERT_EQ(in_span, csg->inside(r.at(t))) << "ray " << n << " t " << t;
+            ASSERT_EQ(in_span, csg.inside(r.at(t))) << "ray " << n << " t " << t;
             ++checked;
         }
     }
     EXPECT_GT(checked, 100000);
+}
+
+TEST(CsgTree, SpansAgreeWithMembershipSampling) { expect_spans_match_membership(*sample_tree()); }
+
+// A tree whose leaves are trees (an instance of a CSG primitive in a CSG object): each level's
+// scratch lists must stay its own.
+TEST(CsgTree, TreesAsLeavesKeepTheirOwnLists) {
+    auto outer = std::make_shared<CsgShape>();
+    const int inner = outer->add_leaf({sample_tree(), Transform::translate({0.3, 0, 0}), 1});
+    const int again = outer->add_leaf({sample_tree(), Transform::rotate({0, 0, 1}, 1.0), 2});
+    const int ball = outer->add_leaf({std::make_shared<SphereShape>(Vec3{0, 0.5, 0}, 0.7), {}, 3});
+    const int cut = outer->add_node(CsgOp::kDifference, {inner, ball});
+    outer->set_root(outer->add_node(CsgOp::kUnion, {cut, again}));
+    expect_spans_match_membership(*outer);
+}
+
+// Pieces (exact lattices) are the leaves: switching off the leaves whose solids keep away from
+// a line changes none of its spans; all leaves on is the tree itself.
+TEST(CsgTree, LeavesAwayFromALineCanBeSwitchedOff) {
+    const auto csg = sample_tree();
+    ASSERT_EQ(csg->piece_count(), 4u);
+    EXPECT_FALSE(csg->pieces_are_union());
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(-2, 2);
+    int switched_off = 0;
+    for (int n = 0; n < 5000; ++n) {
+        const Ray r{{u(rng), u(rng), u(rng)}, normalize(Vec3{u(rng), u(rng), u(rng)})};
+        std::vector<std::uint32_t> on;
+        const std::vector<std::uint32_t> all{0, 1, 2, 3};
+        for (std::uint32_t i = 0; i < 4; ++i) {
+            std::vector<BoundingSphere> spheres;
+            csg->piece_spheres(i, spheres);
+            bool near = false;
+            for (const BoundingSphere& b : spheres) {
+                const Vec3 w = b.center - r.o;
+                near = near || length(w - r.d * dot(w, r.d)) <= b.radius;  // or infinite
+            }
+            if (near) on.push_back(i);
+        }
+        switched_off += static_cast<int>(4 - on.size());
+        SpanList whole, all_on, some_on;
+        csg->spans(r, whole);
+        csg->pieces_spans(all, r, all_on);
+        csg->pieces_spans(on, r, some_on);
+        for (const SpanList* l : {&all_on, &some_on}) {
+            ASSERT_EQ(l->size(), whole.size()) << n;
+            for (std::size_t k = 0; k < whole.size(); ++k) {
+                ASSERT_EQ((*l)[k].in.t, whole[k].in.t) << n;
+                ASSERT_EQ((*l)[k].in.leaf, whole[k].in.leaf) << n;
+                ASSERT_EQ((*l)[k].out.t, whole[k].out.t) << n;
+            }
+        }
+    }
+    EXPECT_GT(switched_off, 4000);
+    // The half-space (leaf 2) is unbounded: near every line.
+    std::vector<BoundingSphere> h;
+    csg->piece_spheres(2, h);
+    ASSERT_EQ(h.size(), 1u);
+    EXPECT_EQ(h[0].radius, kInfinity);
 }
 
 TEST(CsgTree, SubtractedSurfaceNormalPointsOutOfTheResult) {

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "geometry/capped_cylinder.h"
+#include "geometry/algebraic.h"
 #include "geometry/chain.h"
 #include "geometry/halfspace.h"
 #include "geometry/named_shapes.h"
@@ -236,6 +237,63 @@ TEST(Torus, PlacedBoundsAreExact) {
             EXPECT_NEAR(b.lo[axis], seen.lo[axis], 2e-3 * scale) << k;
             EXPECT_NEAR(b.hi[axis], seen.hi[axis], 2e-3 * scale) << k;
         }
+    }
+}
+
+
+// A torus's solid within ball of its ring: the ring test in line_roots (rays that keep out of
+// the slab-and-annulus around the ring cost no quartic) must lose no root. The same polynomial
+// and box without the extent is the reference, on lines aimed near the tube, through the hole,
+// grazing it and from far away.
+TEST(Torus, RingTestLosesNoRoot) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (const auto& [major, minor] : {std::pair{3.0, 0.35}, {1.0, 0.6}, {0.5, 0.5}, {2.0, 0.01}}) {
+        const PlacedShape t = make_torus({0, 0, 0}, {0, 0, 1}, major, minor);
+        const auto& ring = dynamic_cast<const AlgebraicShape&>(*t.shape);
+        const AlgebraicShape plain(ring.polynomial(), ring.bounds(), {0, 0, 0});
+        int crossings = 0;
+        for (int n = 0; n < 20000; ++n) {
+            const double a = M_PI * u(rng), reach = major + minor * (1.2 * u(rng));
+            const Vec3 target{reach * std::cos(a), reach * std::sin(a), 1.2 * minor * u(rng)};
+            const Vec3 d = normalize(Vec3{u(rng), u(rng), n % 3 == 0 ? 0.0 : u(rng)});
+            const double back = n % 7 == 0 ? 1e4 : 3 * (major + minor);
+            const Ray r{target - d * back, d};
+            SpanList a1, a2;
+            ring.spans(r, a1);
+            plain.spans(r, a2);
+            ASSERT_EQ(a1.size(), a2.size()) << n;
+            for (std::size_t k = 0; k < a1.size(); ++k) {
+                ASSERT_EQ(a1[k].in.t, a2[k].in.t) << n;
+                ASSERT_EQ(a1[k].out.t, a2[k].out.t) << n;
+            }
+            crossings += static_cast<int>(a1.size());
+        }
+        EXPECT_GT(crossings, 5000) << major;
+    }
+}
+
+// The ring of spheres a torus gives for culling (lattice rasterization, candidates) holds the
+// whole solid, and is much tighter than the sphere around its box.
+TEST(Torus, RingSpheresHoldTheSolid) {
+    for (const auto& [major, minor] : {std::pair{3.0, 0.35}, {1.0, 0.6}, {2.0, 0.01}}) {
+        const PlacedShape t = make_torus({0, 0, 0}, {0, 0, 1}, major, minor);
+        std::vector<BoundingSphere> spheres;
+        t.shape->primitive_spheres(0, spheres);
+        double volume = 0;
+        for (const BoundingSphere& s : spheres) volume += 4.0 / 3 * M_PI * std::pow(s.radius, 3);
+        const double box = std::pow(0.5 * length(t.shape->bounds().extent()), 3) * 4.0 / 3 * M_PI;
+        EXPECT_LT(volume, (minor < 0.2 * major ? 0.1 : 1.0) * box) << major;
+        for (int i = 0; i < 720; ++i)
+            for (int j = 0; j < 36; ++j) {
+                const double a = 2 * M_PI * i / 720, v = 2 * M_PI * j / 36;
+                const double w = major + minor * std::cos(v);
+                const Vec3 p{w * std::cos(a), w * std::sin(a), minor * std::sin(v)};
+                bool held = false;
+                for (const BoundingSphere& s : spheres)
+                    held = held || length(p - s.center) <= s.radius;
+                ASSERT_TRUE(held) << major << " " << i << " " << j;
+            }
     }
 }
 

@@ -20,7 +20,11 @@ bool apply(CsgOp op, bool a, bool b) {
     return false;
 }
 
-// Scratch lists per recursion depth, so that tracing a ray allocates nothing once warm.
+// Scratch lists per recursion depth, so that tracing a ray allocates nothing once warm. A leaf
+// may itself be a CSG tree (an instance of a CSG primitive): t_depth is the first depth free
+// for it, so that its lists are not those its parent is still using.
+thread_local int t_depth = 0;
+
 SpanList& scratch(int depth, int which) {
     thread_local std::deque<SpanList> pool;  // a deque: growing it keeps references valid
     const auto i = static_cast<std::size_t>(2 * depth + which);
@@ -90,10 +94,7 @@ void CsgShape::set_root(int ref) {
     for (const Leaf& l : leaves_) {
         const double t = l.leaf.shape->surface_tolerance();
         if (t == 0) continue;
-        // A length in the leaf grows by at most the transform's largest column norm.
-        const Mat3& m = l.leaf.xf.forward().m;
-        const double scale = std::max({length(m.col(0)), length(m.col(1)), length(m.col(2))});
-        tolerance_ = std::max(tolerance_, t * scale);
+        tolerance_ = std::max(tolerance_, t * l.leaf.xf.max_stretch());
     }
 }
 
@@ -152,16 +153,21 @@ Bounds3 CsgShape::bounds() const {
                               : nodes_[static_cast<std::size_t>(root_)].bounds;
 }
 
-void CsgShape::eval(int ref, const Ray& r, SpanList& out, int depth) const {
+void CsgShape::eval(int ref, const Ray& r, SpanList& out, int depth, const LeafSet* on) const {
     double t0 = -kInfinity, t1 = kInfinity;
     if (is_leaf_ref(ref)) {
         const std::size_t li = leaf_of(ref);
         const Leaf& leaf = leaves_[li];
+        if (on && !std::binary_search(on->begin(), on->end(), static_cast<std::uint32_t>(li)))
+            return;
         if (leaf.bounds.empty() || (leaf.bounds.finite() && !clip_ray(leaf.bounds, r, t0, t1)))
             return;
         const std::size_t first = out.size();
         const Ray local = leaf.leaf.xf.is_identity() ? r : leaf.leaf.xf.inverse_ray(r);
+        const int parent = t_depth;
+        t_depth = depth;
         leaf.leaf.shape->spans(local, out);
+        t_depth = parent;
         for (std::size_t k = first; k < out.size(); ++k) {
             out[k].in.leaf = static_cast<std::uint32_t>(li);
             out[k].out.leaf = static_cast<std::uint32_t>(li);
@@ -170,12 +176,12 @@ void CsgShape::eval(int ref, const Ray& r, SpanList& out, int depth) const {
     }
     const Node& n = nodes_[static_cast<std::size_t>(ref)];
     if (n.bounds.empty() || !clip_ray(n.bounds, r, t0, t1)) return;
-    eval(n.children[0], r, out, depth + 1);
+    eval(n.children[0], r, out, depth + 1, on);
     for (std::size_t k = 1; k < n.children.size(); ++k) {
         if (out.empty() && n.op != CsgOp::kUnion) return;
         SpanList& b = scratch(depth, 0);
         b.clear();
-        eval(n.children[k], r, b, depth + 1);
+        eval(n.children[k], r, b, depth + 1, on);
         if (b.empty() && n.op != CsgOp::kIntersection) continue;
         SpanList& c = scratch(depth, 1);
         combine_spans(out, b, n.op, c);
@@ -184,17 +190,42 @@ void CsgShape::eval(int ref, const Ray& r, SpanList& out, int depth) const {
 }
 
 void CsgShape::spans(const Ray& r, SpanList& out) const {
-    SpanList& tmp = scratch(0, 0);
+    SpanList& tmp = scratch(t_depth, 0);
     tmp.clear();
-    eval(root_, r, tmp, 1);
+    eval(root_, r, tmp, t_depth + 1, nullptr);
     out.insert(out.end(), tmp.begin(), tmp.end());
 }
 
 bool CsgShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
-    SpanList& tmp = scratch(0, 1);
+    SpanList& tmp = scratch(t_depth, 1);
     tmp.clear();
-    eval(root_, r, tmp, 1);
+    eval(root_, r, tmp, t_depth + 1, nullptr);
     return first_crossing(tmp, tmin, tmax, hit);
+}
+
+void CsgShape::pieces_spans(std::span<const std::uint32_t> on, const Ray& r, SpanList& out) const {
+    assert(std::is_sorted(on.begin(), on.end()));
+    SpanList& tmp = scratch(t_depth, 0);
+    tmp.clear();
+    eval(root_, r, tmp, t_depth + 1, &on);
+    out.insert(out.end(), tmp.begin(), tmp.end());
+}
+
+// A leaf's spheres, carried to CSG coordinates: centres mapped, radii grown by the largest
+// stretch. A leaf without finite bounds (a half-space) gets an unbounded sphere at the origin.
+void CsgShape::piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
+    const Leaf& leaf = leaves_[i];
+    if (!leaf.bounds.finite()) {
+        out.push_back({{0, 0, 0}, kInfinity});
+        return;
+    }
+    const Shape& shape = *leaf.leaf.shape;
+    const Transform& xf = leaf.leaf.xf;
+    const double stretch = xf.max_stretch();
+    const std::size_t first = out.size();
+    for (std::size_t j = 0; j < shape.primitive_count(); ++j) shape.primitive_spheres(j, out);
+    for (std::size_t k = first; k < out.size(); ++k)
+        out[k] = {xf.point(out[k].center), out[k].radius * stretch};
 }
 
 Vec3 CsgShape::normal(const Ray& r, const Crossing& c) const {

@@ -55,6 +55,13 @@ public:
     // A leaf's stored surface point (lattices) is carried to CSG coordinates.
     SurfacePoint surface(const Ray& r, const Crossing& c) const override;
     bool inside(Vec3 p) const override { return inside(root_, p); }
+    // Pieces (exact lattices) are the leaves: a leaf whose solid keeps away from a ray is
+    // empty along it, and the tree is evaluated with the others.
+    std::size_t piece_count() const override { return leaves_.size(); }
+    void piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
+    bool pieces_are_union() const override { return false; }
+    void pieces_spans(std::span<const std::uint32_t> on, const Ray& r,
+                      SpanList& out) const override;
     // The largest of the leaves' (lattices have one), in this shape's units.
     double surface_tolerance() const override { return tolerance_; }
     std::uint32_t tag(const Crossing& c, std::uint32_t fallback) const override {
@@ -80,7 +87,10 @@ private:
 
     Bounds3 compute_bounds(int ref);
     Bounds3 placed_bounds(int ref, const Transform& xf) const;
-    void eval(int ref, const Ray& r, SpanList& out, int depth) const;
+    // The spans of subtree ref along r's line; `on`, when set, lists the leaves evaluated
+    // (ascending), the others counting as empty.
+    using LeafSet = std::span<const std::uint32_t>;
+    void eval(int ref, const Ray& r, SpanList& out, int depth, const LeafSet* on) const;
     bool inside(int ref, Vec3 p) const;
 };
 

@@ -28,6 +28,9 @@ public:
 
     Bounds3 bounds() const override { return bounds_; }
     Bounds3 placed_bounds(const Transform& xf) const override;
+    // With a ring extent, a ring of spheres along the circle (a torus's box sphere holds its
+    // hole and more); else the sphere around the box.
+    void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
@@ -44,6 +47,9 @@ public:
     bool line_roots(const Ray& r, LineRoots& out) const;
 
 private:
+    // Whether the line p + u dn, u in [u0, u1], keeps out of the region the ring extent gives.
+    bool misses_ring(Vec3 p, Vec3 dn, double u0, double u1) const;
+
     Poly3 f_;
     Bounds3 bounds_;
     Vec3 center_;

@@ -3,6 +3,7 @@
 // lattice instance) and every CSG tree implements it in its own coordinates.
 #include <algorithm>
 #include <cstdint>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -164,6 +165,22 @@ public:
     // A capsule holding primitive i, when the shape knows one (chains do): lattices cull with
     // them, grown by how far their answers can stray.
     virtual bool primitive_capsule(std::size_t, Capsule&) const { return false; }
+
+    // Pieces: what an exact lattice (`candidates`) lists per grid-point pair, the pieces of the
+    // shape that a ray near the pair's segment can meet; the others are switched off for the
+    // ray. By default the pieces are the primitives and the shape is their union, so a listed
+    // piece is intersected on its own (intersect_primitive). Shapes that are not the union of
+    // their pieces (CSG: its leaves) say so and answer pieces_spans.
+    virtual std::size_t piece_count() const { return primitive_count(); }
+    // Spheres that together enclose the solid of piece i.
+    virtual void piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
+        primitive_spheres(i, out);
+    }
+    virtual bool pieces_are_union() const { return true; }
+    // Appends the spans of r's whole line through the solid made of the pieces `on` (ascending)
+    // with every other piece empty: the shape's own spans wherever the solids of the pieces
+    // switched off are away from the line.
+    virtual void pieces_spans(std::span<const std::uint32_t> on, const Ray& r, SpanList& out) const;
 
     // Culling parts: regions the accelerator prunes rays with, for shapes it answers as a whole
     // (a lattice gives parts hugging its primitive, much tighter than its lattice box). A ray

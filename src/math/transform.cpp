@@ -1,5 +1,6 @@
 #include "math/transform.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lat {
@@ -81,6 +82,20 @@ Transform Transform::rotate(Vec3 axis, double angle) {
 
 Transform operator*(const Transform& a, const Transform& b) {
     return Transform(a.fwd_ * b.fwd_, b.inv_ * a.inv_);
+}
+
+// The stretch squared, the largest eigenvalue of M^T M, is at most the largest absolute row sum
+// of M^T M (Gershgorin).
+double Transform::max_stretch() const {
+    if (identity_) return 1.0;
+    const Mat3& m = fwd_.m;
+    double stretch2 = 0;
+    for (int i = 0; i < 3; ++i) {
+        double row = 0;
+        for (int j = 0; j < 3; ++j) row += std::abs(dot(m.col(i), m.col(j)));
+        stretch2 = std::max(stretch2, row);
+    }
+    return std::sqrt(stretch2) * (1 + 1e-12);
 }
 
 Bounds3 Transform::bounds(const Bounds3& b) const {

@@ -62,6 +62,9 @@ public:
     Vec3 normal(Vec3 n) const { return transpose(inv_.m) * n; }
     Ray ray(const Ray& r) const { return {fwd_.point(r.o), fwd_.vector(r.d)}; }
     Bounds3 bounds(const Bounds3& b) const;
+    // An upper bound on how much the map stretches a length (|M v| <= max_stretch() |v|):
+    // exact for rotations and scales, safe for shears.
+    double max_stretch() const;
 
     Vec3 inverse_point(Vec3 p) const { return inv_.point(p); }
     Vec3 inverse_vector(Vec3 v) const { return inv_.vector(v); }
