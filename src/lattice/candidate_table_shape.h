@@ -1,8 +1,16 @@
 #pragma once
-// An exact lattice: the table (encoding `candidates`) names, per snapped pair, the parts of the
-// primitive that a ray snapping to it can meet, and those are intersected exactly with the
-// real ray. Images equal exact mode; the cost of a ray depends on how many parts lie near it,
-// not on how many the primitive has.
+// An exact lattice: the table (encoding `candidates`) names, per snapped pair, the pieces of the
+// primitive (Shape::piece_count) that a ray snapping to it can meet, and those are intersected
+// exactly with the real ray. Images equal exact mode; the cost of a ray depends on how many
+// pieces lie near it, not on how many the primitive has.
+//
+// A primitive that is the union of its pieces (a chain) has each listed piece intersected on
+// its own. Otherwise (CSG: the pieces are its leaves) the primitive is evaluated with the
+// unlisted pieces empty, which changes nothing along the ray's chord through the box: a
+// piece is unlisted only when its solid keeps farther from the pair's segment than any ray
+// snapping to it comes, and those rays' chords lie within kSnapReach of the segment. Outside
+// the chord the primitive is empty, so spans that stay in the chord are the primitive's own;
+// should one leave it (the pieces left on reach outside the box), the primitive answers whole.
 #include <memory>
 
 #include "lattice/lattice_shape.h"
@@ -35,8 +43,14 @@ private:
     LatticeFrame frame_;
     PartBoxes boxes_;  // rejects candidates whose box the ray misses (lattice/part_boxes.h)
 
-    // The parts the ray can meet; false when none.
-    bool candidates(const Ray& r, CandidateList& list) const;
+    bool union_;  // primitive_->pieces_are_union()
+
+    // The pieces the ray can meet, and the ray's chord through the box; false when none.
+    bool candidates(const Ray& r, CandidateList& list, LatticeFrame::Snap& s) const;
+    // Not union_: the primitive's spans along r's line from the listed pieces alone; false
+    // when one leaves the chord (they are then not the primitive's own).
+    bool listed_spans(const Ray& r, const CandidateList& list, const LatticeFrame::Snap& s,
+                      SpanList& out) const;
 };
 
 }  // namespace lat

@@ -58,8 +58,8 @@ std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double gro
         bs.clear();
         shape.primitive_spheres(i, bs);
         for (const BoundingSphere& b : bs)
-            out.push_back({b.center / cell, (b.radius / cell + grow) * (1 + rel_pad) + 1e-9,
-                           static_cast<std::uint32_t>(i)});
+            out.push_back(grown_sphere({b.center / cell, b.radius / cell},
+                                       static_cast<std::uint32_t>(i), grow, rel_pad));
     }
     return out;
 }

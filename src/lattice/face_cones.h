@@ -29,6 +29,13 @@ struct PartSphere {
     std::uint32_t part;
 };
 
+// Sphere b (lattice units) of part `part` grown by `grow` cells and padded against rounding by
+// `rel_pad` of the radius and 1e-9.
+inline PartSphere grown_sphere(const BoundingSphere& b, std::uint32_t part, double grow,
+                               double rel_pad) {
+    return {b.center, (b.radius + grow) * (1 + rel_pad) + 1e-9, part};
+}
+
 // The culling spheres of every part of `shape` (Shape::primitive_spheres), in lattice units
 // (cell: the primitive units of one), grown by `grow` cells and padded against rounding by
 // `rel_pad` of the radius and 1e-9; grouped by part in ascending order, so a list built from

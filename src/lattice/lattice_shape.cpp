@@ -150,17 +150,9 @@ bool LatticeFrame::cull_meets(std::size_t i, const Ray& r) const {
 }
 
 // A point within the reach of a part (primitive units) lies within reach times the largest
-// stretch of xf of the placed part. That stretch squared, the largest eigenvalue of M^T M, is
-// at most the largest absolute row sum of M^T M (Gershgorin): exact for rotations and scales.
+// stretch of xf of the placed part.
 Bounds3 LatticeFrame::placed_parts(const CullPart& p, const Transform& xf) const {
-    const Mat3& m = xf.forward().m;
-    double stretch2 = 0;
-    for (int i = 0; i < 3; ++i) {
-        double row = 0;
-        for (int j = 0; j < 3; ++j) row += std::abs(dot(m.col(i), m.col(j)));
-        stretch2 = std::max(stretch2, row);
-    }
-    const double grow = reach_ * std::sqrt(stretch2) * (1 + 1e-12);
+    const double grow = reach_ * xf.max_stretch();
     Bounds3 placed;
     for (std::uint32_t k = p.part_first; k < p.part_first + p.part_count; ++k)
         placed = merge(placed, expand(primitive_->primitive_bounds(parts_[k], xf), grow));
@@ -199,6 +191,7 @@ bool LatticeFrame::snap(const Ray& r, Snap& s) const {
         if (tf < t1) t1 = tf, ax1 = k;
     }
     if (!(t0 <= t1) || ax0 < 0 || ax1 < 0) return false;
+    s.t0 = t0, s.t1 = t1;
     // Round the entry and exit points to the nearest grid points on their faces.
     auto on_face = [&](double t, int axis, bool high) {
         GridPoint g;

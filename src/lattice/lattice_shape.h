@@ -35,6 +35,7 @@ public:
     // The ray's line in lattice units, and its snapped entry and exit points.
     struct Snap {
         Vec3 o, d;                 // the ray, lattice units
+        double t0 = 0, t1 = 0;       // the ray's chord through the box: parameters of r
         std::uint32_t a = 0, b = 0;  // grid point ids of the entry and exit points
         GridPoint pa, pb;
     };

@@ -18,9 +18,13 @@
 namespace lat {
 namespace {
 
-// Payload tags: "CAND1" stored part sets as 64-bit masks, "CAND2" as sorted index lists.
+// Payload tags: "CAND1" stored part sets as 64-bit masks, "CAND2" as sorted index lists of
+// primitives (Shape::primitive_count), "CAND3" (the same layout) of pieces (Shape::piece_count).
+// The first two name the pieces of shapes that are the union of their primitives, not a CSG's
+// leaves: they open only for such shapes.
 constexpr std::uint64_t kMagicMasks = 0x31444E4143'5441ull;
-constexpr std::uint64_t kMagic = 0x32444E4143'5441ull;
+constexpr std::uint64_t kMagicPrimitives = 0x32444E4143'5441ull;
+constexpr std::uint64_t kMagic = 0x33444E4143'5441ull;
 
 struct Header {
     std::uint64_t magic;
@@ -83,7 +87,8 @@ double segment_segment_distance(Vec3 p0, Vec3 p1, Vec3 q0, Vec3 q1) {
     return length(p0 + d1 * s - (q0 + d2 * t));
 }
 
-// One part of the primitive, in lattice units: what "within reach of a segment" means for it.
+// One piece of the primitive (Shape::piece_count), in lattice units: what "within reach of a
+// segment" means for it.
 struct Part {
     enum Kind { kSphere, kCapsule, kSpheres } kind;
     Vec3 a, b;                            // centre, or capsule axis
@@ -98,10 +103,24 @@ struct Part {
     }
 };
 
-std::vector<Part> parts_of(const Shape& shape, double cell) {
+// Piece i's spheres in lattice units. Segments lie in the box, so a sphere larger than the
+// box's own (a half-space's unbounded one) is replaced by that: near every segment.
+std::vector<BoundingSphere> piece_balls(const Shape& shape, std::size_t i, double cell,
+                                        const Vec3& cells) {
+    const BoundingSphere box{cells * 0.5, 0.5 * length(cells)};
+    std::vector<BoundingSphere> balls;
+    shape.piece_spheres(i, balls);
+    for (BoundingSphere& s : balls) {
+        s = {s.center / cell, s.radius / cell};
+        if (!(s.radius < box.radius) || !std::isfinite(length_squared(s.center))) s = box;
+    }
+    return balls;
+}
+
+std::vector<Part> parts_of(const Shape& shape, double cell, const Vec3& cells) {
     std::vector<Part> parts;
     const auto* chain = dynamic_cast<const ChainShape*>(&shape);
-    for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
+    for (std::size_t i = 0; i < shape.piece_count(); ++i) {
         Part p{Part::kSpheres, {}, {}, 0, {}};
         if (chain && i < chain->spheres().size()) {
             p = {Part::kSphere, chain->spheres()[i].center / cell, {}, chain->spheres()[i].radius / cell, {}};
@@ -110,12 +129,20 @@ std::vector<Part> parts_of(const Shape& shape, double cell) {
             p = {Part::kCapsule, chain->spheres()[static_cast<std::size_t>(c.from)].center / cell,
                  chain->spheres()[static_cast<std::size_t>(c.to)].center / cell, c.radius / cell, {}};
         } else {
-            shape.primitive_spheres(i, p.spheres);
-            for (BoundingSphere& s : p.spheres) s = {s.center / cell, s.radius / cell};
+            p.spheres = piece_balls(shape, i, cell, cells);
         }
         parts.push_back(std::move(p));
     }
     return parts;
+}
+
+// The culling spheres of the pieces, grown by the reach, grouped by piece in ascending order.
+std::vector<PartSphere> cull_spheres(const Shape& shape, double cell, const Vec3& cells) {
+    std::vector<PartSphere> out;
+    for (std::size_t i = 0; i < shape.piece_count(); ++i)
+        for (const BoundingSphere& b : piece_balls(shape, i, cell, cells))
+            out.push_back(grown_sphere(b, static_cast<std::uint32_t>(i), kSnapReach, 1e-9));
+    return out;
 }
 
 struct Scratch {
@@ -140,10 +167,11 @@ struct Block {
 // and a with itself) and the parts within kSnapReach of the segment a b.
 std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& grid, bool progress) {
     const Shape& shape = *ctx.primitive;
-    const std::vector<Part> parts = parts_of(shape, ctx.cell);
-    // Culling spheres, grown by the reach, grouped by part in ascending order: each face point's
-    // list is then built sorted, and a part already in it is its last entry.
-    const std::vector<PartSphere> cull = part_spheres(shape, ctx.cell, kSnapReach, 1e-9);
+    const Vec3 cells{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])};
+    const std::vector<Part> parts = parts_of(shape, ctx.cell, cells);
+    // Grouped by part in ascending order: each face point's list is then built sorted, and a
+    // part already in it is its last entry.
+    const std::vector<PartSphere> cull = cull_spheres(shape, ctx.cell, cells);
     std::array<FaceLayout, 6> faces;
     for (int f = 0; f < 6; ++f) faces[static_cast<std::size_t>(f)] = layout_face(grid, f);
 
@@ -202,8 +230,8 @@ std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& 
 
 ByteBuffer CandidatesTable::build(const TableContext& ctx, bool progress) {
     if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
-    if (ctx.primitive->primitive_count() > 0xFFFFFFFFull)
-        throw std::runtime_error("candidates: the primitive has more than 2^32 parts");
+    if (ctx.primitive->piece_count() > 0xFFFFFFFFull)
+        throw std::runtime_error("candidates: the primitive has more than 2^32 pieces");
     const BoundaryGrid grid(ctx.cells);
     const std::vector<Block> blocks = find_candidates(ctx, grid, progress);
 
@@ -254,7 +282,12 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
     if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
     Header h;
     std::memcpy(&h, payload, sizeof h);
-    if (h.magic != kMagic && h.magic != kMagicMasks) throw std::runtime_error("candidates: bad payload tag");
+    if (h.magic != kMagic && h.magic != kMagicPrimitives && h.magic != kMagicMasks)
+        throw std::runtime_error("candidates: bad payload tag");
+    if (h.magic != kMagic && !ctx.primitive->pieces_are_union())
+        throw std::runtime_error(
+            "candidates: the table lists parts of an older kind for a CSG primitive (rebuild it)");
+    if (h.magic == kMagicPrimitives) h.magic = kMagic;  // the same layout
     points_ = h.points, set_bits_ = h.set_bits, sets_ = h.sets, occupied_ = h.occupied;
     if (points_ != grid_.count() || h.domain != std::uint64_t(points_) * (points_ + 1) / 2 ||
         set_bits_ > 32 || (sets_ > 1 && (1ull << set_bits_) < sets_) || occupied_ > h.domain ||
@@ -295,7 +328,7 @@ void CandidatesTable::lists_from_masks(const std::uint64_t* masks) {
 
 // Every list lies within the index array, ascending, and names parts the primitive has.
 void CandidatesTable::check_lists(std::uint64_t total) const {
-    const std::uint64_t nparts = ctx_.primitive->primitive_count();
+    const std::uint64_t nparts = ctx_.primitive->piece_count();
     if (offsets_[0] != 0 || offsets_[sets_] != total)
         throw std::runtime_error("candidates: part list offsets do not match their count");
     for (std::uint32_t i = 0; i < sets_; ++i) {
@@ -337,9 +370,14 @@ bool CandidatesTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) co
         return true;
     }
     Crossing best{kInfinity, 0, 0};
-    for (int k = 0; k < list.count; ++k) {
-        Crossing c;
-        if (shape.intersect_primitive(list.parts[k], seg, 0.0, std::min(best.t, 1.0 + 1e-12), c)) best = c;
+    if (!shape.pieces_are_union()) {
+        shape.intersect(seg, 0.0, 1.0 + 1e-12, best);  // not a hot path: the whole primitive
+    } else {
+        for (int k = 0; k < list.count; ++k) {
+            Crossing c;
+            const double tmax = std::min(best.t, 1.0 + 1e-12);
+            if (shape.intersect_primitive(list.parts[k], seg, 0.0, tmax, c)) best = c;
+        }
     }
     if (best.t > 1.0) return false;
     hit = {std::min(best.t, 1.0), normalize(shape.normal(seg, best))};
