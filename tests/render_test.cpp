@@ -111,6 +111,42 @@ TEST(Render, InstancedAndFlattenedAgree) {
     EXPECT_GT(covered, ia.rgb.size() / 3 / 10);
 }
 
+// An instance of a CSG primitive as a leaf of a CSG object: a tree inside a tree. Its cut faces
+// must shade with the subtracted sphere's normal (turned) and the leaves' own materials, as
+// the same tree written out in place does.
+TEST(Render, TreesAsCsgLeavesShadeAsWrittenOut) {
+    const std::string head = R"({
+      "camera": {"eye": [7, -9, 6], "look_at": [0, 0, 0.6], "fov_y_deg": 32, "width": 96, "height": 72},
+      "lights": [{"position": [10, -6, 14], "intensity": 0.9}],
+      "materials": {"gold": {"color": [0.85, 0.62, 0.2], "ks": 0.6, "shininess": 40},
+                    "blue": {"color": [0.2, 0.3, 0.9]}},
+      "primitives": {"bite": {"object": BITE, "lattice": {"sigma": 1, "cells": [7, 7, 3]}}},
+      "objects": [{"type": "csg", "op": "union", "material": "gold",
+                   "transform": [{"rotate": {"axis": [1, 0, 0], "angle_deg": 20}}], "children": [
+        LEAF,
+        {"type": "sphere", "center": [0, 0, 1.8], "radius": 0.6, "material": "blue"}]}]})";
+    const std::string bite = R"({"type": "csg", "op": "difference",
+        "transform": [{"translate": [3.5, 3.5, 1.5]}], "children": [
+          {"type": "torus", "major_radius": 2.2, "minor_radius": 0.85},
+          {"type": "sphere", "center": [1.6, -1.6, 0.5], "radius": 1.25}]})";
+    auto scene = [&](const std::string& leaf) {
+        std::string t = head;
+        t.replace(t.find("BITE"), 4, bite);
+        t.replace(t.find("LEAF"), 4, leaf);
+        return load_scene_text(t, "trees.json");
+    };
+    const Scene nested = scene(R"({"type": "instance", "primitive": "bite",
+                                    "transform": [{"translate": [-3.5, -3.5, -1.5]}]})");
+    std::string inline_bite = bite;
+    inline_bite.replace(inline_bite.find("[3.5, 3.5, 1.5]"), 15, "[0, 0, 0]");
+    const Scene written = scene(inline_bite);
+    const Image8 a = render_image(RenderScene(nested), {}).display;
+    const Image8 b = render_image(RenderScene(written), {}).display;
+    int differ = 0;
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) differ += std::abs(a.rgb[i] - b.rgb[i]) > 1;
+    EXPECT_EQ(differ, 0);
+}
+
 TEST(Render, SupersamplingAveragesAnEdge) {
     // A wall (y >= 0) cut to x >= 0 by CSG, seen head-on: its edge runs down the middle of the
     // centre column, so stratified samples give that column half the wall's colour.

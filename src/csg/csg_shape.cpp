@@ -77,7 +77,11 @@ void combine_spans(const SpanList& a, const SpanList& b, CsgOp op, SpanList& out
 
 int CsgShape::add_leaf(CsgLeaf leaf) {
     const Bounds3 b = leaf.shape->placed_bounds(leaf.xf);
-    leaves_.push_back({std::move(leaf), b});
+    const auto* tree = dynamic_cast<const CsgShape*>(leaf.shape.get());
+    const std::uint32_t first = surfaces_;
+    surfaces_ += tree ? tree->surfaces_ : 1;
+    assert(surfaces_ < Crossing::kFlipBit);  // 2^31 leaves would not fit in memory
+    leaves_.push_back({std::move(leaf), b, tree, first});
     return -static_cast<int>(leaves_.size());
 }
 
@@ -168,10 +172,12 @@ void CsgShape::eval(int ref, const Ray& r, SpanList& out, int depth, const LeafS
         t_depth = depth;
         leaf.leaf.shape->spans(local, out);
         t_depth = parent;
-        for (std::size_t k = first; k < out.size(); ++k) {
-            out[k].in.leaf = static_cast<std::uint32_t>(li);
-            out[k].out.leaf = static_cast<std::uint32_t>(li);
-        }
+        // A tree's crossings keep their surface (shifted into this tree's numbers) and flip.
+        for (std::size_t k = first; k < out.size(); ++k)
+            for (Crossing* c : {&out[k].in, &out[k].out})
+                c->leaf = leaf.tree ? (c->leaf & Crossing::kFlipBit) |
+                                          (leaf.first_surface + c->leaf_index())
+                                    : leaf.first_surface;
         return;
     }
     const Node& n = nodes_[static_cast<std::size_t>(ref)];
@@ -228,27 +234,49 @@ void CsgShape::piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) co
         out[k] = {xf.point(out[k].center), out[k].radius * stretch};
 }
 
-Vec3 CsgShape::normal(const Ray& r, const Crossing& c) const {
-    const CsgLeaf& leaf = leaves_[c.leaf_index()].leaf;
-    const Ray local = leaf.xf.is_identity() ? r : leaf.xf.inverse_ray(r);
+CsgShape::Located CsgShape::locate(const Crossing& c) const {
+    const std::uint32_t s = c.leaf_index();
+    assert(s < surfaces_);  // a crossing of this shape (names_surface)
+    const auto it = std::upper_bound(leaves_.begin(), leaves_.end(), s,
+                                     [](std::uint32_t v, const Leaf& l) { return v < l.first_surface; });
+    const Leaf& leaf = *(it - 1);
     Crossing in_leaf = c;
-    in_leaf.leaf = 0;
-    Vec3 n = leaf.shape->normal(local, in_leaf);
+    in_leaf.leaf = leaf.tree ? s - leaf.first_surface : 0;
+    return {&leaf, in_leaf};
+}
+
+bool CsgShape::names_surface(const Crossing& c) const {
+    if (c.leaf_index() >= surfaces_) return false;
+    const Located at = locate(c);
+    return at.leaf->leaf.shape->names_surface(at.in_leaf);
+}
+
+std::uint32_t CsgShape::tag(const Crossing& c, std::uint32_t fallback) const {
+    const Located at = locate(c);
+    const std::uint32_t own = at.leaf->leaf.tag;
+    const std::uint32_t t = at.leaf->tree ? at.leaf->tree->tag(at.in_leaf, own) : own;
+    return t == kNoMaterial ? fallback : t;
+}
+
+Vec3 CsgShape::normal(const Ray& r, const Crossing& c) const {
+    const Located at = locate(c);
+    const CsgLeaf& leaf = at.leaf->leaf;
+    const Ray local = leaf.xf.is_identity() ? r : leaf.xf.inverse_ray(r);
+    Vec3 n = leaf.shape->normal(local, at.in_leaf);
     if (!leaf.xf.is_identity()) n = normalize(leaf.xf.normal(n));
     return c.flipped() ? -n : n;
 }
 
 bool CsgShape::cheap_normal(const Crossing& c) const {
-    assert(c.leaf_index() < leaves_.size());  // a crossing of this shape (names_surface)
-    Crossing in_leaf = c;
-    in_leaf.leaf = 0;
-    return leaves_[c.leaf_index()].leaf.shape->cheap_normal(in_leaf);
+    const Located at = locate(c);
+    return at.leaf->leaf.shape->cheap_normal(at.in_leaf);
 }
 
 SurfacePoint CsgShape::surface(const Ray& r, const Crossing& c) const {
     if (!c.has_stored) return {r.at(c.t), normal(r, c)};
-    const Transform& xf = leaves_[c.leaf_index()].leaf.xf;
-    SurfacePoint s = c.stored;
+    const Located at = locate(c);
+    const Transform& xf = at.leaf->leaf.xf;
+    SurfacePoint s = at.leaf->tree ? at.leaf->tree->surface(xf.inverse_ray(r), at.in_leaf) : c.stored;
     if (!xf.is_identity()) s = {xf.point(s.p), normalize(xf.normal(s.n))};
     if (c.flipped()) s.n = -s.n;
     return s;

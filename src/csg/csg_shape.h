@@ -48,10 +48,7 @@ public:
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
     bool cheap_normal(const Crossing& c) const override;
-    bool names_surface(const Crossing& c) const override {
-        return c.leaf_index() < leaves_.size() &&
-               leaves_[c.leaf_index()].leaf.shape->names_surface({c.t, c.part, 0});
-    }
+    bool names_surface(const Crossing& c) const override;
     // A leaf's stored surface point (lattices) is carried to CSG coordinates.
     SurfacePoint surface(const Ray& r, const Crossing& c) const override;
     bool inside(Vec3 p) const override { return inside(root_, p); }
@@ -64,16 +61,26 @@ public:
                       SpanList& out) const override;
     // The largest of the leaves' (lattices have one), in this shape's units.
     double surface_tolerance() const override { return tolerance_; }
-    std::uint32_t tag(const Crossing& c, std::uint32_t fallback) const override {
-        const std::uint32_t t = leaves_[c.leaf_index()].leaf.tag;
-        return t == kNoMaterial ? fallback : t;
-    }
+    std::uint32_t tag(const Crossing& c, std::uint32_t fallback) const override;
 
 private:
+    // A crossing's leaf field numbers surfaces: one per leaf, except that a leaf which is itself
+    // a tree (an instance of a CSG primitive) has a range, one per surface of its own, so that
+    // its normals and materials are those of the surface crossed.
     struct Leaf {
         CsgLeaf leaf;
-        Bounds3 bounds;  // in CSG coordinates
+        Bounds3 bounds;               // in CSG coordinates
+        const CsgShape* tree;         // leaf.shape when it is a tree, else null
+        std::uint32_t first_surface;  // its numbers: [first_surface, + tree's surfaces_ or 1)
     };
+    std::uint32_t surfaces_ = 0;
+    // The leaf of crossing c, and c as that leaf reported it (its flip bit cleared: this
+    // tree's flips count them all).
+    struct Located {
+        const Leaf* leaf;
+        Crossing in_leaf;
+    };
+    Located locate(const Crossing& c) const;
     struct Node {
         CsgOp op;
         std::vector<int> children;
