@@ -35,12 +35,15 @@ struct Built {
     RasterizeResult raster;
 };
 
-// A table of the scene's first primitive, its lattice refined k times.
-Built build_for(const Scene& s, const std::string& encoding, int k, const EncodeOptions& opt = {}) {
+// A table of the scene's first primitive (or of `shape` in its place), its lattice refined k
+// times.
+Built build_for(const Scene& s, const std::string& encoding, int k, const EncodeOptions& opt = {},
+                const Shape* shape = nullptr) {
     const Primitive& p = s.primitives.at(0);
     const LatticeSpec& l = *p.lattice;
     Built b;
-    b.ctx = {{l.cells[0] * k, l.cells[1] * k, l.cells[2] * k}, l.sigma / k, l.sigma, p.shape.get()};
+    b.ctx = {{l.cells[0] * k, l.cells[1] * k, l.cells[2] * k}, l.sigma / k, l.sigma,
+             shape ? shape : p.shape.get()};
     b.raster = rasterize(b.ctx);
     const Encoding& e = find_encoding(encoding);
     b.payload = e.build(b.raster.raw, b.ctx, opt);
@@ -199,12 +202,12 @@ TEST(EncodingCandidates, EveryPartARayMeetsIsACandidate) {
     EXPECT_GT(hits, 3000);
 }
 
-// Issue 9's CSG class: tilted tori minus a sphere, centred in an 8^3 box, instanced turned.
-const Scene& tori_scene() {
-    static const Scene s = load_scene_text(R"({
+// Issue 9's CSG class: tilted tori minus a sphere, centred in an 8^3 box, placed by `objects`.
+Scene tori_scene_with(const std::string& objects) {
+    std::string text = R"({
       "camera": {"eye": [15, -12, 9], "look_at": [5, 3, 0], "fov_y_deg": 45, "width": 96, "height": 96},
       "lights": [{"position": [40, -30, 50], "intensity": 0.9}],
-      "materials": {"m": {"color": [0.8, 0.6, 0.3], "ks": 0.4}},
+      "materials": {"m": {"color": [0.8, 0.6, 0.3], "ks": 0.4}, "cut": {"color": [0.2, 0.4, 0.9]}},
       "primitives": {"tori": {"object": {"type": "csg", "op": "difference", "children": [
           {"type": "csg", "op": "union", "children": [
             {"type": "torus", "center": [4, 4, 4], "axis": [0.06, 0.8, -0.6], "major_radius": 3, "minor_radius": 0.35},
@@ -213,20 +216,68 @@ const Scene& tori_scene() {
             {"type": "torus", "center": [4, 4, 4], "axis": [-0.21, -0.65, -0.73], "major_radius": 3, "minor_radius": 0.35}]},
           {"type": "sphere", "center": [4, 4, 6.5], "radius": 1.8}]},
         "lattice": {"sigma": 1.0, "cells": [8, 8, 8]}}},
-      "objects": [
+      "objects": OBJECTS})";
+    text.replace(text.find("OBJECTS"), 7, objects);
+    return load_scene_text(text, "tori.json");
+}
+
+// Two instances, one turned, over a floor.
+const Scene& tori_scene() {
+    static const Scene s = tori_scene_with(R"([
         {"type": "instance", "primitive": "tori", "material": "m"},
         {"type": "instance", "primitive": "tori", "material": "m",
          "transform": [{"rotate": {"axis": [1, 2, 3], "angle_deg": 70}}, {"translate": [5, 3, -4]}]},
-        {"type": "halfspace", "point": [0, 0, -6], "normal": [0, 0, 1], "material": "m"}]})",
-                                           "tori.json");
+        {"type": "halfspace", "point": [0, 0, -6], "normal": [0, 0, 1], "material": "m"}])");
     return s;
 }
+
+// An image of s through `candidates` lattices.
+Image8 render_candidates(const Scene& s) {
+    test::TempDir dir;
+    const TableCache cache(dir.path().string(), true);
+    TableSpec spec;
+    spec.encoding = "candidates";
+    const SceneLattices l = scene_lattices(s, cache, spec, false);
+    const RenderScene lattice(s, [&](int i) { return l.shapes[static_cast<std::size_t>(i)]; });
+    return render_image(lattice, {}).display;
+}
+
+// A primitive that counts how it is asked: with some leaves switched off (pieces_spans), or
+// whole (the lattice's fallback when a span leaves the ray's chord).
+class CountingTree final : public Shape {
+public:
+    explicit CountingTree(const Shape& tree) : tree_(tree) {}
+    mutable int whole = 0, pieces = 0;
+
+    Bounds3 bounds() const override { return tree_.bounds(); }
+    bool intersect(const Ray& r, double t0, double t1, Crossing& c) const override {
+        ++whole;
+        return tree_.intersect(r, t0, t1, c);
+    }
+    void spans(const Ray& r, SpanList& out) const override { ++whole, tree_.spans(r, out); }
+    Vec3 normal(const Ray& r, const Crossing& c) const override { return tree_.normal(r, c); }
+    bool inside(Vec3 p) const override { return tree_.inside(p); }
+    std::uint32_t surface_count() const override { return tree_.surface_count(); }
+    std::size_t piece_count() const override { return tree_.piece_count(); }
+    void piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override {
+        tree_.piece_spheres(i, out);
+    }
+    bool pieces_are_union() const override { return tree_.pieces_are_union(); }
+    void pieces_spans(std::span<const std::uint32_t> on, const Ray& r, SpanList& out) const override {
+        ++pieces, tree_.pieces_spans(on, r, out);
+    }
+
+private:
+    const Shape& tree_;
+};
 
 TEST(EncodingCandidates, CsgPrimitivesListTheirLeaves) {
     // Random rays through the lattice of a CSG of tori: the lattice evaluates the tree with the
     // leaves listed for the ray's pair alone, and answers as the whole tree does.
-    const Built b = build_for(tori_scene(), "candidates", 1);
     const Primitive& p = tori_scene().primitives.at(0);
+    const CountingTree counting(*p.shape);
+    const Built b = build_for(tori_scene(), "candidates", 1, {}, &counting);
+    counting.whole = counting.pieces = 0;  // rasterizing asked it whole
     const auto shared = std::shared_ptr<const LatticeTable>(b.table.get(), [](const LatticeTable*) {});
     const auto ls = make_lattice_shape(shared, b.ctx, 0.0);
     std::mt19937 rng(23);
@@ -259,19 +310,34 @@ TEST(EncodingCandidates, CsgPrimitivesListTheirLeaves) {
     EXPECT_GT(hits, 5000);
     // Of five leaves, about three are listed a pair (3.2 when written): the others are off.
     EXPECT_LT(listed, 7 * pairs / 2);
+    // The answers came from the listed leaves: every span stays in the box (the subtracted
+    // sphere, which reaches out of it, only takes away).
+    EXPECT_GT(counting.pieces, 3 * pairs / 2);
+    EXPECT_EQ(counting.whole, 0);
 }
 
 TEST(EncodingCandidates, CsgPrimitivesRenderAsExact) {
-    test::TempDir dir;
-    const TableCache cache(dir.path().string(), true);
-    TableSpec spec;
-    spec.encoding = "candidates";
     const Scene& s = tori_scene();
-    const SceneLattices l = scene_lattices(s, cache, spec, false);
-    const RenderScene lattice(s, [&](int i) { return l.shapes[static_cast<std::size_t>(i)]; });
     const ImageDiffStats d =
-        compare_images(render_image(RenderScene(s), {}).display, render_image(lattice, {}).display);
+        compare_images(render_image(RenderScene(s), {}).display, render_candidates(s));
     EXPECT_EQ(d.max_abs_error, 0);
+}
+
+TEST(EncodingCandidates, CsgPrimitivesAsCsgLeavesRenderAsExact) {
+    // The lattice's crossings name the primitive's surfaces: the cut faces of the subtracted
+    // spheres (the primitive's and the object's) shade with their own normals and materials.
+    const Scene s = tori_scene_with(R"([
+        {"type": "csg", "op": "difference", "material": "m", "children": [
+          {"type": "instance", "primitive": "tori",
+           "transform": [{"rotate": {"axis": [0, 1, 0], "angle_deg": 200}}, {"translate": [8, 0, 8]}]},
+          {"type": "sphere", "center": [5, 4, 6], "radius": 2.2, "material": "cut"}]},
+        {"type": "halfspace", "point": [0, 0, -6], "normal": [0, 0, 1], "material": "m"}])");
+    const Image8 exact = render_image(RenderScene(s), {}).display;
+    EXPECT_EQ(compare_images(exact, render_candidates(s)).max_abs_error, 0);
+    std::size_t covered = 0;
+    for (std::size_t i = 0; i + 2 < exact.rgb.size(); i += 3)
+        covered += std::equal(exact.rgb.begin() + i, exact.rgb.begin() + i + 3, exact.rgb.begin()) ? 0 : 1;
+    EXPECT_GT(covered, exact.rgb.size() / 3 / 10);
 }
 
 TEST(EncodingCandidates, OlderTablesOfCsgPrimitivesAreRefused) {

@@ -4,8 +4,8 @@
 #include <memory>
 #include <random>
 
-#include "geometry/capped_cylinder.h"
 #include "geometry/algebraic.h"
+#include "geometry/capped_cylinder.h"
 #include "geometry/chain.h"
 #include "geometry/halfspace.h"
 #include "geometry/named_shapes.h"
@@ -134,6 +134,20 @@ TEST(Chain, UnionOfPartsMergesSpans) {
     EXPECT_EQ(chain.primitive_count(), 3u);
     EXPECT_TRUE(chain.inside({0, 0, 4.9}));
     EXPECT_FALSE(chain.inside({0.9, 0, 4.9}));
+    // Its pieces (exact lattices) are its parts, and it is their union: the top sphere alone
+    // is the span from 3 to 5, all three the capsule.
+    EXPECT_TRUE(chain.pieces_are_union());
+    const Ray up{{0, 0, -10}, {0, 0, 1}};
+    const std::uint32_t top[] = {1}, all[] = {0, 1, 2};
+    SpanList one, three;
+    chain.pieces_spans(top, up, one);
+    chain.pieces_spans(all, up, three);
+    ASSERT_EQ(one.size(), 1u);
+    EXPECT_DOUBLE_EQ(one[0].in.t, 13);
+    EXPECT_DOUBLE_EQ(one[0].out.t, 15);
+    ASSERT_EQ(three.size(), 1u);
+    EXPECT_DOUBLE_EQ(three[0].in.t, 9);
+    EXPECT_DOUBLE_EQ(three[0].out.t, 15);
 }
 
 TEST(Transform, InverseAndNormals) {
@@ -239,7 +253,6 @@ TEST(Torus, PlacedBoundsAreExact) {
         }
     }
 }
-
 
 // A torus's solid within ball of its ring: the ring test in line_roots (rays that keep out of
 // the slab-and-annulus around the ring cost no quartic) must lose no root. The same polynomial

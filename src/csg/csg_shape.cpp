@@ -1,9 +1,10 @@
 #include "csg/csg_shape.h"
 
+#include "geometry/scratch_spans.h"
+
 #include <cassert>
 #include <algorithm>
 #include <cmath>
-#include <deque>
 
 namespace lat {
 namespace {
@@ -18,18 +19,6 @@ bool apply(CsgOp op, bool a, bool b) {
         case CsgOp::kDifference: return a && !b;
     }
     return false;
-}
-
-// Scratch lists per recursion depth, so that tracing a ray allocates nothing once warm. A leaf
-// may itself be a CSG tree (an instance of a CSG primitive): t_depth is the first depth free
-// for it, so that its lists are not those its parent is still using.
-thread_local int t_depth = 0;
-
-SpanList& scratch(int depth, int which) {
-    thread_local std::deque<SpanList> pool;  // a deque: growing it keeps references valid
-    const auto i = static_cast<std::size_t>(2 * depth + which);
-    if (pool.size() <= i) pool.resize(i + 1);
-    return pool[i];
 }
 
 }  // namespace
@@ -77,11 +66,10 @@ void combine_spans(const SpanList& a, const SpanList& b, CsgOp op, SpanList& out
 
 int CsgShape::add_leaf(CsgLeaf leaf) {
     const Bounds3 b = leaf.shape->placed_bounds(leaf.xf);
-    const auto* tree = dynamic_cast<const CsgShape*>(leaf.shape.get());
-    const std::uint32_t first = surfaces_;
-    surfaces_ += tree ? tree->surfaces_ : 1;
-    assert(surfaces_ < Crossing::kFlipBit);  // 2^31 leaves would not fit in memory
-    leaves_.push_back({std::move(leaf), b, tree, first});
+    const std::uint32_t first = surfaces_, count = leaf.shape->surface_count();
+    assert(count >= 1 && room_for(*leaf.shape));
+    surfaces_ += count;
+    leaves_.push_back({std::move(leaf), b, count > 1, first});
     return -static_cast<int>(leaves_.size());
 }
 
@@ -157,7 +145,7 @@ Bounds3 CsgShape::bounds() const {
                               : nodes_[static_cast<std::size_t>(root_)].bounds;
 }
 
-void CsgShape::eval(int ref, const Ray& r, SpanList& out, int depth, const LeafSet* on) const {
+void CsgShape::eval(int ref, const Ray& r, SpanList& out, const LeafSet* on) const {
     double t0 = -kInfinity, t1 = kInfinity;
     if (is_leaf_ref(ref)) {
         const std::size_t li = leaf_of(ref);
@@ -168,53 +156,48 @@ void CsgShape::eval(int ref, const Ray& r, SpanList& out, int depth, const LeafS
             return;
         const std::size_t first = out.size();
         const Ray local = leaf.leaf.xf.is_identity() ? r : leaf.leaf.xf.inverse_ray(r);
-        const int parent = t_depth;
-        t_depth = depth;
         leaf.leaf.shape->spans(local, out);
-        t_depth = parent;
-        // A tree's crossings keep their surface (shifted into this tree's numbers) and flip.
+        // A numbered leaf's crossings keep their surface (shifted into this tree's numbers) and
+        // flip; others are the leaf's one surface (a table's stored normals face outward).
         for (std::size_t k = first; k < out.size(); ++k)
             for (Crossing* c : {&out[k].in, &out[k].out})
-                c->leaf = leaf.tree ? (c->leaf & Crossing::kFlipBit) |
-                                          (leaf.first_surface + c->leaf_index())
-                                    : leaf.first_surface;
+                c->leaf = leaf.numbered ? (c->leaf & Crossing::kFlipBit) |
+                                              (leaf.first_surface + c->leaf_index())
+                                        : leaf.first_surface;
         return;
     }
     const Node& n = nodes_[static_cast<std::size_t>(ref)];
     if (n.bounds.empty() || !clip_ray(n.bounds, r, t0, t1)) return;
-    eval(n.children[0], r, out, depth + 1, on);
+    eval(n.children[0], r, out, on);
+    if (n.children.size() == 1) return;
+    ScratchSpans b, c;
     for (std::size_t k = 1; k < n.children.size(); ++k) {
         if (out.empty() && n.op != CsgOp::kUnion) return;
-        SpanList& b = scratch(depth, 0);
-        b.clear();
-        eval(n.children[k], r, b, depth + 1, on);
-        if (b.empty() && n.op != CsgOp::kIntersection) continue;
-        SpanList& c = scratch(depth, 1);
-        combine_spans(out, b, n.op, c);
-        out.swap(c);
+        b->clear();
+        eval(n.children[k], r, *b, on);
+        if (b->empty() && n.op != CsgOp::kIntersection) continue;
+        combine_spans(out, *b, n.op, *c);
+        out.swap(*c);
     }
 }
 
 void CsgShape::spans(const Ray& r, SpanList& out) const {
-    SpanList& tmp = scratch(t_depth, 0);
-    tmp.clear();
-    eval(root_, r, tmp, t_depth + 1, nullptr);
-    out.insert(out.end(), tmp.begin(), tmp.end());
+    ScratchSpans tmp;
+    eval(root_, r, *tmp, nullptr);
+    out.insert(out.end(), tmp->begin(), tmp->end());
 }
 
 bool CsgShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
-    SpanList& tmp = scratch(t_depth, 1);
-    tmp.clear();
-    eval(root_, r, tmp, t_depth + 1, nullptr);
-    return first_crossing(tmp, tmin, tmax, hit);
+    ScratchSpans tmp;
+    eval(root_, r, *tmp, nullptr);
+    return first_crossing(*tmp, tmin, tmax, hit);
 }
 
 void CsgShape::pieces_spans(std::span<const std::uint32_t> on, const Ray& r, SpanList& out) const {
     assert(std::is_sorted(on.begin(), on.end()));
-    SpanList& tmp = scratch(t_depth, 0);
-    tmp.clear();
-    eval(root_, r, tmp, t_depth + 1, &on);
-    out.insert(out.end(), tmp.begin(), tmp.end());
+    ScratchSpans tmp;
+    eval(root_, r, *tmp, &on);
+    out.insert(out.end(), tmp->begin(), tmp->end());
 }
 
 // A leaf's spheres, carried to CSG coordinates: centres mapped, radii grown by the largest
@@ -237,11 +220,10 @@ void CsgShape::piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) co
 CsgShape::Located CsgShape::locate(const Crossing& c) const {
     const std::uint32_t s = c.leaf_index();
     assert(s < surfaces_);  // a crossing of this shape (names_surface)
-    const auto it = std::upper_bound(leaves_.begin(), leaves_.end(), s,
-                                     [](std::uint32_t v, const Leaf& l) { return v < l.first_surface; });
-    const Leaf& leaf = *(it - 1);
+    const auto later = [](std::uint32_t v, const Leaf& l) { return v < l.first_surface; };
+    const Leaf& leaf = *(std::upper_bound(leaves_.begin(), leaves_.end(), s, later) - 1);
     Crossing in_leaf = c;
-    in_leaf.leaf = leaf.tree ? s - leaf.first_surface : 0;
+    in_leaf.leaf = s - leaf.first_surface;
     return {&leaf, in_leaf};
 }
 
@@ -253,8 +235,7 @@ bool CsgShape::names_surface(const Crossing& c) const {
 
 std::uint32_t CsgShape::tag(const Crossing& c, std::uint32_t fallback) const {
     const Located at = locate(c);
-    const std::uint32_t own = at.leaf->leaf.tag;
-    const std::uint32_t t = at.leaf->tree ? at.leaf->tree->tag(at.in_leaf, own) : own;
+    const std::uint32_t t = at.leaf->leaf.shape->tag(at.in_leaf, at.leaf->leaf.tag);
     return t == kNoMaterial ? fallback : t;
 }
 
@@ -276,7 +257,8 @@ SurfacePoint CsgShape::surface(const Ray& r, const Crossing& c) const {
     if (!c.has_stored) return {r.at(c.t), normal(r, c)};
     const Located at = locate(c);
     const Transform& xf = at.leaf->leaf.xf;
-    SurfacePoint s = at.leaf->tree ? at.leaf->tree->surface(xf.inverse_ray(r), at.in_leaf) : c.stored;
+    SurfacePoint s =
+        at.leaf->numbered ? at.leaf->leaf.shape->surface(xf.inverse_ray(r), at.in_leaf) : c.stored;
     if (!xf.is_identity()) s = {xf.point(s.p), normalize(xf.normal(s.n))};
     if (c.flipped()) s.n = -s.n;
     return s;

@@ -15,6 +15,9 @@ enum class CsgOp { kUnion, kIntersection, kDifference };
 
 // A leaf tag meaning "no material of its own": the object's material applies.
 inline constexpr std::uint32_t kNoMaterial = 0xFFFFFFFFu;
+// Surfaces one tree can number (Shape::surface_count): a crossing's leaf field below its flip
+// bit. Instances of CSG primitives as leaves multiply them.
+inline constexpr std::uint32_t kMaxCsgSurfaces = Crossing::kFlipBit - 1;
 
 struct CsgLeaf {
     std::shared_ptr<const Shape> shape;
@@ -27,7 +30,9 @@ class CsgShape final : public Shape {
 public:
     // Children are references returned by add_leaf / add_node. Nodes are n-ary: union and
     // intersection of all children; difference is the first child minus all the others.
-    int add_leaf(CsgLeaf leaf);
+    int add_leaf(CsgLeaf leaf);  // requires room_for(*leaf.shape)
+    // Whether the tree can number the surfaces of one more leaf of this shape.
+    bool room_for(const Shape& s) const { return s.surface_count() <= kMaxCsgSurfaces - surfaces_; }
     int add_node(CsgOp op, std::vector<int> children);
     // Ends construction; the tree must be non-empty.
     void set_root(int ref);
@@ -48,6 +53,7 @@ public:
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;
     bool cheap_normal(const Crossing& c) const override;
+    std::uint32_t surface_count() const override { return surfaces_; }
     bool names_surface(const Crossing& c) const override;
     // A leaf's stored surface point (lattices) is carried to CSG coordinates.
     SurfacePoint surface(const Ray& r, const Crossing& c) const override;
@@ -64,14 +70,14 @@ public:
     std::uint32_t tag(const Crossing& c, std::uint32_t fallback) const override;
 
 private:
-    // A crossing's leaf field numbers surfaces: one per leaf, except that a leaf which is itself
-    // a tree (an instance of a CSG primitive) has a range, one per surface of its own, so that
-    // its normals and materials are those of the surface crossed.
+    // A crossing's leaf field numbers surfaces: one per leaf, except that a leaf whose shape
+    // names several (a tree: an instance of a CSG primitive, exact or through a `candidates`
+    // lattice) has a range, so that normals and materials are those of the surface crossed.
     struct Leaf {
         CsgLeaf leaf;
         Bounds3 bounds;               // in CSG coordinates
-        const CsgShape* tree;         // leaf.shape when it is a tree, else null
-        std::uint32_t first_surface;  // its numbers: [first_surface, + tree's surfaces_ or 1)
+        bool numbered;                // its shape names several surfaces
+        std::uint32_t first_surface;  // its numbers: [first_surface, + its surface_count())
     };
     std::uint32_t surfaces_ = 0;
     // The leaf of crossing c, and c as that leaf reported it (its flip bit cleared: this
@@ -97,7 +103,7 @@ private:
     // The spans of subtree ref along r's line; `on`, when set, lists the leaves evaluated
     // (ascending), the others counting as empty.
     using LeafSet = std::span<const std::uint32_t>;
-    void eval(int ref, const Ray& r, SpanList& out, int depth, const LeafSet* on) const;
+    void eval(int ref, const Ray& r, SpanList& out, const LeafSet* on) const;
     bool inside(int ref, Vec3 p) const;
 };
 

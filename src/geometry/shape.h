@@ -130,6 +130,10 @@ public:
     // Whether c's part (and CSG leaf) name a surface of this shape, so that normal() may be
     // asked for it: crossings read from files (lattice tables) are checked with it first.
     virtual bool names_surface(const Crossing& c) const { return c.part == 0; }
+    // How many surfaces the leaf field of this shape's crossings can name, each with its own
+    // normal and material (a CSG tree: one per surface of its leaves); 1 for shapes whose
+    // crossings need no such name.
+    virtual std::uint32_t surface_count() const { return 1; }
     // Whether normal() at c is a few flops (a plane, quadric, sphere or cylinder), not the
     // gradient of a quartic: `dense` tables store a hit's part, to re-evaluate its normal at
     // every lookup, only where that is cheap.

@@ -1,33 +1,10 @@
 #include "lattice/candidate_table_shape.h"
 
 #include <cassert>
-#include <deque>
+
+#include "geometry/scratch_spans.h"
 
 namespace lat {
-namespace {
-
-// A span list per nesting level (a lattice leaf of a CSG primitive of a lattice), so that a
-// visit allocates nothing once warm and a nested visit does not reuse its caller's list.
-class ScratchSpans {
-public:
-    ScratchSpans() : list_(level(depth_++)) { list_.clear(); }
-    ~ScratchSpans() { --depth_; }
-    ScratchSpans(const ScratchSpans&) = delete;
-    ScratchSpans& operator=(const ScratchSpans&) = delete;
-    SpanList& get() { return list_; }
-
-private:
-    static SpanList& level(std::size_t i) {
-        thread_local std::deque<SpanList> pool;  // a deque: growing it keeps references valid
-        if (pool.size() <= i) pool.resize(i + 1);
-        return pool[i];
-    }
-    static thread_local std::size_t depth_;
-    SpanList& list_;
-};
-thread_local std::size_t ScratchSpans::depth_ = 0;
-
-}  // namespace
 
 CandidateTableShape::CandidateTableShape(std::shared_ptr<const LatticeTable> table,
                                          const TableContext& ctx)
@@ -59,9 +36,9 @@ bool CandidateTableShape::intersect(const Ray& r, double tmin, double tmax, Cros
     if (!candidates(r, list, s)) return false;
     if (!union_) {
         ScratchSpans spans;
-        if (!listed_spans(r, list, s, spans.get()))
+        if (!listed_spans(r, list, s, *spans))
             return primitive_->intersect(r, tmin, tmax, hit);
-        return first_crossing(spans.get(), tmin, tmax, hit);
+        return first_crossing(*spans, tmin, tmax, hit);
     }
     const PartBoxes::Ray4 slabs(boxes_, r);
     PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);
@@ -84,9 +61,9 @@ bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const
     if (!candidates(r, list, s)) return false;
     if (!union_) {
         ScratchSpans spans;
-        if (!listed_spans(r, list, s, spans.get())) return primitive_->occluded(r, tmin, tmax);
+        if (!listed_spans(r, list, s, *spans)) return primitive_->occluded(r, tmin, tmax);
         Crossing c;
-        return first_crossing(spans.get(), tmin, tmax, c);
+        return first_crossing(*spans, tmin, tmax, c);
     }
     const PartBoxes::Ray4 slabs(boxes_, r);
     const PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);

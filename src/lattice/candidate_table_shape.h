@@ -31,6 +31,13 @@ public:
         return primitive_->normal(r, c);
     }
     bool inside(Vec3 p) const override { return primitive_->inside(p); }
+    // Crossings are the primitive's own: it names their surfaces and materials.
+    std::uint32_t surface_count() const override { return primitive_->surface_count(); }
+    bool names_surface(const Crossing& c) const override { return primitive_->names_surface(c); }
+    bool cheap_normal(const Crossing& c) const override { return primitive_->cheap_normal(c); }
+    std::uint32_t tag(const Crossing& c, std::uint32_t fallback) const override {
+        return primitive_->tag(c, fallback);
+    }
     std::size_t cull_count() const override { return frame_.cull_count(); }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf) const override {
         return frame_.cull_bounds(i, xf);

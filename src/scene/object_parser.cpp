@@ -207,6 +207,9 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
     if (override_material && v.has("material")) (void)material(v.at("material"));  // still check
     const Transform placed = xf * leaf.placement;
     require_finite_transform(placed, v);
+    if (!csg.room_for(*leaf.shape))
+        v.fail("a csg tree with more than " + std::to_string(kMaxCsgSurfaces) +
+               " surfaces (instances of csg primitives count all of theirs)");
     return csg.add_leaf({leaf.shape, placed, mat, leaf.primitive});
 }
 

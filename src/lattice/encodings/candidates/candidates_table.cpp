@@ -88,18 +88,17 @@ double segment_segment_distance(Vec3 p0, Vec3 p1, Vec3 q0, Vec3 q1) {
 }
 
 // One piece of the primitive (Shape::piece_count), in lattice units: what "within reach of a
-// segment" means for it.
+// segment" means for it. A chain's spheres and capsules are tested exactly; other pieces by
+// their spheres, one at a time (the culling sphere that found the segment: a mesh leaf has one
+// per triangle, and scanning them all for every segment would be quadratic).
 struct Part {
     enum Kind { kSphere, kCapsule, kSpheres } kind;
-    Vec3 a, b;                            // centre, or capsule axis
-    double r;                             // radius
-    std::vector<BoundingSphere> spheres;  // for other shapes
-    bool near(Vec3 p, Vec3 q, double reach) const {
-        if (kind == kSphere) return point_segment_distance(a, p, q) <= r + reach;
-        if (kind == kCapsule) return segment_segment_distance(p, q, a, b) <= r + reach;
-        for (const BoundingSphere& s : spheres)
-            if (point_segment_distance(s.center, p, q) <= s.radius + reach) return true;
-        return false;
+    Vec3 a, b;  // centre, or capsule axis
+    double r;   // radius
+    bool near(const PartSphere& found_by, Vec3 p, Vec3 q) const {
+        if (kind == kSphere) return point_segment_distance(a, p, q) <= r + kSnapReach;
+        if (kind == kCapsule) return segment_segment_distance(p, q, a, b) <= r + kSnapReach;
+        return point_segment_distance(found_by.c, p, q) <= found_by.r;  // grown by the reach
     }
 };
 
@@ -117,21 +116,20 @@ std::vector<BoundingSphere> piece_balls(const Shape& shape, std::size_t i, doubl
     return balls;
 }
 
-std::vector<Part> parts_of(const Shape& shape, double cell, const Vec3& cells) {
+std::vector<Part> parts_of(const Shape& shape, double cell) {
     std::vector<Part> parts;
     const auto* chain = dynamic_cast<const ChainShape*>(&shape);
     for (std::size_t i = 0; i < shape.piece_count(); ++i) {
-        Part p{Part::kSpheres, {}, {}, 0, {}};
+        Part p{Part::kSpheres, {}, {}, 0};
         if (chain && i < chain->spheres().size()) {
-            p = {Part::kSphere, chain->spheres()[i].center / cell, {}, chain->spheres()[i].radius / cell, {}};
+            const ChainSphere& s = chain->spheres()[i];
+            p = {Part::kSphere, s.center / cell, {}, s.radius / cell};
         } else if (chain) {
             const ChainCylinder& c = chain->cylinders()[i - chain->spheres().size()];
             p = {Part::kCapsule, chain->spheres()[static_cast<std::size_t>(c.from)].center / cell,
-                 chain->spheres()[static_cast<std::size_t>(c.to)].center / cell, c.radius / cell, {}};
-        } else {
-            p.spheres = piece_balls(shape, i, cell, cells);
+                 chain->spheres()[static_cast<std::size_t>(c.to)].center / cell, c.radius / cell};
         }
-        parts.push_back(std::move(p));
+        parts.push_back(p);
     }
     return parts;
 }
@@ -168,7 +166,7 @@ struct Block {
 std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& grid, bool progress) {
     const Shape& shape = *ctx.primitive;
     const Vec3 cells{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])};
-    const std::vector<Part> parts = parts_of(shape, ctx.cell, cells);
+    const std::vector<Part> parts = parts_of(shape, ctx.cell);
     // Grouped by part in ascending order: each face point's list is then built sorted, and a
     // part already in it is its last entry.
     const std::vector<PartSphere> cull = cull_spheres(shape, ctx.cell, cells);
@@ -196,8 +194,9 @@ std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& 
             const Vec3 p = to_vec(ga);
             // The pair of a point with itself: parts within reach of the point.
             self.clear();
-            for (std::size_t i = 0; i < parts.size(); ++i)
-                if (parts[i].near(p, p, kSnapReach)) self.push_back(static_cast<std::uint32_t>(i));
+            for (const PartSphere& ps : cull)
+                if ((self.empty() || self.back() != ps.part) && parts[ps.part].near(ps, p, p))
+                    self.push_back(ps.part);
             if (!self.empty()) emit(CandidatesTable::pair_index(a, a), self);
             for (const FaceLayout& fl : faces) {
                 if (s.parts.size() < fl.mask.size()) s.parts.resize(fl.mask.size());
@@ -206,7 +205,7 @@ std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& 
                         std::vector<std::uint32_t>& l = s.parts[k];
                         if (fl.ids[k] <= a || (!l.empty() && l.back() == ps.part)) return;
                         if (!BoundaryGrid::valid_pair(fa, fl.mask[k])) return;
-                        if (!parts[ps.part].near(p, q, kSnapReach)) return;
+                        if (!parts[ps.part].near(ps, p, q)) return;
                         if (l.empty()) s.touched.push_back(k);
                         l.push_back(ps.part);
                     });
