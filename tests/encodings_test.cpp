@@ -19,6 +19,7 @@
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 #include "test_paths.h"
+#include "util/error.h"
 
 namespace lat {
 namespace {
@@ -347,6 +348,29 @@ TEST(EncodingCandidates, OlderTablesOfCsgPrimitivesAreRefused) {
     std::memcpy(b.payload.data(), &magic2, 8);
     EXPECT_THROW(CandidatesTable(b.payload.data(), b.payload.size(), b.table->entries(), b.ctx),
                  std::runtime_error);
+}
+
+TEST(EncodingCandidates, BuildsStopAtTheirMemoryBudget) {
+    // A table's lists grow with the parts near each pair, which the plan before a build cannot
+    // foresee: past its budget the build stops with an input error, not an exhausted machine.
+    const Primitive& p = hair_scene().primitives.at(0);
+    const LatticeSpec& l = *p.lattice;
+    const TableContext ctx{{l.cells[0] * 2, l.cells[1] * 2, l.cells[2] * 2}, l.sigma / 2, l.sigma,
+                           p.shape.get()};
+    EncodeOptions small;
+    small.memory_budget = 20000;
+    try {
+        find_encoding("candidates").build({}, ctx, small);
+        FAIL() << "built within 20 kB";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("more than the 20.0 kB of memory it may use"),
+                  std::string::npos)
+            << e.what();
+    }
+    EncodeOptions ample;
+    ample.memory_budget = 100'000'000;
+    const ByteBuffer payload = find_encoding("candidates").build({}, ctx, ample);
+    EXPECT_EQ(payload.size(), find_encoding("candidates").build({}, ctx, {}).size());
 }
 
 TEST(EncodingCandidates, PlatesRenderAsExact) {

@@ -29,6 +29,10 @@ struct EncodeOptions {
     double max_point_error = 0.01;
     double max_normal_error_deg = 1.0;
     DenseNormals normals = DenseNormals::kAuto;
+    // Bytes a build may hold at its peak, 0 for no limit: encodings whose size the plan cannot
+    // foresee from the hits (`candidates`: lists grow with the parts near each pair) stop with
+    // an InputError past it. Not part of the table: a build fits or is refused.
+    std::size_t memory_budget = 0;
 };
 
 struct Encoding {

@@ -70,6 +70,15 @@ void check_points(const TablePlan& plan) {
                          lattice_size(h) + " has " + std::to_string(count));
 }
 
+// The payload; an encoding's refusal (a limit reached while building) names the primitive.
+ByteBuffer encode(const TablePlan& plan, const RawHits& hits, const EncodeOptions& options) {
+    try {
+        return plan.encoding->build(hits, plan.context, options);
+    } catch (const InputError& e) {
+        throw InputError(plan.place + "primitive '" + plan.primitive->name + "': " + e.what());
+    }
+}
+
 }  // namespace
 
 void check_buildable(const TablePlan& plan) {
@@ -107,7 +116,9 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
     b.raster = rasterize(plan.context, opt);
     const auto encode_and_write = [&] {
         const auto t0 = std::chrono::steady_clock::now();
-        const ByteBuffer payload = plan.encoding->build(b.raster.raw, plan.context, plan.options);
+        EncodeOptions options = plan.options;
+        options.memory_budget = static_cast<std::size_t>(0.8 * double(available_memory_bytes()));
+        const ByteBuffer payload = encode(plan, b.raster.raw, options);
         b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         b.raster.raw = {};
         b.header.pairs = b.raster.pairs_eq2;

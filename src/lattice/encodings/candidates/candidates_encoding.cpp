@@ -13,8 +13,8 @@ const Encoding kCandidatesEncoding{
     .needs_hits = false,
     // 2: CAND3, whose lists name a CSG primitive's leaves (Shape::piece_count).
     .layout = 2,
-    .build = [](const RawHits&, const TableContext& ctx, const EncodeOptions&) {
-        return CandidatesTable::build(ctx, false);
+    .build = [](const RawHits&, const TableContext& ctx, const EncodeOptions& opt) {
+        return CandidatesTable::build(ctx, false, opt.memory_budget);
     },
     .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                const TableContext& ctx) -> std::unique_ptr<LatticeTable> {

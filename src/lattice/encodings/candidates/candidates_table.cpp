@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +14,8 @@
 
 #include "geometry/chain.h"
 #include "lattice/face_cones.h"
+#include "util/error.h"
+#include "util/memory.h"
 #include "util/progress.h"
 
 namespace lat {
@@ -161,9 +164,24 @@ struct Block {
     }
 };
 
+[[noreturn]] void refuse(std::uint64_t held, std::uint64_t done, std::uint32_t points,
+                         std::size_t budget) {
+    char buf[400];
+    std::snprintf(buf, sizeof buf,
+                  "the candidates table would need more than the %s of memory it may use: its "
+                  "part lists took %s for %llu of %u boundary points (they grow with the parts "
+                  "near each pair); use a coarser lattice or another encoding",
+                  human_bytes(double(budget)).c_str(), human_bytes(double(held)).c_str(),
+                  static_cast<unsigned long long>(done), points);
+    throw InputError(buf);
+}
+
 // What the rasterizer does for hits, for reach: per block of entry points, the pairs (a, b > a,
 // and a with itself) and the parts within kSnapReach of the segment a b.
-std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& grid, bool progress) {
+// The lists are about half of the build's peak (the distinct sets and the payload follow): past
+// half the budget it stops.
+std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& grid, bool progress,
+                                   std::size_t budget) {
     const Shape& shape = *ctx.primitive;
     const Vec3 cells{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])};
     const std::vector<Part> parts = parts_of(shape, ctx.cell);
@@ -178,6 +196,7 @@ std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& 
     const std::uint32_t nblocks = (npoints + kBlock - 1) / kBlock;
     std::vector<Block> blocks(nblocks);
     tbb::enumerable_thread_specific<Scratch> scratch;
+    std::atomic<std::uint64_t> held{0}, done{0};
     ProgressBar bar("candidates", npoints, progress);
     tbb::parallel_for(std::uint32_t{0}, nblocks, [&](std::uint32_t blk) {
         Scratch& s = scratch.local();
@@ -219,7 +238,11 @@ std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& 
         }
         std::sort(out.found.begin(), out.found.end(),
                   [](const Found& x, const Found& y) { return x.pair < y.pair; });
-        bar.add(std::min(npoints, (blk + 1) * kBlock) - blk * kBlock);
+        const std::uint32_t points = std::min(npoints, (blk + 1) * kBlock) - blk * kBlock;
+        bar.add(points);
+        const std::uint64_t bytes = out.found.capacity() * sizeof(Found) + out.pool.capacity() * 4;
+        const std::uint64_t total = held += bytes, finished = done += points;
+        if (budget && 2 * total > budget) refuse(total, finished, npoints, budget);
     });
     bar.finish();
     return blocks;
@@ -227,12 +250,12 @@ std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& 
 
 }  // namespace
 
-ByteBuffer CandidatesTable::build(const TableContext& ctx, bool progress) {
+ByteBuffer CandidatesTable::build(const TableContext& ctx, bool progress, std::size_t memory_budget) {
     if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
     if (ctx.primitive->piece_count() > 0xFFFFFFFFull)
         throw std::runtime_error("candidates: the primitive has more than 2^32 pieces");
     const BoundaryGrid grid(ctx.cells);
-    const std::vector<Block> blocks = find_candidates(ctx, grid, progress);
+    const std::vector<Block> blocks = find_candidates(ctx, grid, progress, memory_budget);
 
     // Distinct part lists, numbered in first-seen order (deterministic), each stored once.
     std::unordered_map<std::string_view, std::uint32_t> set_id;

@@ -23,7 +23,8 @@ namespace lat {
 
 class CandidatesTable final : public LatticeTable {
 public:
-    static ByteBuffer build(const TableContext& ctx, bool progress);
+    // Past memory_budget bytes (0: no limit) the build stops with an InputError.
+    static ByteBuffer build(const TableContext& ctx, bool progress, std::size_t memory_budget = 0);
     CandidatesTable(const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                     const TableContext& ctx);
 
