@@ -56,6 +56,14 @@ Built build(const std::string& encoding, int k, const EncodeOptions& opt = {}) {
     return build_for(hair_scene(), encoding, k, opt);
 }
 
+// A ray from 30 units away through a random point of the box [0, size].
+Ray ray_into(const Vec3& size, std::mt19937& rng) {
+    std::uniform_real_distribution<double> u(0, 1);
+    const Vec3 target{size.x * u(rng), size.y * u(rng), size.z * u(rng)};
+    const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+    return {target - d * 30, d};
+}
+
 std::uint32_t normal_mode(const Built& b) {
     return static_cast<const DenseTable&>(*b.table).layout().normal_mode;  // 1: part codes
 }
@@ -184,12 +192,9 @@ TEST(EncodingCandidates, EveryPartARayMeetsIsACandidate) {
     const auto shared = std::shared_ptr<const LatticeTable>(b.table.get(), [](const LatticeTable*) {});
     const auto ls = make_lattice_shape(shared, b.ctx, 0.0);
     std::mt19937 rng(17);
-    std::uniform_real_distribution<double> u(0, 1);
     int hits = 0;
     for (int n = 0; n < 50000; ++n) {
-        const Vec3 target{7 * u(rng), 7 * u(rng), 20 * u(rng)};
-        const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
-        const Ray ray{target - d * 30, d};
+        const Ray ray = ray_into({7, 7, 20}, rng);
         Crossing ce, cl;
         const bool exact = p.shape->intersect(ray, 0, kInfinity, ce);
         const bool lattice = ls->intersect(ray, 0, kInfinity, cl);
@@ -285,9 +290,7 @@ TEST(EncodingCandidates, CsgPrimitivesListTheirLeaves) {
     std::uniform_real_distribution<double> u(0, 1);
     int hits = 0, listed = 0, pairs = 0;
     for (int n = 0; n < 20000; ++n) {
-        const Vec3 target{8 * u(rng), 8 * u(rng), 8 * u(rng)};
-        const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
-        const Ray ray{target - d * 30, d};
+        const Ray ray = ray_into({8, 8, 8}, rng);
         Crossing ce, cl;
         const bool exact = p.shape->intersect(ray, 0, kInfinity, ce);
         ASSERT_EQ(exact, ls->intersect(ray, 0, kInfinity, cl)) << n;
