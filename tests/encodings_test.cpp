@@ -351,6 +351,11 @@ TEST(EncodingCandidates, OlderTablesOfCsgPrimitivesAreRefused) {
     std::memcpy(b.payload.data(), &magic2, 8);
     EXPECT_THROW(CandidatesTable(b.payload.data(), b.payload.size(), b.table->entries(), b.ctx),
                  std::runtime_error);
+    // A chain's CAND2 table (the same layout) still opens: its primitives are its pieces.
+    Built hair = build("candidates", 1);
+    std::memcpy(hair.payload.data(), &magic2, 8);
+    const CandidatesTable old(hair.payload.data(), hair.payload.size(), hair.table->entries(), hair.ctx);
+    EXPECT_EQ(old.pairs_stored(), static_cast<const CandidatesTable&>(*hair.table).pairs_stored());
 }
 
 TEST(EncodingCandidates, BuildsStopAtTheirMemoryBudget) {
