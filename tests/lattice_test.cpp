@@ -108,6 +108,23 @@ TEST(LatticeRasterize, MatchesBruteForceOnARandomChain) {
     EXPECT_LT(r.tests, 4 * r.hits);  // the cone culling does its job
 }
 
+TEST(LatticeRasterize, PartsBeyondWhatAHitRecordsAreAnInputError) {
+    // A hit records its part in 16 bits (a chain of at most 16,384 parts): a chain of 16,400
+    // spheres, the last the largest, cannot have a hit table, and says so; counting its hits
+    // (candidates tables need no parts) still works.
+    std::vector<ChainSphere> spheres;
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<double> u(0.5, 3.5);
+    for (int i = 0; i < 16399; ++i) spheres.push_back({{u(rng), u(rng), u(rng)}, 0.02});
+    spheres.push_back({{2, 2, 2}, 1.0});
+    const ChainShape chain(spheres, {});
+    const TableContext ctx{{4, 4, 4}, 1.0, 1.0, &chain};
+    EXPECT_THROW(rasterize(ctx), InputError);
+    RasterizeOptions count_only;
+    count_only.keep_hits = false;
+    EXPECT_GT(rasterize(ctx, count_only).hits, 100u);
+}
+
 TEST(LatticeRasterize, IndependentOfThreadCount) {
     const ChainShape s = hook();
     const TableContext lg{{8, 4, 8}, 0.5, 1.0, &s};

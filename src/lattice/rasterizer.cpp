@@ -16,6 +16,7 @@
 #include "lattice/boundary_grid.h"
 #include "lattice/face_cones.h"
 #include "lattice/octahedral.h"
+#include "util/error.h"
 #include "util/progress.h"
 
 namespace lat {
@@ -24,6 +25,16 @@ namespace {
 constexpr std::uint32_t kBlock = 32;  // entry points per task
 
 
+
+// A hit records its part and CSG leaf in 16 and 15 bits (RawHit): a primitive whose crossings
+// are numbered beyond cannot have a hit table (its normals would come from another part).
+[[noreturn]] void refuse_part(const Crossing& c) {
+    throw InputError("a hit on part number " + std::to_string(c.part) + ", leaf " +
+                     std::to_string(c.leaf_index()) + ": hit tables record parts up to " +
+                     std::to_string(RawHit::kMaxPart) + " (a chain of at most 16,384 spheres and " +
+                     "cylinders) and leaves up to " + std::to_string(RawHit::kMaxLeaf) +
+                     "; use the candidates encoding, or split the primitive");
+}
 
 struct Counts {
     std::uint64_t enumerated = 0, traced = 0, hits = 0, counted = 0, tests = 0;
@@ -187,7 +198,7 @@ private:
             c = nearest_crossing(shape, r);
         }
         const Oct o = oct_encode(shape.normal(r, c), kRawNormalBits);
-        assert(c.part <= RawHit::kMaxPart && c.leaf_index() <= RawHit::kMaxLeaf);
+        if (c.part > RawHit::kMaxPart || c.leaf_index() > RawHit::kMaxLeaf) refuse_part(c);
         return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v),
                 static_cast<std::uint16_t>(c.part), RawHit::pack_leaf(c.leaf)};
     }

@@ -113,7 +113,11 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
     opt.progress = progress;
     opt.keep_hits = plan.encoding->needs_hits;
     opt.across_ranks = across_ranks;
-    b.raster = rasterize(plan.context, opt);
+    try {
+        b.raster = rasterize(plan.context, opt);
+    } catch (const InputError& e) {  // a limit the hits reached (rasterizer.cpp)
+        throw InputError(plan.place + "primitive '" + plan.primitive->name + "': " + e.what());
+    }
     const auto encode_and_write = [&] {
         const auto t0 = std::chrono::steady_clock::now();
         EncodeOptions options = plan.options;
