@@ -149,6 +149,7 @@ std::vector<PartSphere> cull_spheres(const Shape& shape, double cell, const Vec3
 struct Scratch {
     std::vector<std::vector<std::uint32_t>> parts;  // per face point: its parts, ascending
     std::vector<std::size_t> touched;
+    std::vector<std::uint32_t> self;
 };
 
 // A pair's part list, kept in its block's pool.
@@ -159,6 +160,11 @@ struct Found {
 struct Block {
     std::vector<Found> found;
     std::vector<std::uint32_t> pool;
+    void emit(std::uint64_t pair, const std::vector<std::uint32_t>& list) {
+        found.push_back({pair, static_cast<std::uint32_t>(pool.size()),
+                         static_cast<std::uint32_t>(list.size())});
+        pool.insert(pool.end(), list.begin(), list.end());
+    }
     std::string_view list(const Found& f) const {
         return {reinterpret_cast<const char*>(pool.data() + f.first), f.count * sizeof(std::uint32_t)};
     }
@@ -176,21 +182,63 @@ struct Block {
     throw InputError(buf);
 }
 
-// What the rasterizer does for hits, for reach: per block of entry points, the pairs (a, b > a,
-// and a with itself) and the parts within kSnapReach of the segment a b.
-// The lists are about half of the build's peak (the distinct sets and the payload follow): past
-// half the budget it stops.
-std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& grid, bool progress,
-                                   std::size_t budget) {
-    const Shape& shape = *ctx.primitive;
-    const Vec3 cells{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])};
-    const std::vector<Part> parts = parts_of(shape, ctx.cell);
+// What the rasterizer does for hits, for reach: for an entry point a, the pairs (a, b > a, and
+// a with itself) and the parts within kSnapReach of the segment a b.
+class CandidateFinder {
+public:
+    CandidateFinder(const TableContext& ctx, const BoundaryGrid& grid)
+        : grid_(grid), parts_(parts_of(*ctx.primitive, ctx.cell)) {
+        const Vec3 cells{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])};
+        cull_ = cull_spheres(*ctx.primitive, ctx.cell, cells);
+        for (int f = 0; f < 6; ++f) faces_[static_cast<std::size_t>(f)] = layout_face(grid, f);
+    }
+
+    void entry(std::uint32_t a, Scratch& s, Block& out) const {
+        const GridPoint ga = grid_.point(a);
+        const std::uint8_t fa = grid_.faces(ga);
+        const Vec3 p = to_vec(ga);
+        // The pair of a point with itself: parts within reach of the point.
+        std::vector<std::uint32_t>& self = s.self;
+        self.clear();
+        for (const PartSphere& ps : cull_)
+            if ((self.empty() || self.back() != ps.part) && parts_[ps.part].near(ps, p, p))
+                self.push_back(ps.part);
+        if (!self.empty()) out.emit(CandidatesTable::pair_index(a, a), self);
+        for (const FaceLayout& fl : faces_) {
+            if (s.parts.size() < fl.mask.size()) s.parts.resize(fl.mask.size());
+            for (const PartSphere& ps : cull_) {
+                for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
+                    std::vector<std::uint32_t>& l = s.parts[k];
+                    if (fl.ids[k] <= a || (!l.empty() && l.back() == ps.part)) return;
+                    if (!BoundaryGrid::valid_pair(fa, fl.mask[k])) return;
+                    if (!parts_[ps.part].near(ps, p, q)) return;
+                    if (l.empty()) s.touched.push_back(k);
+                    l.push_back(ps.part);
+                });
+            }
+            for (const std::size_t k : s.touched) {
+                out.emit(CandidatesTable::pair_index(a, fl.ids[k]), s.parts[k]);
+                s.parts[k].clear();
+            }
+            s.touched.clear();
+        }
+    }
+
+private:
+    const BoundaryGrid& grid_;
+    std::vector<Part> parts_;
     // Grouped by part in ascending order: each face point's list is then built sorted, and a
     // part already in it is its last entry.
-    const std::vector<PartSphere> cull = cull_spheres(shape, ctx.cell, cells);
-    std::array<FaceLayout, 6> faces;
-    for (int f = 0; f < 6; ++f) faces[static_cast<std::size_t>(f)] = layout_face(grid, f);
+    std::vector<PartSphere> cull_;
+    std::array<FaceLayout, 6> faces_;
+};
 
+// The pairs with candidates, per block of entry points, each block's sorted by pair. The lists
+// are about half of the build's peak (the distinct sets and the payload follow): past half the
+// budget it stops.
+std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& grid, bool progress,
+                                   std::size_t budget) {
+    const CandidateFinder finder(ctx, grid);
     const std::uint32_t npoints = grid.count();
     constexpr std::uint32_t kBlock = 32;
     const std::uint32_t nblocks = (npoints + kBlock - 1) / kBlock;
@@ -199,49 +247,14 @@ std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& 
     std::atomic<std::uint64_t> held{0}, done{0};
     ProgressBar bar("candidates", npoints, progress);
     tbb::parallel_for(std::uint32_t{0}, nblocks, [&](std::uint32_t blk) {
-        Scratch& s = scratch.local();
         Block& out = blocks[blk];
-        auto emit = [&](std::uint64_t pair, const std::vector<std::uint32_t>& list) {
-            out.found.push_back({pair, static_cast<std::uint32_t>(out.pool.size()),
-                                 static_cast<std::uint32_t>(list.size())});
-            out.pool.insert(out.pool.end(), list.begin(), list.end());
-        };
-        std::vector<std::uint32_t> self;
-        for (std::uint32_t a = blk * kBlock; a < std::min(npoints, (blk + 1) * kBlock); ++a) {
-            const GridPoint ga = grid.point(a);
-            const std::uint8_t fa = grid.faces(ga);
-            const Vec3 p = to_vec(ga);
-            // The pair of a point with itself: parts within reach of the point.
-            self.clear();
-            for (const PartSphere& ps : cull)
-                if ((self.empty() || self.back() != ps.part) && parts[ps.part].near(ps, p, p))
-                    self.push_back(ps.part);
-            if (!self.empty()) emit(CandidatesTable::pair_index(a, a), self);
-            for (const FaceLayout& fl : faces) {
-                if (s.parts.size() < fl.mask.size()) s.parts.resize(fl.mask.size());
-                for (const PartSphere& ps : cull) {
-                    for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
-                        std::vector<std::uint32_t>& l = s.parts[k];
-                        if (fl.ids[k] <= a || (!l.empty() && l.back() == ps.part)) return;
-                        if (!BoundaryGrid::valid_pair(fa, fl.mask[k])) return;
-                        if (!parts[ps.part].near(ps, p, q)) return;
-                        if (l.empty()) s.touched.push_back(k);
-                        l.push_back(ps.part);
-                    });
-                }
-                for (const std::size_t k : s.touched) {
-                    emit(CandidatesTable::pair_index(a, fl.ids[k]), s.parts[k]);
-                    s.parts[k].clear();
-                }
-                s.touched.clear();
-            }
-        }
+        const std::uint32_t end = std::min(npoints, (blk + 1) * kBlock);
+        for (std::uint32_t a = blk * kBlock; a < end; ++a) finder.entry(a, scratch.local(), out);
         std::sort(out.found.begin(), out.found.end(),
                   [](const Found& x, const Found& y) { return x.pair < y.pair; });
-        const std::uint32_t points = std::min(npoints, (blk + 1) * kBlock) - blk * kBlock;
-        bar.add(points);
+        bar.add(end - blk * kBlock);
         const std::uint64_t bytes = out.found.capacity() * sizeof(Found) + out.pool.capacity() * 4;
-        const std::uint64_t total = held += bytes, finished = done += points;
+        const std::uint64_t total = held += bytes, finished = done += end - blk * kBlock;
         if (budget && 2 * total > budget) refuse(total, finished, npoints, budget);
     });
     bar.finish();
