@@ -169,10 +169,11 @@ void CsgShape::eval(int ref, const Ray& r, SpanList& out, const LeafSet* on) con
     const Node& n = nodes_[static_cast<std::size_t>(ref)];
     if (n.bounds.empty() || !clip_ray(n.bounds, r, t0, t1)) return;
     eval(n.children[0], r, out, on);
-    if (n.children.size() == 1 || (out.empty() && n.op != CsgOp::kUnion)) return;
+    // Nothing left to intersect with or subtract from: the other children need no evaluating.
+    const auto settled = [&] { return out.empty() && n.op != CsgOp::kUnion; };
+    if (n.children.size() == 1 || settled()) return;
     ScratchSpans b, c;
-    for (std::size_t k = 1; k < n.children.size(); ++k) {
-        if (out.empty() && n.op != CsgOp::kUnion) return;
+    for (std::size_t k = 1; k < n.children.size() && !settled(); ++k) {
         b->clear();
         eval(n.children[k], r, *b, on);
         if (b->empty() && n.op != CsgOp::kIntersection) continue;

@@ -104,8 +104,9 @@ bool AlgebraicShape::line_roots(const Ray& r, LineRoots& out) const {
     }
     // Solve in u, the distance along the unit direction from the point nearest the centre.
     const double shift = dot(c - r.o, dn);
-    if (misses_ring(r.o + dn * shift, dn, tb0 - shift, tb1 - shift)) return false;
-    f_.along_ray(r.o + dn * shift, dn, out.g);
+    const Vec3 near_c = r.o + dn * shift;
+    if (misses_ring(near_c, dn, tb0 - shift, tb1 - shift)) return false;
+    f_.along_ray(near_c, dn, out.g);
     // Extreme coefficients or a far-away ray can overflow the restriction; no root is then
     // trustworthy, and the solver must not see infinities.
     for (const double gi : out.g)

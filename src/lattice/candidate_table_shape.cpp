@@ -30,16 +30,19 @@ bool CandidateTableShape::listed_spans(const Ray& r, const CandidateList& list,
     return true;
 }
 
+bool CandidateTableShape::tree_crossing(const Ray& r, const CandidateList& list,
+                                        const LatticeFrame::Snap& s, double tmin, double tmax,
+                                        Crossing& hit) const {
+    ScratchSpans spans;
+    if (!listed_spans(r, list, s, *spans)) return primitive_->intersect(r, tmin, tmax, hit);
+    return first_crossing(*spans, tmin, tmax, hit);
+}
+
 bool CandidateTableShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
     CandidateList list;
     LatticeFrame::Snap s;
     if (!candidates(r, list, s)) return false;
-    if (!union_) {
-        ScratchSpans spans;
-        if (!listed_spans(r, list, s, *spans))
-            return primitive_->intersect(r, tmin, tmax, hit);
-        return first_crossing(*spans, tmin, tmax, hit);
-    }
+    if (!union_) return tree_crossing(r, list, s, tmin, tmax, hit);
     const PartBoxes::Ray4 slabs(boxes_, r);
     PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);
     bool found = false;
@@ -60,10 +63,8 @@ bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const
     LatticeFrame::Snap s;
     if (!candidates(r, list, s)) return false;
     if (!union_) {
-        ScratchSpans spans;
-        if (!listed_spans(r, list, s, *spans)) return primitive_->occluded(r, tmin, tmax);
-        Crossing c;
-        return first_crossing(*spans, tmin, tmax, c);
+        Crossing c;  // a tree's occlusion is its first crossing (CsgShape has no cheaper one)
+        return tree_crossing(r, list, s, tmin, tmax, c);
     }
     const PartBoxes::Ray4 slabs(boxes_, r);
     const PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);

@@ -58,6 +58,9 @@ private:
     // when one leaves the chord (they are then not the primitive's own).
     bool listed_spans(const Ray& r, const CandidateList& list, const LatticeFrame::Snap& s,
                       SpanList& out) const;
+    // Not union_: the first crossing in (tmin, tmax), from the listed pieces or else whole.
+    bool tree_crossing(const Ray& r, const CandidateList& list, const LatticeFrame::Snap& s,
+                       double tmin, double tmax, Crossing& hit) const;
 };
 
 }  // namespace lat

@@ -70,10 +70,12 @@ void check_points(const TablePlan& plan) {
                          lattice_size(h) + " has " + std::to_string(count));
 }
 
-// The payload; an encoding's refusal (a limit reached while building) names the primitive.
-ByteBuffer encode(const TablePlan& plan, const RawHits& hits, const EncodeOptions& options) {
+// step(), with a limit it reaches while building (rasterizer.cpp's part numbers, an encoding's
+// memory budget) reported as the plan's primitive's.
+template <class Step>
+auto naming_the_primitive(const TablePlan& plan, Step&& step) {
     try {
-        return plan.encoding->build(hits, plan.context, options);
+        return step();
     } catch (const InputError& e) {
         throw InputError(plan.place + "primitive '" + plan.primitive->name + "': " + e.what());
     }
@@ -113,16 +115,13 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
     opt.progress = progress;
     opt.keep_hits = plan.encoding->needs_hits;
     opt.across_ranks = across_ranks;
-    try {
-        b.raster = rasterize(plan.context, opt);
-    } catch (const InputError& e) {  // a limit the hits reached (rasterizer.cpp)
-        throw InputError(plan.place + "primitive '" + plan.primitive->name + "': " + e.what());
-    }
+    b.raster = naming_the_primitive(plan, [&] { return rasterize(plan.context, opt); });
     const auto encode_and_write = [&] {
         const auto t0 = std::chrono::steady_clock::now();
         EncodeOptions options = plan.options;
         options.memory_budget = static_cast<std::size_t>(0.8 * double(available_memory_bytes()));
-        const ByteBuffer payload = encode(plan, b.raster.raw, options);
+        const ByteBuffer payload = naming_the_primitive(
+            plan, [&] { return plan.encoding->build(b.raster.raw, plan.context, options); });
         b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         b.raster.raw = {};
         b.header.pairs = b.raster.pairs_eq2;
