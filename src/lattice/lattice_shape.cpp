@@ -170,6 +170,10 @@ Bounds3 LatticeFrame::cull_bounds(std::size_t i, const Transform& xf) const {
     return lat::intersect(bounds, placed);
 }
 
+// Written so that the grid points stay in registers: built a coordinate at a time through
+// GridPoint's operator[], they went through the stack, and reading them back as one 8-byte
+// load from two 4-byte stores stalled store forwarding, twice a visit (a quarter of snap's
+// time on ball-csg7 with `dense`).
 bool LatticeFrame::snap(const Ray& r, Snap& s) const {
     ++t_visits;
     s.o = r.o * inv_cell_;
@@ -178,6 +182,7 @@ bool LatticeFrame::snap(const Ray& r, Snap& s) const {
     const auto& n = grid_.cells();
     double t0 = -kInfinity, t1 = kInfinity;
     int ax0 = -1, ax1 = -1;
+    bool high0 = false, high1 = false;  // whether the entry (exit) face is the axis's far one
     for (int k = 0; k < 3; ++k) {
         const auto uk = static_cast<std::size_t>(k);
         if (d[uk] == 0) {
@@ -187,25 +192,25 @@ bool LatticeFrame::snap(const Ray& r, Snap& s) const {
         const double inv = 1.0 / d[uk];
         double tn = -o[uk] * inv, tf = (n[uk] - o[uk]) * inv;
         if (tn > tf) std::swap(tn, tf);
-        if (tn > t0) t0 = tn, ax0 = k;
-        if (tf < t1) t1 = tf, ax1 = k;
+        if (tn > t0) t0 = tn, ax0 = k, high0 = d[uk] < 0;
+        if (tf < t1) t1 = tf, ax1 = k, high1 = d[uk] > 0;
     }
     if (!(t0 <= t1) || ax0 < 0 || ax1 < 0) return false;
     s.t0 = t0, s.t1 = t1;
     // Round the entry and exit points to the nearest grid points on their faces.
-    auto on_face = [&](double t, int axis, bool high) {
-        GridPoint g;
+    const auto on_face = [&](double t, int axis, bool high, GridPoint& g) {
         const Vec3 x = o + d * t;
-        for (int k = 0; k < 3; ++k) {
-            const auto uk = static_cast<std::size_t>(k);
-            g[k] = k == axis
-                       ? (high ? n[uk] : 0)
-                       : static_cast<int>(std::clamp(std::nearbyint(x[uk]), 0.0, double(n[uk])));
-        }
-        return g;
+        const auto coord = [&](int k, double xk) {
+            const int nk = n[static_cast<std::size_t>(k)];
+            if (k == axis) return high ? nk : 0;
+            return static_cast<int>(std::clamp(std::nearbyint(xk), 0.0, double(nk)));
+        };
+        g.x = coord(0, x.x);
+        g.y = coord(1, x.y);
+        g.z = coord(2, x.z);
     };
-    s.pa = on_face(t0, ax0, d[static_cast<std::size_t>(ax0)] < 0);
-    s.pb = on_face(t1, ax1, d[static_cast<std::size_t>(ax1)] > 0);
+    on_face(t0, ax0, high0, s.pa);
+    on_face(t1, ax1, high1, s.pb);
     s.a = grid_.id(s.pa);
     s.b = grid_.id(s.pb);
     return true;
