@@ -44,9 +44,11 @@ double lod_blend(double f, double band) {
 }
 
 FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
-                                           double table_error)
+                                           double table_error, bool exact_close)
     // The point-sampled finest level reaches as far as make_lattice_shape's lattices do.
     : filter_(filter),
+      primitive_(levels.empty() ? nullptr : levels.front().ctx.primitive),
+      exact_close_(exact_close && primitive_),
       point_(levels.back().table, levels.back().ctx,
              levels.back().ctx.cell * kSnapReach + table_error) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
@@ -177,15 +179,22 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     const double w_hi = lod_blend(level - double(lo), smooth ? kLodBlendBand : 1.0);
     // The levels of weight above 0: their pairs are found first and located in their tables
     // together, so that the cache misses of the two tables overlap.
-    const std::size_t first = w_hi < 1 ? lo : lo + 1, last = w_hi > 0 ? lo + 1 : lo;
-    Blend b[2];
-    for (std::size_t i = first; i <= last; ++i) {
-        blend(levels_[i], r, i == lo ? 1 - w_hi : w_hi, smooth, b[i - first]);
-        Blend& bi = b[i - first];
-        levels_[i].table->locate_coverage(bi.ia, bi.ib, bi.n, bi.ref);
-    }
+    // Close-ups: the primitive's own crossing, past the finest table (exact_weight).
+    const double w_exact = exact_close_ ? exact_weight(wanted - top) : 0.0;
     Sheet s;
-    for (std::size_t i = first; i <= last; ++i) add_blend(levels_[i], b[i - first], normal, r, tmin, s);
+    if (w_exact < 1) {
+        const std::size_t first = w_hi < 1 ? lo : lo + 1, last = w_hi > 0 ? lo + 1 : lo;
+        Blend b[2];
+        for (std::size_t i = first; i <= last; ++i) {
+            const double w = (i == lo ? 1 - w_hi : w_hi) * (1 - w_exact);
+            blend(levels_[i], r, w, smooth, b[i - first]);
+            Blend& bi = b[i - first];
+            levels_[i].table->locate_coverage(bi.ia, bi.ib, bi.n, bi.ref);
+        }
+        for (std::size_t i = first; i <= last; ++i)
+            add_blend(levels_[i], b[i - first], normal, r, tmin, s);
+    }
+    if (w_exact > 0) add_exact(w_exact, normal, r, tmin, tmax, s);
     if (s.alpha <= 1e-6) return false;
     const Vec3 p = s.p / s.alpha;
     const double t = dot(p - r.o, r.d) / dd;
@@ -211,6 +220,15 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     hit = Crossing(t, 0, SurfacePoint{p, ln > 0 ? s.n / ln * len : -r.d / std::sqrt(dd)});
     hit.coverage = coverage;
     return true;
+}
+
+void FilteredLatticeShape::add_exact(double w, bool normal, const Ray& r, double tmin, double tmax,
+                                     Sheet& s) const {
+    Crossing c;
+    if (!primitive_->intersect(r, tmin, tmax, c)) return;
+    const SurfacePoint sp = primitive_->surface(r, c);
+    const double ln = normal ? length(sp.n) : 0;
+    s.add_opaque(w, sp.p, ln > 0 ? sp.n / ln : -r.d / length(r.d));
 }
 
 bool FilteredLatticeShape::occluded(const Ray& r, double tmin, double tmax) const {

@@ -65,7 +65,8 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
         out.paths.push_back(e.path);
     }
     out.shapes[static_cast<std::size_t>(prim)] =
-        std::make_shared<FilteredLatticeShape>(std::move(levels), filtering.filter, error);
+        std::make_shared<FilteredLatticeShape>(std::move(levels), filtering.filter, error,
+                                               filtering.lod);
 }
 
 }  // namespace
