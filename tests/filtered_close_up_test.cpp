@@ -1,6 +1,6 @@
 // Close-ups through filtered lattices (issue 10): with levels of detail, a ray whose footprint is
-// far narrower than the finest table's cell gets the primitive's own crossing (exact_weight),
-// blended with the table's sheet on the way there.
+// far narrower than the finest table's cell gets the primitive's own crossings (exact_weight),
+// blended with the tables' sheet on the way there.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,81 +15,124 @@ namespace lat {
 namespace {
 
 using test::hook;
-const TableContext& kContext = test::kHookContext;
+const TableContext& kFine = test::kHookContext;  // cells of 0.5
+const TableContext kCoarse{{4, 2, 4}, 1.0, 1.0, &hook()};
 
-// The hook's coverage table behind the smooth filter, with and without exact close-ups.
+// The hook's coverage tables behind the smooth filter, with and without exact close-ups: one
+// level (kFine), or two (kCoarse, then kFine).
 struct HookLattice {
-    ByteBuffer payload;  // the table reads it in place
+    std::vector<ByteBuffer> payloads;  // the tables read them in place
     std::unique_ptr<FilteredLatticeShape> exact_close, tables_only;
 };
 
-HookLattice hook_lattice() {
+HookLattice hook_lattice(bool two_levels) {
     const Encoding& e = find_encoding("coverage");
-    const RasterizeResult r = rasterize(kContext);
     HookLattice h;
-    h.payload = e.build(r.raw, kContext, {});
-    std::shared_ptr<const LatticeTable> table =
-        e.open(h.payload.data(), h.payload.size(), r.hits, kContext);
-    const std::vector<FilterLevel> levels{{table, kContext}};
-    const double error = e.error_bound(kContext, {});
+    std::vector<FilterLevel> levels;
+    std::vector<TableContext> contexts{kFine};
+    if (two_levels) contexts.insert(contexts.begin(), kCoarse);
+    h.payloads.reserve(contexts.size());
+    for (const TableContext& ctx : contexts) {
+        const RasterizeResult r = rasterize(ctx);
+        h.payloads.push_back(e.build(r.raw, ctx, {}));
+        levels.push_back({e.open(h.payloads.back().data(), h.payloads.back().size(), r.hits, ctx), ctx});
+    }
+    const double error = e.error_bound(kFine, {});
     h.exact_close = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, true);
     h.tables_only = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, false);
     return h;
 }
 
 // The footprint width (unit directions, no spread) whose level lies `past` levels beyond the
-// only level's (lod_level).
-double width_past(double past) {
-    return kContext.cell / (kCellPerFootprint * std::exp2(past));
+// finest one's (lod_level counts from the coarsest, cell0).
+double width_past(double past, bool two_levels) {
+    const double cell0 = two_levels ? kCoarse.cell : kFine.cell;
+    const double top = two_levels ? 1 : 0;
+    return cell0 / (kCellPerFootprint * std::exp2(top + past));
 }
 
-// Lines through the hook's box, from outside it.
-std::vector<Ray> lines(int n) {
+// Rays through the hook's box: lines from outside it, or rays starting inside it.
+std::vector<Ray> rays(int n, bool inside = false) {
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    const Bounds3 box = expand(Bounds3{{0, 0, 0}, Vec3{double(kContext.cells[0]), double(kContext.cells[1]),
-                                                      double(kContext.cells[2])} * kContext.cell},
-                               0.5);
-    auto point = [&] { return box.lo + Vec3{u(rng), u(rng), u(rng)} * (box.hi - box.lo); };
+    const Bounds3 box{{0, 0, 0}, Vec3{4, 2, 4}};
+    const Bounds3 around = expand(box, 0.5);
+    auto point = [&](const Bounds3& b) { return b.lo + Vec3{u(rng), u(rng), u(rng)} * (b.hi - b.lo); };
     std::vector<Ray> out;
     for (int i = 0; i < n; ++i) {
-        const Vec3 p = point(), q = point();
-        out.push_back({p - (q - p) * 4.0, (q - p) / length(q - p)});
+        const Vec3 p = point(inside ? box : around), q = point(around);
+        out.push_back({inside ? p : p - (q - p) * 4.0, (q - p) / length(q - p)});
     }
     return out;
 }
 
-TEST(FilteredCloseUps, FootprintsFarNarrowerThanTheFinestCellGetThePrimitivesCrossing) {
-    const HookLattice h = hook_lattice();
-    set_ray_footprint({width_past(kExactTo + 0.5), 0, false});
+// Shadow rays (coverage only) far past the finest level get the primitive's crossing itself,
+// from outside the box or from inside it, after tmin; occluded() says whether there is one.
+TEST(FilteredCloseUps, ShadowRaysFarPastTheFinestLevelGetThePrimitivesCrossing) {
+    for (const bool two : {false, true}) {
+        const HookLattice h = hook_lattice(two);
+        set_ray_footprint({width_past(kExactTo + 0.5, two), 0, true});
+        int hits = 0;
+        for (const bool inside : {false, true})
+            for (const Ray& r : rays(3000, inside)) {
+                const double tmin = inside ? 0.3 : 0.0;
+                Crossing exact, got;
+                const bool e = hook().intersect(r, tmin, kInfinity, exact);
+                ASSERT_EQ(h.exact_close->intersect(r, tmin, kInfinity, got), e);
+                EXPECT_EQ(h.exact_close->occluded(r, tmin, 20.0), e && exact.t < 20.0);
+                if (!e) continue;
+                ++hits;
+                EXPECT_NEAR(got.t, exact.t, 1e-9);
+                EXPECT_EQ(got.coverage, 1.0f);
+            }
+        EXPECT_GT(hits, 1000);
+    }
+    set_ray_footprint({});
+}
+
+// Camera rays: a vanishing footprint puts all their sub-rays on the ray, so the sheet is the
+// crossing and its normal; a footprint a few cells wide covers the hook's edges in part, in
+// steps of one sub-ray. The tables alone answer otherwise.
+TEST(FilteredCloseUps, CameraRaysFarPastTheFinestLevelGetTheirSubRaysCrossings) {
+    const HookLattice h = hook_lattice(false);
+    set_ray_footprint({1e-9, 0, false});
     int hits = 0, tables_differ = 0;
-    for (const Ray& r : lines(5000)) {
+    for (const Ray& r : rays(5000)) {
         Crossing exact, got, table;
         const bool e = hook().intersect(r, 0.0, kInfinity, exact);
         ASSERT_EQ(h.exact_close->intersect(r, 0.0, kInfinity, got), e);
-        if (h.tables_only->intersect(r, 0.0, kInfinity, table) != e ||
-            (e && std::abs(table.t - exact.t) > 1e-6))
-            ++tables_differ;
         if (!e) continue;
         ++hits;
-        EXPECT_NEAR(got.t, exact.t, 1e-9);
+        EXPECT_NEAR(got.t, exact.t, 1e-6);
         EXPECT_EQ(got.coverage, 1.0f);
-        const Vec3 n = normalize(hook().normal(r, exact));
-        EXPECT_NEAR(length(h.exact_close->normal(r, got) - n), 0.0, 1e-9);
+        EXPECT_NEAR(length(got.stored.n - normalize(hook().normal(r, exact))), 0.0, 1e-6);
+        tables_differ += !h.tables_only->intersect(r, 0.0, kInfinity, table) ||
+                         std::abs(table.t - exact.t) > 1e-6;
     }
-    set_ray_footprint({});
     EXPECT_GT(hits, 500);
-    // Without exact close-ups the same rays read the table: most hits differ.
-    EXPECT_GT(tables_differ, hits / 2);
+    EXPECT_GT(tables_differ, hits / 2);  // the test can tell the tables from the primitive
+
+    set_ray_footprint({width_past(kExactTo + 0.1, false), 0, false});
+    const int n = kExactSubRays * kExactSubRays;
+    int partial = 0;
+    for (const Ray& r : rays(20000)) {
+        Crossing got;
+        if (!h.exact_close->intersect(r, 0.0, kInfinity, got)) continue;
+        const double k = double(got.coverage) * n;
+        EXPECT_NEAR(k, std::round(k), 1e-5);
+        partial += got.coverage < 1.0f;
+    }
+    EXPECT_GT(partial, 20);
+    set_ray_footprint({});
 }
 
 TEST(FilteredCloseUps, TheRampBlendsTheTablesSheetWithTheCrossing) {
-    const HookLattice h = hook_lattice();
+    const HookLattice h = hook_lattice(false);
     const double past = 0.5 * (kExactFrom + kExactTo);
     ASSERT_EQ(exact_weight(past), 0.5);
-    set_ray_footprint({width_past(past), 0, false});
+    set_ray_footprint({width_past(past, false), 0, true});
     int blended = 0;
-    for (const Ray& r : lines(5000)) {
+    for (const Ray& r : rays(5000)) {
         Crossing exact, got, table;
         const double e = hook().intersect(r, 0.0, kInfinity, exact) ? 1.0 : 0.0;
         const double a = h.tables_only->intersect(r, 0.0, kInfinity, table) ? double(table.coverage) : 0.0;
@@ -111,22 +154,48 @@ TEST(FilteredCloseUps, TheRampBlendsTheTablesSheetWithTheCrossing) {
     EXPECT_GT(blended, 200);
 }
 
+// How far a ray may go (tmax: for camera rays in the accelerator, the closest crossing found
+// so far) only cuts the sheet, as for the tables: the answer is the same whatever order the
+// accelerator meets objects in.
+TEST(FilteredCloseUps, TheSheetIsCutAtTmaxNotMadeOfWhatLiesBeforeIt) {
+    const HookLattice h = hook_lattice(false);
+    for (const double past : {0.5 * (kExactFrom + kExactTo), kExactTo + 0.5}) {
+        set_ray_footprint({width_past(past, false), 0, false});
+        for (const Ray& r : rays(3000)) {
+            Crossing whole, cut;
+            if (!h.exact_close->intersect(r, 0.0, kInfinity, whole)) continue;
+            for (const double tmax : {whole.t - 0.01, whole.t + 0.01}) {
+                const bool hit = h.exact_close->intersect(r, 0.0, tmax, cut);
+                ASSERT_EQ(hit, whole.t < tmax);
+                if (!hit) continue;
+                EXPECT_EQ(cut.t, whole.t);
+                EXPECT_EQ(cut.coverage, whole.coverage);
+            }
+        }
+    }
+    set_ray_footprint({});
+}
+
 // Footprints the finest level resolves, and rays with none (width 0 asks for the finest level),
-// read the tables alone: the same answers, to the bit, as without exact close-ups.
+// read the tables alone: the same answers, to the bit, as without exact close-ups. With two
+// levels, "past" counts from the finest one.
 TEST(FilteredCloseUps, OtherFootprintsReadTheTablesAlone) {
-    const HookLattice h = hook_lattice();
-    for (const double width : {0.0, width_past(kExactFrom - 0.01), width_past(0), width_past(-2)}) {
-        set_ray_footprint({width, 0, false});
-        for (const Ray& r : lines(2000)) {
-            Crossing a, b;
-            const bool ha = h.exact_close->intersect(r, 0.0, kInfinity, a);
-            ASSERT_EQ(ha, h.tables_only->intersect(r, 0.0, kInfinity, b)) << "width " << width;
-            if (!ha) continue;
-            EXPECT_EQ(a.t, b.t);
-            EXPECT_EQ(a.coverage, b.coverage);
-            EXPECT_EQ(a.stored.n.x, b.stored.n.x);
-            EXPECT_EQ(a.stored.n.y, b.stored.n.y);
-            EXPECT_EQ(a.stored.n.z, b.stored.n.z);
+    for (const bool two : {false, true}) {
+        const HookLattice h = hook_lattice(two);
+        for (const double width :
+             {0.0, width_past(kExactFrom - 0.01, two), width_past(0, two), width_past(-2, two)}) {
+            set_ray_footprint({width, 0, false});
+            for (const Ray& r : rays(2000)) {
+                Crossing a, b;
+                const bool ha = h.exact_close->intersect(r, 0.0, kInfinity, a);
+                ASSERT_EQ(ha, h.tables_only->intersect(r, 0.0, kInfinity, b)) << "width " << width;
+                if (!ha) continue;
+                EXPECT_EQ(a.t, b.t);
+                EXPECT_EQ(a.coverage, b.coverage);
+                EXPECT_EQ(a.stored.n.x, b.stored.n.x);
+                EXPECT_EQ(a.stored.n.y, b.stored.n.y);
+                EXPECT_EQ(a.stored.n.z, b.stored.n.z);
+            }
         }
     }
     set_ray_footprint({});

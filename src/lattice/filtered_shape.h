@@ -9,7 +9,7 @@
 // Levels of detail: tables of the same box at sigma^-1 doubling from level to level; each ray
 // takes the level whose cell matches its footprint (ray_footprint()), blending the two nearest.
 // Past the finest table, the primitive itself is the next level of detail: rays whose footprint
-// is far narrower than the finest cell (close-ups) are answered exactly (kExactFrom).
+// is far narrower than the finest cell (close-ups) get its crossings blended in (exact_weight).
 // As a CSG leaf, for `inside` and for spans, the lattice is point-sampled through the finest
 // level's own hits, exactly as without filtering.
 #include <algorithm>
@@ -57,19 +57,23 @@ double lod_level(double cell0, double width);
 inline constexpr double kLodBlendBand = 0.25;
 // The weight of the finer of two levels at fraction f (0 to 1) of the way to it.
 double lod_blend(double f, double band);
-// With levels of detail, rays whose level (lod_level) lies past the finest table's by more
-// than kExactFrom levels blend the primitive's own crossing (exact, full coverage) into their
-// sheet, with a weight rising linearly to 1 at kExactTo levels past it. The finest table
-// (sigma^-1 4K, the most that is built) has cells several pixels wide in close-ups, which blur
-// edges and highlights over a cell; the exact crossing at 1 spp is sharp but aliased, and the
-// two errors differ enough that their blend beats both. Plate 3 (a hair close up) and Plate 2
-// (thistles), 1 spp, PSNR against 256-spp exact; without: 43.12 and 39.68 dB (exact 1 spp
-// 47.10 and 39.30); a switch at 1.5 levels: 47.09 and 39.63; ramps over [1.5, 2], [1.25,
-// 2.25], [1, 3], [0.75, 2.75], [0.75, 3.25]: 47.68 / 42.55, 48.07 / 43.09, 49.25 / 42.98, 49.12 /
-// 43.23, 49.20 / 43.07 dB. Plates 4 and 5 are unchanged to 0.01 dB (their rays want levels
-// within one of their finest). A constant share of exact crossing everywhere does not pay:
-// Plate 5 at 0.1, 0.2, 0.3 39.42, 39.28, 38.94 dB against 39.38, in a quarter more time.
+// With levels of detail, rays whose level (lod_level) lies past the finest table's (the finest
+// built: at most 4K) by more than kExactFrom levels blend the primitive's own crossings (exact,
+// full coverage) into their sheet, with a weight rising linearly to 1 at kExactTo levels past
+// it. The finest table has cells several pixels wide in close-ups, which blur edges and
+// highlights over a cell; the exact crossing at 1 spp is sharp but aliased, and the two errors
+// differ enough that their blend beats both. Plate 3 (a hair close up) and Plate 2 (thistles),
+// 1 spp, PSNR against 256-spp exact, one exact crossing a ray; without: 43.12 and 39.68 dB
+// (exact 1 spp 47.10 and 39.30); a switch at 1.5 levels: 47.09 and 39.63; ramps over [1.5, 2],
+// [1.25, 2.25], [1, 3], [0.75, 2.75], [0.75, 3.25]: 47.68 / 42.55, 48.07 / 43.09, 49.25 /
+// 42.98, 49.12 / 43.23, 49.20 / 43.07 dB. Plates 4 and 5 keep their PSNR to 0.01 dB: their
+// camera rays want levels within about one of their finest, but shadow rays, whose footprint
+// narrows towards the light, reach the ramp (4-8 % more time there). A constant share of exact
+// crossing everywhere does not pay: Plate 5 at 0.1, 0.2, 0.3 39.42, 39.28, 38.94 dB against
+// 39.38, in a quarter more time.
 inline constexpr double kExactFrom = 1, kExactTo = 3;
+// Sub-rays a side for a camera ray's exact crossings (FilteredLatticeShape::add_exact).
+inline constexpr int kExactSubRays = 2;
 // The weight of the primitive's crossing for a ray `past` levels beyond the finest table.
 inline double exact_weight(double past) {
     return std::clamp((past - kExactFrom) / (kExactTo - kExactFrom), 0.0, 1.0);
@@ -157,8 +161,13 @@ private:
     // Looks the blend's pairs up and adds those that r meets after tmin to the sheet.
     void add_blend(const Level& l, const Blend& b, bool normals, const Ray& r, double tmin,
                    Sheet& s) const;
-    // Adds the primitive's own crossing of r in (tmin, tmax), if any, at weight w.
-    void add_exact(double w, bool normal, const Ray& r, double tmin, double tmax, Sheet& s) const;
+    // Adds the levels' blends around `level` (0 to the finest), at weight `weight` in all.
+    void add_tables(double level, double weight, bool normal, const Ray& r, double tmin,
+                    Sheet& s) const;
+    // Adds the primitive's own crossings of r past tmin, at weight `weight` in all (see the
+    // definition); width: the ray's footprint at the box, primitive units.
+    void add_exact(double weight, double width, bool normal, const Ray& r, double tmin,
+                   Sheet& s) const;
 };
 
 }  // namespace lat

@@ -170,10 +170,10 @@ Bounds3 LatticeFrame::cull_bounds(std::size_t i, const Transform& xf) const {
     return lat::intersect(bounds, placed);
 }
 
-// Written so that the grid points stay in registers: built a coordinate at a time through
-// GridPoint's operator[], they went through the stack, and reading them back as one 8-byte
-// load from two 4-byte stores stalled store forwarding, twice a visit (a quarter of snap's
-// time on ball-csg7 with `dense`).
+// The grid points are written field by field: built a coordinate at a time through
+// GridPoint's operator[], they went through a stack copy that was read back as one 8-byte load
+// of two 4-byte stores, which stalled store forwarding twice a visit (a quarter of snap's
+// samples on ball-csg7 with `dense`; 1-2 % of the render).
 bool LatticeFrame::snap(const Ray& r, Snap& s) const {
     ++t_visits;
     s.o = r.o * inv_cell_;
