@@ -1,11 +1,12 @@
 // Close-ups through filtered lattices (issue 10): with levels of detail, a ray whose footprint is
-// far narrower than the finest table's cell gets the primitive's own crossings (exact_weight),
+// near or past the finest table's cell gets the primitive's own crossings (exact_weight),
 // blended with the tables' sheet on the way there.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include "geometry/chain.h"
 #include "hook_primitive.h"
 #include "lattice/encoding.h"
 #include "lattice/filtered_shape.h"
@@ -71,7 +72,7 @@ std::vector<Ray> rays(int n, bool inside = false) {
 TEST(FilteredCloseUps, ShadowRaysFarPastTheFinestLevelGetThePrimitivesCrossing) {
     for (const bool two : {false, true}) {
         const HookLattice h = hook_lattice(two);
-        set_ray_footprint({width_past(kExactTo + 0.5, two), 0, true});
+        set_ray_footprint({width_past(kShadowExact.to + 0.5, two), 0, true});
         int hits = 0;
         for (const bool inside : {false, true})
             for (const Ray& r : rays(3000, inside)) {
@@ -112,7 +113,7 @@ TEST(FilteredCloseUps, CameraRaysFarPastTheFinestLevelGetTheirSubRaysCrossings) 
     EXPECT_GT(hits, 500);
     EXPECT_GT(tables_differ, hits / 2);  // the test can tell the tables from the primitive
 
-    set_ray_footprint({width_past(kExactTo + 0.1, false), 0, false});
+    set_ray_footprint({width_past(kCameraExact.to + 0.1, false), 0, false});
     const int n = kExactSubRays * kExactSubRays;
     int partial = 0;
     for (const Ray& r : rays(20000)) {
@@ -128,8 +129,8 @@ TEST(FilteredCloseUps, CameraRaysFarPastTheFinestLevelGetTheirSubRaysCrossings) 
 
 TEST(FilteredCloseUps, TheRampBlendsTheTablesSheetWithTheCrossing) {
     const HookLattice h = hook_lattice(false);
-    const double past = 0.5 * (kExactFrom + kExactTo);
-    ASSERT_EQ(exact_weight(past), 0.5);
+    const double past = 0.5 * (kShadowExact.from + kShadowExact.to);
+    ASSERT_EQ(exact_weight(past, kShadowExact), 0.5);
     set_ray_footprint({width_past(past, false), 0, true});
     int blended = 0;
     for (const Ray& r : rays(5000)) {
@@ -159,7 +160,7 @@ TEST(FilteredCloseUps, TheRampBlendsTheTablesSheetWithTheCrossing) {
 // accelerator meets objects in.
 TEST(FilteredCloseUps, TheSheetIsCutAtTmaxNotMadeOfWhatLiesBeforeIt) {
     const HookLattice h = hook_lattice(false);
-    for (const double past : {0.5 * (kExactFrom + kExactTo), kExactTo + 0.5}) {
+    for (const double past : {0.5 * (kCameraExact.from + kCameraExact.to), kCameraExact.to + 0.5}) {
         set_ray_footprint({width_past(past, false), 0, false});
         for (const Ray& r : rays(3000)) {
             Crossing whole, cut;
@@ -176,19 +177,32 @@ TEST(FilteredCloseUps, TheSheetIsCutAtTmaxNotMadeOfWhatLiesBeforeIt) {
     set_ray_footprint({});
 }
 
-// Footprints the finest level resolves, and rays with none (width 0 asks for the finest level),
-// read the tables alone: the same answers, to the bit, as without exact close-ups. With two
-// levels, "past" counts from the finest one.
-TEST(FilteredCloseUps, OtherFootprintsReadTheTablesAlone) {
+// Footprints short of the ramps (camera rays: two levels before the finest table; shadow
+// rays: one level past it), and rays with none (width 0 asks for the finest level), read the
+// tables alone: the same answers, to the bit, as without exact close-ups. With two levels,
+// "past" counts from the finest one.
+TEST(FilteredCloseUps, FootprintsShortOfTheRampReadTheTablesAlone) {
+    struct Case {
+        bool shadow;
+        double past;  // NaN: no footprint
+    };
+    const double none = std::nan("");
+    const std::vector<Case> cases{{false, none},
+                                  {false, kCameraExact.from - 0.01},
+                                  {false, kCameraExact.from - 2},
+                                  {true, none},
+                                  {true, kShadowExact.from - 0.01},
+                                  {true, 0.0}};
     for (const bool two : {false, true}) {
         const HookLattice h = hook_lattice(two);
-        for (const double width :
-             {0.0, width_past(kExactFrom - 0.01, two), width_past(0, two), width_past(-2, two)}) {
-            set_ray_footprint({width, 0, false});
+        for (const Case& c : cases) {
+            const double width = std::isnan(c.past) ? 0.0 : width_past(c.past, two);
+            set_ray_footprint({width, 0, c.shadow});
             for (const Ray& r : rays(2000)) {
                 Crossing a, b;
                 const bool ha = h.exact_close->intersect(r, 0.0, kInfinity, a);
-                ASSERT_EQ(ha, h.tables_only->intersect(r, 0.0, kInfinity, b)) << "width " << width;
+                ASSERT_EQ(ha, h.tables_only->intersect(r, 0.0, kInfinity, b))
+                    << "past " << c.past << (c.shadow ? ", shadow ray" : ", camera ray");
                 if (!ha) continue;
                 EXPECT_EQ(a.t, b.t);
                 EXPECT_EQ(a.coverage, b.coverage);
@@ -199,6 +213,37 @@ TEST(FilteredCloseUps, OtherFootprintsReadTheTablesAlone) {
         }
     }
     set_ray_footprint({});
+}
+
+// A primitive of more than kMaxExactParts parts keeps to its tables: its exact intersection
+// would test every part, for every sub-ray.
+TEST(FilteredCloseUps, PrimitivesOfManyPartsKeepToTheirTables) {
+    std::vector<ChainSphere> beads;
+    for (std::size_t i = 0; i <= kMaxExactParts; ++i)
+        beads.push_back({{0.5 + 3.0 * double(i) / double(kMaxExactParts), 1.0, 2.0}, 0.2});
+    const ChainShape chain(beads, {});
+    ASSERT_GT(chain.primitive_count(), kMaxExactParts);
+    const TableContext ctx{{4, 2, 4}, 1.0, 1.0, &chain};
+    const Encoding& e = find_encoding("coverage");
+    const RasterizeResult raster = rasterize(ctx);
+    const ByteBuffer payload = e.build(raster.raw, ctx, {});
+    const std::vector<FilterLevel> levels{
+        {e.open(payload.data(), payload.size(), raster.hits, ctx), ctx}};
+    const FilteredLatticeShape asked(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), true);
+    const FilteredLatticeShape tables(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), false);
+    set_ray_footprint({1e-9, 0, false});  // far past the finest level
+    int hits = 0;
+    for (const Ray& r : rays(3000)) {
+        Crossing a, b;
+        const bool ha = asked.intersect(r, 0.0, kInfinity, a);
+        ASSERT_EQ(ha, tables.intersect(r, 0.0, kInfinity, b));
+        if (!ha) continue;
+        ++hits;
+        EXPECT_EQ(a.t, b.t);
+        EXPECT_EQ(a.coverage, b.coverage);
+    }
+    set_ray_footprint({});
+    EXPECT_GT(hits, 100);
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 // Levels of detail: tables of the same box at sigma^-1 doubling from level to level; each ray
 // takes the level whose cell matches its footprint (ray_footprint()), blending the two nearest.
 // Past the finest table, the primitive itself is the next level of detail: rays whose footprint
-// is far narrower than the finest cell (close-ups) get its crossings blended in (exact_weight).
+// comes near or past the finest cell get its crossings blended in (exact_weight).
 // As a CSG leaf, for `inside` and for spans, the lattice is point-sampled through the finest
 // level's own hits, exactly as without filtering.
 #include <algorithm>
@@ -57,27 +57,34 @@ double lod_level(double cell0, double width);
 inline constexpr double kLodBlendBand = 0.25;
 // The weight of the finer of two levels at fraction f (0 to 1) of the way to it.
 double lod_blend(double f, double band);
-// With levels of detail, rays whose level (lod_level) lies past the finest table's (the finest
-// built: at most 4K) by more than kExactFrom levels blend the primitive's own crossings (exact,
-// full coverage) into their sheet, with a weight rising linearly to 1 at kExactTo levels past
-// it. The finest table has cells several pixels wide in close-ups, which blur edges and
-// highlights over a cell; the exact crossing at 1 spp is sharp but aliased, and the two errors
-// differ enough that their blend beats both. Plate 3 (a hair close up) and Plate 2 (thistles),
-// 1 spp, PSNR against 256-spp exact, one exact crossing a ray; without: 43.12 and 39.68 dB
-// (exact 1 spp 47.10 and 39.30); a switch at 1.5 levels: 47.09 and 39.63; ramps over [1.5, 2],
-// [1.25, 2.25], [1, 3], [0.75, 2.75], [0.75, 3.25]: 47.68 / 42.55, 48.07 / 43.09, 49.25 /
-// 42.98, 49.12 / 43.23, 49.20 / 43.07 dB. Plates 4 and 5 keep their PSNR to 0.01 dB: their
-// camera rays want levels within about one of their finest, but shadow rays, whose footprint
-// narrows towards the light, reach the ramp (4-8 % more time there). A constant share of exact
-// crossing everywhere does not pay: Plate 5 at 0.1, 0.2, 0.3 39.42, 39.28, 38.94 dB against
-// 39.38, in a quarter more time.
-inline constexpr double kExactFrom = 1, kExactTo = 3;
+// With levels of detail, the primitive itself is the level after the finest table (the finest
+// built: at most 4K). A ray whose level (lod_level) lies `past` levels beyond the finest
+// table's blends the primitive's own crossings (exact, full coverage) into its sheet, with a
+// weight rising linearly from 0 at `from` to 1 at `to` (ExactRamp). The finest table has cells
+// several pixels wide in close-ups, which blur edges and highlights over a cell; the exact
+// crossings at 1 spp are sharp but aliased, and the two errors differ enough that their blend
+// beats both. Camera rays take 2 x 2 sub-rays across their footprint (add_exact), whose
+// coverage antialiases edges at the pixel's own scale; with them the blend pays from two levels
+// before the finest table on. 1 spp, PSNR against 256-spp exact, Plates 2 / 3 / 4 / 5 (exact 4
+// spp: 44.45 / 52.81 / 36.92 / 39.46 dB), camera ramp over [1, 3], [-1, 3], [-2, 2], [-3, 3],
+// and every camera ray exact: 43.32 / 50.62 / 38.55 / 39.38; 44.82 / 51.40 / 39.14 / 39.98;
+// 45.98 / 51.64 / 39.35 / 40.33; 45.92 / 51.66 / 39.35 / 40.32; 45.83 / 51.64 / 38.52 / 40.10
+// dB (docs/filtering.md, "Close-ups"). Shadow rays, which want only the coverage, take their
+// own crossing over [1, 3]: starting at -1, Plate 5 lost 0.09 dB in 15 % more time.
+struct ExactRamp {
+    double from, to;
+};
+inline constexpr ExactRamp kCameraExact{-2, 2}, kShadowExact{1, 3};
+// The weight of the primitive's crossings for a ray `past` levels beyond the finest table.
+inline double exact_weight(double past, const ExactRamp& ramp) {
+    return std::clamp((past - ramp.from) / (ramp.to - ramp.from), 0.0, 1.0);
+}
 // Sub-rays a side for a camera ray's exact crossings (FilteredLatticeShape::add_exact).
 inline constexpr int kExactSubRays = 2;
-// The weight of the primitive's crossing for a ray `past` levels beyond the finest table.
-inline double exact_weight(double past) {
-    return std::clamp((past - kExactFrom) / (kExactTo - kExactFrom), 0.0, 1.0);
-}
+// Primitives of more parts than this are answered by their tables alone: their exact
+// intersection tests part after part (a chain has no hierarchy of its own), 4 times a camera
+// ray, which is what their lattice is there to spare (a tuft of 2,000 parts).
+inline constexpr std::size_t kMaxExactParts = 64;
 
 // One level: a coverage table and its lattice.
 struct FilterLevel {
@@ -89,8 +96,9 @@ class FilteredLatticeShape final : public Shape {
 public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage; the
     // primitive (ctx.primitive) must outlive the shape. table_error: Encoding::error_bound of
-    // the finest level. exact_close: rays far finer than the finest level are answered by the
-    // primitive (exact_weight; levels of detail on).
+    // the finest level. exact_close: rays near or past the finest level blend in the
+    // primitive's crossings (exact_weight; levels of detail on), if it has at most
+    // kMaxExactParts parts.
     FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter, double table_error,
                          bool exact_close = false);
 
