@@ -17,7 +17,12 @@ from png_downscale import read_png, write_png  # noqa: E402
 def main():
     if len(sys.argv) < 7:
         sys.exit(__doc__)
-    out, x0, y0, size, scale = sys.argv[1], *map(int, sys.argv[2:6])
+    try:
+        out, x0, y0, size, scale = sys.argv[1], *map(int, sys.argv[2:6])
+    except ValueError:
+        sys.exit(__doc__)
+    if size < 1 or scale < 1:
+        sys.exit("SIZE and SCALE must be at least 1")
     images = [read_png(p) for p in sys.argv[6:]]
     for path, (w, h, _) in zip(sys.argv[6:], images):
         if x0 < 0 or y0 < 0 or x0 + size > w or y0 + size > h:

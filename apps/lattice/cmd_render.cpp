@@ -243,9 +243,9 @@ Command add_render_command(CLI::App& parent) {
         ->check(CLI::IsMember(kFilters));
     c.app->add_option("--lod", args->lod,
                       "lattice mode with a filter: levels of detail, sigma^-1 = K, 2K, 4K as "
-                      "the pixels' footprints need, blending in the primitive's exact crossings "
-                      "where they are far finer than the finest level's cells (on); or only K "
-                      "(off)")
+                      "the pixels' footprints need, with the primitive's exact crossings blended in "
+                      "(camera rays: half, all where the footprints are far finer than the "
+                      "finest level's cells) (on); or only K, tables alone (off)")
         ->check(CLI::IsMember(kOnOff));
     c.app->add_option("--instancing", args->instancing,
                       "Multi-part objects as Embree instances (always), flattened into one "

@@ -44,11 +44,11 @@ double lod_blend(double f, double band) {
 }
 
 FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
-                                           double table_error, bool exact_close)
+                                           double table_error, bool exact_blend)
     // The point-sampled finest level reaches as far as make_lattice_shape's lattices do.
     : filter_(filter),
       primitive_(levels.back().ctx.primitive),
-      exact_close_(exact_close && primitive_ && primitive_->primitive_count() <= kMaxExactParts),
+      exact_blend_(exact_blend && primitive_ && primitive_->primitive_count() <= kMaxExactParts),
       point_(levels.back().table, levels.back().ctx,
              levels.back().ctx.cell * kSnapReach + table_error) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
@@ -174,14 +174,13 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     const double top = double(levels_.size() - 1);
     const double wanted = width > 0 ? lod_level(levels_.front().frame.cell(), width) : top;
     const double level = std::clamp(wanted, 0.0, top);
-    // The primitive's own crossings, near and past the finest table (exact_weight); rays
-    // without a footprint ask for the finest table alone.
-    const double w_exact =
-        exact_close_ && width > 0 ? exact_weight(wanted - top, normal ? kCameraExact : kShadowExact)
-                                  : 0.0;
+    // The primitive's own crossings (exact_weight); rays without a footprint ask for the
+    // finest table alone.
+    const ExactMode& mode = normal ? kCameraExact : kShadowExact;
+    const double w_exact = exact_blend_ && width > 0 ? exact_weight(wanted - top, mode) : 0.0;
     Sheet tables, exact;
     if (w_exact < 1) add_tables(level, 1 - w_exact, normal, r, tmin, tables);
-    if (w_exact > 0) add_exact(w_exact, width, normal, r, tmin, exact);
+    if (w_exact > 0) add_exact(w_exact, width, mode.sub_rays, normal, r, tmin, exact);
     const double alpha = tables.alpha + exact.alpha;
     if (alpha <= 1e-6) return false;
     const Vec3 p = (tables.p + exact.p) / alpha;
@@ -234,19 +233,15 @@ void FilteredLatticeShape::add_tables(double level, double weight, bool normal, 
     for (std::size_t i = first; i <= last; ++i) add_blend(levels_[i], b[i - first], normal, r, tmin, s);
 }
 
-// Camera rays get the crossings of kExactSubRays^2 sub-rays parallel to them, on a grid across
-// their footprint (the pixel's box filter, as exact mode at that many samples would, but on
-// this primitive only and shaded once), so that edges are antialiased as well as sharp: with
-// the ray's own crossing instead, the blend from two levels before the finest lost (Plate 5
-// 39.26 dB against 39.98 over [-1, 3]), and close-ups were blurrier (Plate 3 49.25 dB against
-// 50.62 over [1, 3]). Shadow rays, which want only the coverage, get their own crossing:
-// sub-rays for them cost Plates 4 and 5 time and changed no PSNR. The crossings are those of
-// the ray's chord through the box, however far it is allowed to go (tmax): what the tables
-// answer does not depend on the order in which the accelerator meets objects either, and the
-// sheet is cut at tmax after.
-void FilteredLatticeShape::add_exact(double weight, double width, bool normal, const Ray& r,
-                                     double tmin, Sheet& s) const {
-    const int n = normal ? kExactSubRays : 1;
+// The crossings of sub_rays^2 sub-rays parallel to r, on a grid across its footprint (for
+// camera rays the pixel's box filter, as exact mode at that many samples would, but on this
+// primitive only and shaded once). They are those of the sub-rays' chords through the box,
+// however far r may go (tmax): what the tables answer does not depend on the order in which
+// the accelerator meets objects either, and the sheet is cut at tmax after. The footprint's
+// width is taken across the ray as along it (instances scaled uniformly, as lod_range assumes).
+void FilteredLatticeShape::add_exact(double weight, double width, int sub_rays, bool normal,
+                                     const Ray& r, double tmin, Sheet& s) const {
+    const int n = sub_rays;
     Vec3 u, v;
     orthonormal_basis(r.d / length(r.d), u, v);
     const double w = weight / (n * n);
@@ -254,11 +249,9 @@ void FilteredLatticeShape::add_exact(double weight, double width, bool normal, c
         for (int j = 0; j < n; ++j) {
             const double a = ((i + 0.5) / n - 0.5) * width, b = ((j + 0.5) / n - 0.5) * width;
             const Ray sub{r.o + u * a + v * b, r.d};
-            double t0 = tmin, t1 = kInfinity;
+            double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
             Crossing c;
-            if (!clip_ray(bounds(), sub, t0, t1) ||
-                !primitive_->intersect(sub, std::max(tmin, t0), t1, c))
-                continue;
+            if (!clip_ray(bounds(), sub, t0, t1) || !primitive_->intersect(sub, t0, t1, c)) continue;
             if (!normal) {
                 s.add_opaque(w, c.has_stored ? c.stored.p : sub.at(c.t), {});
                 continue;

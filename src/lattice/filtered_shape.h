@@ -8,8 +8,8 @@
 //           linearly over a simplex of the 4-D (entry, exit) grid: continuous in ray space.
 // Levels of detail: tables of the same box at sigma^-1 doubling from level to level; each ray
 // takes the level whose cell matches its footprint (ray_footprint()), blending the two nearest.
-// Past the finest table, the primitive itself is the next level of detail: rays whose footprint
-// comes near or past the finest cell get its crossings blended in (exact_weight).
+// The primitive itself is the level after the finest table: its exact crossings are blended
+// into every camera ray's answer, and into shadow rays' past the finest table (exact_weight).
 // As a CSG leaf, for `inside` and for spans, the lattice is point-sampled through the finest
 // level's own hits, exactly as without filtering.
 #include <algorithm>
@@ -58,30 +58,40 @@ inline constexpr double kLodBlendBand = 0.25;
 // The weight of the finer of two levels at fraction f (0 to 1) of the way to it.
 double lod_blend(double f, double band);
 // With levels of detail, the primitive itself is the level after the finest table (the finest
-// built: at most 4K). A ray whose level (lod_level) lies `past` levels beyond the finest
-// table's blends the primitive's own crossings (exact, full coverage) into its sheet, with a
-// weight rising linearly from 0 at `from` to 1 at `to` (ExactRamp). The finest table has cells
-// several pixels wide in close-ups, which blur edges and highlights over a cell; the exact
-// crossings at 1 spp are sharp but aliased, and the two errors differ enough that their blend
-// beats both. Camera rays take 2 x 2 sub-rays across their footprint (add_exact), whose
-// coverage antialiases edges at the pixel's own scale; with them the blend pays from two levels
-// before the finest table on. 1 spp, PSNR against 256-spp exact, Plates 2 / 3 / 4 / 5 (exact 4
-// spp: 44.45 / 52.81 / 36.92 / 39.46 dB), camera ramp over [1, 3], [-1, 3], [-2, 2], [-3, 3],
-// and every camera ray exact: 43.32 / 50.62 / 38.55 / 39.38; 45.52 / 51.52 / 39.14 / 39.98;
-// 45.98 / 51.64 / 39.35 / 40.33; 45.92 / 51.66 / 39.35 / 40.32; 45.83 / 51.64 / 38.52 / 40.10
-// dB (docs/filtering.md, "The primitive as the level after the finest table"). Shadow rays,
-// which want only the coverage, take their own crossing over [1, 3]: starting at -1, Plate 5
-// lost 0.09 dB in 12 % more time.
-struct ExactRamp {
-    double from, to;
+// built: at most 4K): a ray's sheet blends the primitive's own crossings (exact, full coverage)
+// with the tables' answer, at weight exact_weight(past, mode), `past` being how many levels
+// beyond the finest table's the ray's level (lod_level) lies. The tables blur edges and
+// highlights over a cell (several pixels wide in close-ups, where the finest table is
+// coarser than the footprint); exact crossings at 1 spp are sharp but aliased; the two errors
+// differ enough that their blend beats both.
+//   Camera rays take the crossings of 2 x 2 sub-rays across their footprint (add_exact), at
+//   half weight wherever the tables match the footprint, rising to all of it at 2 levels past
+//   the finest table. Half at every level makes a ray's answer independent of which levels
+//   the scene's other instances made the finest (a ramp tied to the finest level was not), and
+//   was as good or better: 1 spp, PSNR against 256-spp exact (64 for the furry bunny and
+//   grass), Plates 2 / 3 / 4 / 5, bunny, grass (exact 4 spp: 44.45 / 52.81 / 36.92 / 39.46 /
+//   31.03 / 35.73 dB); no exact crossings: 39.68 / 43.12 / 38.55 / 39.38 / 31.62 / 37.60; a
+//   ramp from 0 at 2 levels before the finest to 1 at 2 past: 45.98 / 51.64 / 39.35 / 40.33 /
+//   32.61 / 38.03; half, rising from 1 to 3 past: 45.52 / 51.52 / 39.35 / 40.32 / 33.01 /
+//   38.45; half, rising from 0 to 2 past (kept): 45.98 / 51.64 / 39.35 / 40.33 / 33.01 / 38.45
+//   (docs/filtering.md, "The primitive as the level after the finest table"). One crossing a
+//   ray instead of sub-rays lost (Plate 5 39.26 dB over a ramp [-1, 3]): the sub-rays'
+//   coverage antialiases edges at the pixel's own scale.
+//   Shadow rays, which want only the coverage, take their own crossing, from 0 at 1 level
+//   past the finest to all at 3: sub-rays for them changed no PSNR, and starting at -1 cost
+//   Plate 5 0.09 dB in 12 % more time; without them Plates 2 and 3 lost 1.1 and 2 dB.
+struct ExactMode {
+    double base;      // the weight at and before `from`
+    double from, to;  // levels past the finest table where the weight rises from base to 1
+    int sub_rays;     // a side: sub_rays^2 crossings across the footprint
 };
-inline constexpr ExactRamp kCameraExact{-2, 2}, kShadowExact{1, 3};
+inline constexpr ExactMode kCameraExact{0.5, 0, 2, 2}, kShadowExact{0, 1, 3, 1};
+static_assert(kCameraExact.from < kCameraExact.to && kShadowExact.from < kShadowExact.to);
 // The weight of the primitive's crossings for a ray `past` levels beyond the finest table.
-inline double exact_weight(double past, const ExactRamp& ramp) {
-    return std::clamp((past - ramp.from) / (ramp.to - ramp.from), 0.0, 1.0);
+inline double exact_weight(double past, const ExactMode& mode) {
+    const double rise = std::clamp((past - mode.from) / (mode.to - mode.from), 0.0, 1.0);
+    return mode.base + (1 - mode.base) * rise;
 }
-// Sub-rays a side for a camera ray's exact crossings (FilteredLatticeShape::add_exact).
-inline constexpr int kExactSubRays = 2;
 // Primitives of more parts than this are answered by their tables alone: their exact
 // intersection tests part after part (a chain has no hierarchy of its own), 4 times a camera
 // ray, which is what their lattice is there to spare (a tuft of 2,000 parts).
@@ -97,11 +107,10 @@ class FilteredLatticeShape final : public Shape {
 public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage; the
     // primitive (ctx.primitive) must outlive the shape. table_error: Encoding::error_bound of
-    // the finest level. exact_close: rays near or past the finest level blend in the
-    // primitive's crossings (exact_weight; levels of detail on), if it has at most
-    // kMaxExactParts parts.
+    // the finest level. exact_blend: rays blend in the primitive's crossings (exact_weight;
+    // levels of detail on), if it has at most kMaxExactParts parts.
     FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter, double table_error,
-                         bool exact_close = false);
+                         bool exact_blend = false);
 
     Bounds3 bounds() const override { return point_.bounds(); }
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
@@ -159,8 +168,8 @@ private:
     std::vector<Level> levels_;
     std::size_t cull_level_ = 0;
     LatticeFilter filter_;
-    const Shape* primitive_;  // answers close-ups when exact_close_
-    bool exact_close_;
+    const Shape* primitive_;  // its crossings are blended in when exact_blend_
+    bool exact_blend_;
     HitTableShape point_;  // the finest level, point-sampled
 
     const LatticeFrame& cull_frame() const { return levels_[cull_level_].frame; }
@@ -174,9 +183,9 @@ private:
     void add_tables(double level, double weight, bool normal, const Ray& r, double tmin,
                     Sheet& s) const;
     // Adds the primitive's own crossings of r past tmin, at weight `weight` in all (see the
-    // definition); width: the ray's footprint at the box, primitive units.
-    void add_exact(double weight, double width, bool normal, const Ray& r, double tmin,
-                   Sheet& s) const;
+    // definition); width: the ray's footprint at the box, primitive units; sub_rays a side.
+    void add_exact(double weight, double width, int sub_rays, bool normal, const Ray& r,
+                   double tmin, Sheet& s) const;
 };
 
 }  // namespace lat
