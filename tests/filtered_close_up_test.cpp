@@ -194,6 +194,34 @@ TEST(FilteredCloseUps, CameraRaysBlendHalfTheirSubRaysCrossings) {
     EXPECT_GT(checked, 500);
 }
 
+// A ray's direction need not be a unit vector in the primitive's frame (scaled instances): the
+// footprint scales with it, so twice the direction and half the footprint is the same ray and
+// footprint, answered at half the parameter.
+TEST(FilteredCloseUps, LongerDirectionsAreTheSameRay) {
+    const HookLattice h = hook_lattice(false);
+    for (const double past : {0.0, 1.0, kCameraExact.to + 0.5}) {
+        const double width = width_past(past, false);
+        for (const bool shadow : {false, true}) {
+            int hits = 0;
+            for (const Ray& r : rays(2000)) {
+                Crossing a, b;
+                set_ray_footprint({width, 0, shadow});
+                const bool ha = h.blended->intersect(r, 0.0, kInfinity, a);
+                set_ray_footprint({width / 2, 0, shadow});
+                const bool hb = h.blended->intersect({r.o, r.d * 2.0}, 0.0, kInfinity, b);
+                ASSERT_EQ(ha, hb) << "past " << past;
+                if (!ha) continue;
+                ++hits;
+                EXPECT_NEAR(b.t, a.t / 2, 1e-9);
+                EXPECT_NEAR(b.coverage, a.coverage, 1e-6);
+                EXPECT_NEAR(length(b.stored.n - a.stored.n), 0.0, 1e-9);
+            }
+            EXPECT_GT(hits, 300);
+        }
+    }
+    set_ray_footprint({});
+}
+
 // How far a ray may go (tmax: for camera rays in the accelerator, the closest crossing found
 // so far) only cuts the sheet, as for the tables: the answer is the same whatever order the
 // accelerator meets objects in.
