@@ -25,8 +25,10 @@ bool CandidateTableShape::listed_spans(const Ray& r, const CandidateList& list,
                                        const LatticeFrame::Snap& s, SpanList& out) const {
     const std::size_t first = out.size();
     primitive_->pieces_spans({list.parts, static_cast<std::size_t>(list.count)}, r, out);
+    LatticeFrame::Chord c;
+    if (!frame_.chord(s.o, s.d, c)) return false;
     for (std::size_t k = first; k < out.size(); ++k)
-        if (!(out[k].in.t >= s.t0 && out[k].out.t <= s.t1)) return false;
+        if (!(out[k].in.t >= c.t0 && out[k].out.t <= c.t1)) return false;
     return true;
 }
 

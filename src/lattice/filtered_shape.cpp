@@ -82,19 +82,12 @@ void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bo
         return;
     }
     // The real entry and exit points, on the faces snap chose (the axes that clip first and
-    // last, found by the same loop), in face coordinates u, v (the next two axes).
+    // last), in face coordinates u, v (the next two axes).
     const auto& n = l.grid.cells();
-    double t0 = -kInfinity, t1 = kInfinity;
-    int ax[2] = {0, 0};
-    for (int k = 0; k < 3; ++k) {
-        const auto uk = static_cast<std::size_t>(k);
-        if (sn.d[uk] == 0) continue;
-        double tn = -sn.o[uk] / sn.d[uk], tf = (n[uk] - sn.o[uk]) / sn.d[uk];
-        if (tn > tf) std::swap(tn, tf);
-        if (tn > t0) t0 = tn, ax[0] = k;
-        if (tf < t1) t1 = tf, ax[1] = k;
-    }
-    const Vec3 x[2] = {sn.o + sn.d * t0, sn.o + sn.d * t1};
+    LatticeFrame::Chord ch;
+    if (!l.frame.chord(sn.o, sn.d, ch)) return;  // (not reached: snap met the box)
+    const int ax[2] = {ch.ax0, ch.ax1};
+    const Vec3 x[2] = {sn.o + sn.d * ch.t0, sn.o + sn.d * ch.t1};
     // The 4-D coordinates (u, v of the entry, u, v of the exit): the corners' coordinates
     // start at their cell's (c), each with its fraction in the cell and the axis it moves.
     int c[2][3] = {{sn.pa.x, sn.pa.y, sn.pa.z}, {sn.pb.x, sn.pb.y, sn.pb.z}};

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "lattice/candidate_table_shape.h"
+#include "lattice/float_snap.h"
 #include "lattice/hit_table_shape.h"
 
 namespace lat {
@@ -170,19 +171,34 @@ Bounds3 LatticeFrame::cull_bounds(std::size_t i, const Transform& xf) const {
     return lat::intersect(bounds, placed);
 }
 
-// The grid points are written field by field: built a coordinate at a time through
-// GridPoint's operator[], they went through a stack copy that was read back as one 8-byte load
-// of two 4-byte stores, which stalled store forwarding twice a visit (a quarter of snap's
-// samples on ball-csg7 with `dense`; 1-2 % of the render).
 bool LatticeFrame::snap(const Ray& r, Snap& s) const {
     ++t_visits;
+    const Vec3 o = r.o * inv_cell_, d = r.d * inv_cell_;
+    s.o = o;
+    s.d = d;
+    switch (snap_float(o, d, grid_.cells(), s.pa, s.pb)) {
+        case FloatSnap::kMiss: return false;
+        case FloatSnap::kPair: break;
+        case FloatSnap::kUnsure:
+            if (!snap_points(s)) return false;
+    }
+    s.a = grid_.id(s.pa);
+    s.b = grid_.id(s.pb);
+    return true;
+}
+
+bool LatticeFrame::snap_double(const Ray& r, Snap& s) const {
     s.o = r.o * inv_cell_;
     s.d = r.d * inv_cell_;
-    const Vec3 o = s.o, d = s.d;
+    if (!snap_points(s)) return false;
+    s.a = grid_.id(s.pa);
+    s.b = grid_.id(s.pb);
+    return true;
+}
+
+bool LatticeFrame::chord(const Vec3& o, const Vec3& d, Chord& c) const {
     const auto& n = grid_.cells();
-    double t0 = -kInfinity, t1 = kInfinity;
-    int ax0 = -1, ax1 = -1;
-    bool high0 = false, high1 = false;  // whether the entry (exit) face is the axis's far one
+    c = Chord{-kInfinity, kInfinity};
     for (int k = 0; k < 3; ++k) {
         const auto uk = static_cast<std::size_t>(k);
         if (d[uk] == 0) {
@@ -192,14 +208,22 @@ bool LatticeFrame::snap(const Ray& r, Snap& s) const {
         const double inv = 1.0 / d[uk];
         double tn = -o[uk] * inv, tf = (n[uk] - o[uk]) * inv;
         if (tn > tf) std::swap(tn, tf);
-        if (tn > t0) t0 = tn, ax0 = k, high0 = d[uk] < 0;
-        if (tf < t1) t1 = tf, ax1 = k, high1 = d[uk] > 0;
+        if (tn > c.t0) c.t0 = tn, c.ax0 = k, c.high0 = d[uk] < 0;
+        if (tf < c.t1) c.t1 = tf, c.ax1 = k, c.high1 = d[uk] > 0;
     }
-    if (!(t0 <= t1) || ax0 < 0 || ax1 < 0) return false;
-    s.t0 = t0, s.t1 = t1;
-    // Round the entry and exit points to the nearest grid points on their faces.
+    return c.t0 <= c.t1 && c.ax0 >= 0 && c.ax1 >= 0;
+}
+
+// Rounds the entry and exit points to the nearest grid points on their faces, in double. The
+// grid points are written field by field: built a coordinate at a time through GridPoint's
+// operator[], they went through a stack copy that was read back as one 8-byte load of two
+// 4-byte stores, which stalled store forwarding twice a visit.
+bool LatticeFrame::snap_points(Snap& s) const {
+    Chord c;
+    if (!chord(s.o, s.d, c)) return false;
+    const auto& n = grid_.cells();
     const auto on_face = [&](double t, int axis, bool high, GridPoint& g) {
-        const Vec3 x = o + d * t;
+        const Vec3 x = s.o + s.d * t;
         const auto coord = [&](int k, double xk) {
             const int nk = n[static_cast<std::size_t>(k)];
             if (k == axis) return high ? nk : 0;
@@ -209,10 +233,8 @@ bool LatticeFrame::snap(const Ray& r, Snap& s) const {
         g.y = coord(1, x.y);
         g.z = coord(2, x.z);
     };
-    on_face(t0, ax0, high0, s.pa);
-    on_face(t1, ax1, high1, s.pb);
-    s.a = grid_.id(s.pa);
-    s.b = grid_.id(s.pb);
+    on_face(c.t0, c.ax0, c.high0, s.pa);
+    on_face(c.t1, c.ax1, c.high1, s.pb);
     return true;
 }
 

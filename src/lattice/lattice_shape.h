@@ -34,15 +34,29 @@ public:
 
     // The ray's line in lattice units, and its snapped entry and exit points.
     struct Snap {
-        Vec3 o, d;                 // the ray, lattice units
-        double t0 = 0, t1 = 0;       // the ray's chord through the box: parameters of r
+        Vec3 o, d;                   // the ray, lattice units
         std::uint32_t a = 0, b = 0;  // grid point ids of the entry and exit points
         GridPoint pa, pb;
     };
-    // False when the line misses the box.
+    // False when the line misses the box. Snapped in float where a certified error bound
+    // shows the answer is snap_double's (lattice/float_snap.h), else in double: the result is
+    // snap_double's, bit for bit.
     bool snap(const Ray& r, Snap& s) const;
+    bool snap_double(const Ray& r, Snap& s) const;
+
+    // The line's chord through the box, in double: parameters of the ray (lattice units or
+    // not: the same t), and the axes of the faces it enters and leaves by, and whether each
+    // face is its axis's far one. False when the line misses the box.
+    struct Chord {
+        double t0 = 0, t1 = 0;
+        int ax0 = -1, ax1 = -1;
+        bool high0 = false, high1 = false;
+    };
+    bool chord(const Vec3& o, const Vec3& d, Chord& c) const;
 
 private:
+    bool snap_points(Snap& s) const;  // from s.o and s.d, in double
+
     BoundaryGrid grid_;
     double cell_, inv_cell_;
     Bounds3 box_;  // primitive units
