@@ -45,19 +45,8 @@ bool CandidateTableShape::intersect(const Ray& r, double tmin, double tmax, Cros
     LatticeFrame::Snap s;
     if (!candidates(r, list, s)) return false;
     if (!union_) return tree_crossing(r, list, s, tmin, tmax, hit);
-    const PartBoxes::Ray4 slabs(boxes_, r);
-    PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);
-    bool found = false;
-    for (int k = 0; k < list.count; ++k) {
-        const std::uint32_t part = list.parts[k];
-        if (!slabs.meets(part, range)) continue;
-        if (primitive_->intersect_primitive(part, r, tmin, tmax, hit)) {
-            tmax = hit.t;
-            range = slabs.range(tmin, tmax);
-            found = true;
-        }
-    }
-    return found;
+    return boxes_.first_crossing(*primitive_, {list.parts, static_cast<std::size_t>(list.count)},
+                                 r, tmin, tmax, hit);
 }
 
 bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const {

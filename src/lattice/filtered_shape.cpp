@@ -29,6 +29,9 @@ double cull_cells(LatticeFilter f) {
     return std::min(reach_cells(f), kSmoothCullCells);
 }
 
+// Exact crossings of a union of at least this many parts test the parts' boxes first.
+constexpr std::size_t kMinBoxedParts = 8;
+
 }  // namespace
 
 void set_ray_footprint(const RayFootprint& f) { t_footprint = f; }
@@ -71,6 +74,11 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
             i == cull_level_ ? cull_cells(filter) * l.ctx.cell + table_error : kInfinity;
         levels_.push_back({l.table, LatticeFrame(l.ctx, reach), BoundaryGrid(l.ctx.cells)});
     }
+    // Boxes pay for their set-up (a ray's four divisions) on a hair of 19 parts (Plates 4 and
+    // 5 render 1-2 % faster, images identical), not on a thistle spike of 3 (9 % slower).
+    if (exact_blend_ && primitive_->pieces_are_union() &&
+        primitive_->primitive_count() >= kMinBoxedParts)
+        part_boxes_ = std::make_unique<const PartBoxes>(*primitive_, bounds());
 }
 
 void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bool smooth,
@@ -244,7 +252,11 @@ void FilteredLatticeShape::add_exact(double weight, double width, int sub_rays, 
             const Ray sub{r.o + u * a + v * b, r.d};
             double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
             Crossing c;
-            if (!clip_ray(bounds(), sub, t0, t1) || !primitive_->intersect(sub, t0, t1, c)) continue;
+            if (!clip_ray(bounds(), sub, t0, t1)) continue;
+            if (!(part_boxes_ ? part_boxes_->first_crossing(*primitive_, part_boxes_->all_parts(),
+                                                            sub, t0, t1, c)
+                              : primitive_->intersect(sub, t0, t1, c)))
+                continue;
             if (!normal) {
                 s.add_opaque(w, c.has_stored ? c.stored.p : sub.at(c.t), {});
                 continue;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "lattice/hit_table_shape.h"
+#include "lattice/part_boxes.h"
 
 namespace lat {
 
@@ -170,6 +171,8 @@ private:
     LatticeFilter filter_;
     const Shape* primitive_;  // its crossings are blended in when exact_blend_
     bool exact_blend_;
+    // A union's parts' boxes: a sub-ray is intersected with the parts whose box it meets only.
+    std::unique_ptr<const PartBoxes> part_boxes_;
     HitTableShape point_;  // the finest level, point-sampled
 
     const LatticeFrame& cull_frame() const { return levels_[cull_level_].frame; }

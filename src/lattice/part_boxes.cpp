@@ -37,7 +37,24 @@ PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box) : center_(box.c
                 -INFINITY},
                {up(f.hi.x - center_.x), up(f.hi.y - center_.y), up(f.hi.z - center_.z), INFINITY}};
         f_.push_back(q);
+        all_.push_back(static_cast<std::uint32_t>(i));
     }
+}
+
+bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint32_t> parts,
+                               const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    const Ray4 slabs(*this, r);
+    Ray4::Range range = slabs.range(tmin, tmax);
+    bool found = false;
+    for (const std::uint32_t part : parts) {
+        if (!slabs.meets(part, range)) continue;
+        if (primitive.intersect_primitive(part, r, tmin, tmax, hit)) {
+            tmax = hit.t;
+            range = slabs.range(tmin, tmax);
+            found = true;
+        }
+    }
+    return found;
 }
 
 PartBoxes::Ray4::Ray4(const PartBoxes& boxes, const Ray& r) : boxes_(boxes), ray_(r) {

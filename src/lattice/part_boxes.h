@@ -16,6 +16,7 @@
 #include <immintrin.h>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "geometry/shape.h"
@@ -26,6 +27,14 @@ class PartBoxes {
 public:
     // box: the lattice box (primitive units) that every part and every crossing lies in.
     PartBoxes(const Shape& primitive, const Bounds3& box);
+
+    // The first crossing in (tmin, tmax) of the union of the listed parts of primitive (the
+    // one the boxes were made for): each part whose box the ray meets within the range left
+    // is intersected, in list order (ties go to the earlier part, as in a loop over them all).
+    bool first_crossing(const Shape& primitive, std::span<const std::uint32_t> parts, const Ray& r,
+                        double tmin, double tmax, Crossing& hit) const;
+    // 0, 1, ..., the primitive's part count - 1.
+    std::span<const std::uint32_t> all_parts() const { return all_; }
 
     // One ray (primitive units), prepared once a visit for any number of tests.
     class Ray4 {
@@ -70,6 +79,7 @@ private:
     struct alignas(16) Box4 {
         float lo[4], hi[4];
     };
+    std::vector<std::uint32_t> all_;
     std::vector<Bounds3> exact_;  // the parts' bounds padded as in double
     std::vector<Box4> f_;         // padded by kPad x D, rounded outward
     Vec3 center_;
