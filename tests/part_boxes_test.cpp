@@ -3,8 +3,10 @@
 // from far, along axes and grazing box corners.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
+#include "geometry/chain.h"
 #include "lattice/part_boxes.h"
 
 namespace lat {
@@ -73,6 +75,41 @@ TEST(PartBoxes, FloatTestNeverRejectsAPartTheRayMeets) {
             }
     }
     EXPECT_GT(met, 20000);
+}
+
+// A union's first crossing over its parts, box-tested first (what filtered lattices blend in),
+// is the primitive's own, bit for bit: the same t, part and stored point, and none where it has
+// none; rays aimed at joints (where a sphere and its cylinders meet) and grazing the hair.
+TEST(PartBoxes, FirstCrossingOverAllPartsIsTheUnions) {
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<ChainSphere> spheres;
+    std::vector<ChainCylinder> cylinders;
+    for (int i = 0; i < 10; ++i) {
+        spheres.push_back({{3.5 + std::sin(i * 0.7), 3.5 + std::cos(i * 0.5), 1 + 1.8 * i}, 0.3});
+        if (i > 0) cylinders.push_back({i - 1, i, 0.3});
+    }
+    const ChainShape hair(spheres, cylinders);
+    const PartBoxes boxes(hair, Bounds3{{0, 0, 0}, {7, 7, 20}});
+    int hits = 0;
+    for (int n = 0; n < 20000; ++n) {
+        const ChainSphere& aim = spheres[static_cast<std::size_t>(n) % spheres.size()];
+        // At a joint's centre, on its surface, or near the hair.
+        const Vec3 jitter = Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * (n % 3 == 0 ? 0.0 : 1.2);
+        const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+        const Ray r{aim.center + jitter - d * (1 + 50 * u(rng)), d * (0.1 + 3 * u(rng))};
+        const double tmin = n % 4 == 0 ? 0.5 : 0.0, tmax = n % 5 == 0 ? 2.0 : kInfinity;
+        Crossing want, got;
+        const bool w = hair.intersect(r, tmin, tmax, want);
+        const bool g = boxes.first_crossing(hair, boxes.all_parts(), r, tmin, tmax, got);
+        ASSERT_EQ(w, g) << "ray " << n;
+        if (!w) continue;
+        ++hits;
+        ASSERT_EQ(want.t, got.t) << "ray " << n;
+        ASSERT_EQ(want.part, got.part) << "ray " << n;
+        ASSERT_TRUE(want.stored.p == got.stored.p && want.stored.n == got.stored.n) << "ray " << n;
+    }
+    EXPECT_GT(hits, 5000);
 }
 
 }  // namespace
