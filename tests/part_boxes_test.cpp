@@ -3,6 +3,7 @@
 // from far, along axes and grazing box corners.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -75,6 +76,48 @@ TEST(PartBoxes, FloatTestNeverRejectsAPartTheRayMeets) {
             }
     }
     EXPECT_GT(met, 20000);
+}
+
+// near_parts keeps every part that a ray parallel to r, shifted by up to g along each axis (the
+// box grown by g), meets after tmin: the sub-rays of a filtered lattice's exact blend.
+TEST(PartBoxes, NearPartsKeepEveryPartAParallelRayWithinGrowMeets) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    Boxes prim;
+    for (int i = 0; i < 60; ++i) {
+        const Vec3 c{7 * u(rng), 7 * u(rng), 20 * u(rng)};
+        const Vec3 h{0.2 * u(rng), 0.2 * u(rng), 1.0 * u(rng)};
+        prim.parts.push_back(lat::intersect(Bounds3{c - h, c + h}, prim.bounds()));
+    }
+    const PartBoxes boxes(prim, prim.bounds());
+    std::vector<std::uint32_t> near(prim.parts.size());
+    int kept = 0, met = 0;
+    for (int n = 0; n < 20000; ++n) {
+        const Bounds3& target = prim.parts[static_cast<std::size_t>(n) % prim.parts.size()];
+        const Vec3 p = target.lo + (target.hi - target.lo) * Vec3{u(rng), u(rng), u(rng)};
+        Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+        if (n % 7 == 0) d = {0, 1, 0};  // along an axis: the double fallback
+        const double dist = std::pow(10.0, 4 * u(rng));
+        const double g = std::pow(10.0, 3 * u(rng) - 2.5);  // 0.003 to 3 cells
+        const Ray r{p - d * dist, d * (0.1 + 5 * u(rng))};
+        const double tmin = n % 2 ? 0.0 : dist / length(r.d) * u(rng);
+        const std::size_t count = boxes.near_parts(r, g, tmin, near);
+        kept += static_cast<int>(count);
+        for (int k = 0; k < 8; ++k) {
+            // A shift of up to g along each axis (a cube corner when k = 0).
+            const Vec3 s = k == 0 ? Vec3{g, -g, g}
+                                  : Vec3{u(rng) * 2 - 1, u(rng) * 2 - 1, u(rng) * 2 - 1} * g;
+            const Ray shifted{r.o + s, r.d};
+            for (std::uint32_t i = 0; i < prim.parts.size(); ++i) {
+                if (!meets_exact(prim.parts[i], shifted, tmin, kInfinity)) continue;
+                ++met;
+                ASSERT_TRUE(std::find(near.begin(), near.begin() + count, i) != near.begin() + count)
+                    << "ray " << n << " part " << i;
+            }
+        }
+    }
+    EXPECT_GT(met, 20000);
+    EXPECT_LT(kept, 20000 * 20);  // and it does leave parts out
 }
 
 // A union's first crossing over its parts, box-tested first (what filtered lattices blend in),

@@ -1,6 +1,7 @@
 #include "lattice/part_boxes.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 namespace lat {
@@ -55,6 +56,28 @@ bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint
         }
     }
     return found;
+}
+
+std::size_t PartBoxes::near_parts(const Ray& r, double grow, double tmin,
+                                  std::span<std::uint32_t> out) const {
+    assert(out.size() >= all_.size());
+    const Ray4 slabs(*this, r);
+    const Ray4::Range range = slabs.range(tmin, kInfinity);
+    std::size_t n = 0;
+    for (const std::uint32_t part : all_)
+        if (slabs.meets_grown(part, range, grow)) out[n++] = part;
+    return n;
+}
+
+// In float, lo - g rounds by at most 2^-24 (D + g) (coordinates relative to the box centre are
+// below D): growing by 1e-6 more covers the part in g, the boxes' padding (1e-4 D) the rest.
+bool PartBoxes::Ray4::meets_grown(std::uint32_t i, const Range& r, double g) const {
+    if (!use_float_) return meets_double(expand(boxes_.exact_[i], g), r);
+    const Box4& b = boxes_.f_[i];
+    const float gf = up(g * (1 + 1e-6));
+    Box4 grown;
+    for (int k = 0; k < 4; ++k) grown.lo[k] = b.lo[k] - gf, grown.hi[k] = b.hi[k] + gf;
+    return meets_float(grown, r);
 }
 
 PartBoxes::Ray4::Ray4(const PartBoxes& boxes, const Ray& r) : boxes_(boxes), ray_(r) {

@@ -35,6 +35,11 @@ public:
                         double tmin, double tmax, Crossing& hit) const;
     // 0, 1, ..., the primitive's part count - 1.
     std::span<const std::uint32_t> all_parts() const { return all_; }
+    // The parts, in order, whose box grown by `grow` on every side the ray's line meets after
+    // tmin: all that a ray parallel to r within grow of its line can meet there (same t). out
+    // holds at least the part count; returns how many were written.
+    std::size_t near_parts(const Ray& r, double grow, double tmin,
+                           std::span<std::uint32_t> out) const;
 
     // One ray (primitive units), prepared once a visit for any number of tests.
     class Ray4 {
@@ -50,6 +55,8 @@ public:
         bool meets(std::uint32_t i, const Range& r) const {
             return use_float_ ? meets_float(boxes_.f_[i], r) : meets_double(boxes_.exact_[i], r);
         }
+        // The same for the box grown by g on every side.
+        bool meets_grown(std::uint32_t i, const Range& r, double g) const;
 
     private:
         const PartBoxes& boxes_;
