@@ -63,20 +63,26 @@ std::size_t PartBoxes::near_parts(const Ray& r, double grow, double tmin,
     assert(out.size() >= all_.size());
     const Ray4 slabs(*this, r);
     const Ray4::Range range = slabs.range(tmin, kInfinity);
+    const Ray4::Grow g = Ray4::grow(grow);
     std::size_t n = 0;
     for (const std::uint32_t part : all_)
-        if (slabs.meets_grown(part, range, grow)) out[n++] = part;
+        if (slabs.meets_grown(part, range, g)) out[n++] = part;
     return n;
 }
 
 // In float, lo - g rounds by at most 2^-24 (D + g) (coordinates relative to the box centre are
 // below D): growing by 1e-6 more covers the part in g, the boxes' padding (1e-4 D) the rest.
-bool PartBoxes::Ray4::meets_grown(std::uint32_t i, const Range& r, double g) const {
-    if (!use_float_) return meets_double(expand(boxes_.exact_[i], g), r);
+PartBoxes::Ray4::Grow PartBoxes::Ray4::grow(double g) {
+    return {g, up(g * (1 + 1e-6))};
+}
+
+bool PartBoxes::Ray4::meets_grown(std::uint32_t i, const Range& r, const Grow& g) const {
+    if (!use_float_) return meets_double(expand(boxes_.exact_[i], g.g), r);
     const Box4& b = boxes_.f_[i];
-    const float gf = up(g * (1 + 1e-6));
+    const __m128 gf = _mm_set1_ps(g.f);
     Box4 grown;
-    for (int k = 0; k < 4; ++k) grown.lo[k] = b.lo[k] - gf, grown.hi[k] = b.hi[k] + gf;
+    _mm_store_ps(grown.lo, _mm_sub_ps(_mm_load_ps(b.lo), gf));
+    _mm_store_ps(grown.hi, _mm_add_ps(_mm_load_ps(b.hi), gf));
     return meets_float(grown, r);
 }
 

@@ -55,8 +55,14 @@ public:
         bool meets(std::uint32_t i, const Range& r) const {
             return use_float_ ? meets_float(boxes_.f_[i], r) : meets_double(boxes_.exact_[i], r);
         }
-        // The same for the box grown by g on every side.
-        bool meets_grown(std::uint32_t i, const Range& r, double g) const;
+        // A growth of every box by g on every side, prepared once for meets_grown.
+        struct Grow {
+            double g;
+            float f;  // g for the float test, rounded up with a margin
+        };
+        static Grow grow(double g);
+        // Whether the ray's line meets part i's box grown by g at some t in the range.
+        bool meets_grown(std::uint32_t i, const Range& r, const Grow& g) const;
 
     private:
         const PartBoxes& boxes_;
