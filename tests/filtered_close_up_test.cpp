@@ -5,7 +5,9 @@
 #include <cmath>
 #include <random>
 
+#include "csg/csg_shape.h"
 #include "geometry/chain.h"
+#include "geometry/triangle_mesh.h"
 #include "hook_primitive.h"
 #include "lattice/encoding.h"
 #include "lattice/filtered_shape.h"
@@ -25,12 +27,22 @@ struct HookLattice {
     std::unique_ptr<FilteredLatticeShape> blended, tables_only;
 };
 
-HookLattice hook_lattice(bool two_levels) {
+// The hook with a fifth bead: 9 parts, enough for the blend to find the parts near a ray
+// first (PartBoxes::near_parts), in the hook's box.
+const ChainShape& long_hook() {
+    static const ChainShape s(
+        {{{1, 1, 1}, 0.5}, {{1, 1, 3}, 0.5}, {{3, 1, 3}, 0.5}, {{3, 1, 2}, 0.5}, {{2.2, 1, 1.2}, 0.4}},
+        {{0, 1, 0.5}, {1, 2, 0.5}, {2, 3, 0.5}, {3, 4, 0.4}});
+    return s;
+}
+
+HookLattice hook_lattice(bool two_levels, const Shape& primitive = hook()) {
     const Encoding& e = find_encoding("coverage");
     HookLattice h;
     std::vector<FilterLevel> levels;
     std::vector<TableContext> contexts{kFine};
     if (two_levels) contexts.insert(contexts.begin(), kCoarse);
+    for (TableContext& ctx : contexts) ctx.primitive = &primitive;
     h.payloads.reserve(contexts.size());
     for (const TableContext& ctx : contexts) {
         const RasterizeResult r = rasterize(ctx);
@@ -156,8 +168,10 @@ TEST(FilteredCloseUps, TheRampBlendsTheTablesSheetWithTheCrossing) {
 
 // Camera rays at the finest level: half the tables' sheet, half the crossings of their sub-rays
 // (a grid across the footprint, recomputed here), in coverage and in the normal.
-TEST(FilteredCloseUps, CameraRaysBlendHalfTheirSubRaysCrossings) {
-    const HookLattice h = hook_lattice(false);
+// (With the hook, and with a hook of 9 parts, whose sub-rays meet only the parts found near
+// the ray first: the same crossings as the whole primitive's.)
+void expect_camera_rays_blend_half_their_sub_rays(const ChainShape& prim) {
+    const HookLattice h = hook_lattice(false, prim);
     ASSERT_EQ(exact_weight(0.0, kCameraExact), 0.5);
     const double width = width_past(0.0, false);
     set_ray_footprint({width, 0, false});
@@ -176,9 +190,9 @@ TEST(FilteredCloseUps, CameraRaysBlendHalfTheirSubRaysCrossings) {
                 const Ray sub{r.o + u * (((i + 0.5) / n - 0.5) * width) + v * (((j + 0.5) / n - 0.5) * width), r.d};
                 double t0 = 0, t1 = kInfinity;
                 Crossing c;
-                if (!clip_ray(box, sub, t0, t1) || !hook().intersect(sub, t0, t1, c)) continue;
+                if (!clip_ray(box, sub, t0, t1) || !prim.intersect(sub, t0, t1, c)) continue;
                 alpha += 0.5 / (n * n);
-                normal += normalize(hook().normal(sub, c)) * (0.5 / (n * n));
+                normal += normalize(prim.normal(sub, c)) * (0.5 / (n * n));
             }
         const bool hit = h.blended->intersect(r, 0.0, kInfinity, got);
         if (alpha <= 1e-6) {
@@ -192,6 +206,13 @@ TEST(FilteredCloseUps, CameraRaysBlendHalfTheirSubRaysCrossings) {
     }
     set_ray_footprint({});
     EXPECT_GT(checked, 500);
+}
+
+TEST(FilteredCloseUps, CameraRaysBlendHalfTheirSubRaysCrossings) {
+    ASSERT_LT(hook().primitive_count(), 8u);
+    expect_camera_rays_blend_half_their_sub_rays(hook());
+    ASSERT_GE(long_hook().primitive_count(), 8u);
+    expect_camera_rays_blend_half_their_sub_rays(long_hook());
 }
 
 // A ray's direction need not be a unit vector in the primitive's frame (scaled instances): the
@@ -279,15 +300,10 @@ TEST(FilteredCloseUps, FootprintsShortOfTheRampReadTheTablesAlone) {
     set_ray_footprint({});
 }
 
-// A primitive of more than kMaxExactParts parts keeps to its tables: its exact intersection
-// would test every part, for every sub-ray.
-// How many of 3000 rays a chain of `parts` beads answers differently with the blend asked for.
-int differing_answers(std::size_t parts) {
-    std::vector<ChainSphere> beads;
-    for (std::size_t i = 0; i < parts; ++i)
-        beads.push_back({{0.5 + 3.0 * double(i) / double(parts - 1), 1.0, 2.0}, 0.2});
-    const ChainShape chain(beads, {});
-    const TableContext ctx{{4, 2, 4}, 1.0, 1.0, &chain};
+// How many of 3000 rays far past the finest level a primitive in a {4, 2, 4} box answers
+// differently with the exact blend asked for than without it.
+int differing_answers(const Shape& primitive) {
+    const TableContext ctx{{4, 2, 4}, 1.0, 1.0, &primitive};
     const Encoding& e = find_encoding("coverage");
     const RasterizeResult raster = rasterize(ctx);
     const ByteBuffer payload = e.build(raster.raw, ctx, {});
@@ -306,9 +322,50 @@ int differing_answers(std::size_t parts) {
     return differ;
 }
 
+// A row of `parts` beads across the box.
+ChainShape beads(std::size_t parts) {
+    std::vector<ChainSphere> b;
+    for (std::size_t i = 0; i < parts; ++i)
+        b.push_back({{0.5 + 3.0 * double(i) / double(parts - 1), 1.0, 2.0}, 0.2});
+    return ChainShape(b, {});
+}
+
+// A primitive whose exact intersection costs more than kMaxExactCost simple tests keeps to its
+// tables: a chain would test every part, for every sub-ray.
 TEST(FilteredCloseUps, PrimitivesOfManyPartsKeepToTheirTables) {
-    EXPECT_EQ(differing_answers(kMaxExactParts + 1), 0);
-    EXPECT_GT(differing_answers(kMaxExactParts), 500);  // the blend shows where it is allowed
+    const auto most = static_cast<std::size_t>(kMaxExactCost);
+    EXPECT_EQ(differing_answers(beads(most + 1)), 0);
+    EXPECT_GT(differing_answers(beads(most)), 500);  // the blend shows where it is allowed
+}
+
+// A mesh descends its own hierarchy: one of many more triangles than kMaxExactCost is blended
+// (a sheet of 2 x 12 x 8 triangles); and a CSG tree costs its leaves' costs, so one with such
+// a chain as a leaf keeps to its tables.
+TEST(FilteredCloseUps, MeshesAreBlendedAndTreesCostTheirLeaves) {
+    std::vector<Vec3> positions;
+    std::vector<TriangleMeshShape::Triangle> triangles;
+    const int nu = 12, nv = 8;
+    for (int j = 0; j <= nv; ++j)
+        for (int i = 0; i <= nu; ++i)
+            positions.push_back({0.5 + 3.0 * i / nu, 0.6 + 0.8 * j / nv, 1.0 + 2.0 * j / nv});
+    const auto at = [&](int i, int j) { return static_cast<std::uint32_t>(j * (nu + 1) + i); };
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+            triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+    const TriangleMeshShape sheet(positions, triangles);
+    ASSERT_GT(static_cast<double>(sheet.primitive_count()), kMaxExactCost);
+    EXPECT_LE(sheet.intersect_cost(), kMaxExactCost);
+    EXPECT_GT(differing_answers(sheet), 500);
+
+    CsgShape tree;
+    const auto small = static_cast<std::size_t>(kMaxExactCost) / 2;
+    const int a = tree.add_leaf({std::make_shared<ChainShape>(beads(small)), {}, 1});
+    const int b = tree.add_leaf({std::make_shared<ChainShape>(beads(small + 1)), {}, 2});
+    tree.set_root(tree.add_node(CsgOp::kUnion, {a, b}));
+    EXPECT_EQ(tree.intersect_cost(), double(2 * small + 1));
+    EXPECT_EQ(differing_answers(tree), 0);
 }
 
 }  // namespace

@@ -182,6 +182,12 @@ void CsgShape::eval(int ref, const Ray& r, SpanList& out, const LeafSet* on) con
     }
 }
 
+double CsgShape::intersect_cost() const {
+    double cost = 0;
+    for (const Leaf& l : leaves_) cost += l.leaf.shape ? l.leaf.shape->intersect_cost() : 1.0;
+    return cost;
+}
+
 void CsgShape::spans(const Ray& r, SpanList& out) const {
     ScratchSpans tmp;
     eval(root_, r, *tmp, nullptr);

@@ -61,6 +61,8 @@ public:
     // Pieces (exact lattices) are the leaves: a leaf whose solid keeps away from a ray is
     // empty along it, and the tree is evaluated with the others.
     std::size_t piece_count() const override { return leaves_.size(); }
+    // The tree evaluates every leaf whose bounds the ray meets: their costs, summed.
+    double intersect_cost() const override;
     void piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
     bool pieces_are_union() const override { return false; }
     void pieces_spans(std::span<const std::uint32_t> on, const Ray& r,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ranges>
 
 namespace lat {
 
@@ -40,14 +41,8 @@ void ChainShape::primitive_spheres(std::size_t i, std::vector<BoundingSphere>& o
 
 bool ChainShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
     // From outside, the union's first crossing is the first crossing of any part.
-    bool found = false;
-    for (std::size_t i = 0; i < primitive_count(); ++i) {
-        if (intersect_primitive(i, r, tmin, tmax, hit)) {
-            tmax = hit.t;
-            found = true;
-        }
-    }
-    return found;
+    return first_crossing_of_parts(*this, std::views::iota(std::size_t{0}, primitive_count()), r,
+                                   tmin, tmax, hit);
 }
 
 bool ChainShape::occluded(const Ray& r, double tmin, double tmax) const {

@@ -29,6 +29,7 @@ public:
 
     Bounds3 bounds() const override { return bounds_; }
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
+    bool intersects_parts_in_order() const override { return true; }
     bool occluded(const Ray& r, double tmin, double tmax) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;

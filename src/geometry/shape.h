@@ -139,6 +139,14 @@ public:
     // every lookup, only where that is cheap.
     virtual bool cheap_normal(const Crossing&) const { return true; }
 
+    // Whether intersect() is first_crossing_of_parts over all the primitives in order: then
+    // any superset of the parts a ray can meet, in order, gives the same crossing, bit for bit.
+    virtual bool intersects_parts_in_order() const { return false; }
+    // About how many simple tests (a sphere's or a cylinder's) one intersect() makes: what a
+    // lattice weighs before tracing its primitive exactly where its tables could answer
+    // (FilteredLatticeShape). By default its primitives, tested one by one.
+    virtual double intersect_cost() const { return static_cast<double>(primitive_count()); }
+
     // Shapes made of many parts (sphere/cylinder chains) expose them so the accelerator can
     // build a hierarchy over them; by default the shape is one primitive.
     virtual std::size_t primitive_count() const { return 1; }
@@ -205,6 +213,20 @@ public:
 
 // Spans from `first` on, possibly overlapping: sorted and merged into their union.
 void merge_span_union(SpanList& spans, std::size_t first);
+
+// The first crossing in (tmin, tmax) of the union of the listed parts of s, each intersected
+// with intersect_primitive in list order (ties go to the earlier part). S: the shape's own type
+// where the caller knows it, so that its parts' tests inline.
+template <class S, class Parts>
+bool first_crossing_of_parts(const S& s, const Parts& parts, const Ray& r, double tmin,
+                             double tmax, Crossing& hit) {
+    bool found = false;
+    for (const auto part : parts) {
+        Crossing c;
+        if (s.intersect_primitive(part, r, tmin, tmax, c)) tmax = c.t, hit = c, found = true;
+    }
+    return found;
+}
 
 // The first crossing of a span list with tmin < t < tmax, if any.
 bool first_crossing(const SpanList& spans, double tmin, double tmax, Crossing& hit);

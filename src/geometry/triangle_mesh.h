@@ -5,6 +5,7 @@
 // mesh (every edge shared by exactly two triangles, consistently oriented) is also a solid for
 // CSG, inside by ray parity; an open one is only a surface.
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -41,6 +42,10 @@ public:
     bool inside(Vec3 p) const override;
     bool names_surface(const Crossing& c) const override { return c.part < triangles_.size(); }
 
+    // intersect() descends its own hierarchy: about two boxes a level and a leaf's triangles.
+    double intersect_cost() const override {
+        return 2.0 * std::bit_width(triangles_.size()) + 4;
+    }
     std::size_t primitive_count() const override { return triangles_.size(); }
     Bounds3 primitive_bounds(std::size_t i) const override;
     Bounds3 primitive_bounds(std::size_t i, const Transform& xf) const override;

@@ -41,14 +41,8 @@ CoverageSample summarise(const BoundaryGrid& grid, std::uint32_t a, std::uint32_
 template <class S, class Parts>
 void trace_sub_ray(const S& shape, double h, const SubRay& s, const Parts& parts, Tally& n) {
     const Ray r{s.p * h, (s.q - s.p) * h};
-    double best = 1.0 + 1e-12;
     Crossing bc;
-    bool hit = false;
-    for (const std::uint32_t part : parts) {
-        Crossing c;
-        if (shape.intersect_primitive(part, r, 0.0, best, c)) best = c.t, bc = c, hit = true;
-    }
-    if (!hit) return;
+    if (!first_crossing_of_parts(shape, parts, r, 0.0, 1.0 + 1e-12, bc)) return;
     ++n.hits;
     n.psum += lerp(s.p, s.q, bc.t);
     n.nsum += shape.normal(r, bc);

@@ -30,7 +30,7 @@ double cull_cells(LatticeFilter f) {
     return std::min(reach_cells(f), kSmoothCullCells);
 }
 
-// Exact crossings of a union of at least this many parts test the parts' boxes first.
+// Exact crossings of a chain of at least this many parts test the parts' boxes first.
 constexpr std::size_t kMinBoxedParts = 8;
 
 }  // namespace
@@ -52,7 +52,7 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // The point-sampled finest level reaches as far as make_lattice_shape's lattices do.
     : filter_(filter),
       primitive_(levels.back().ctx.primitive),
-      exact_blend_(exact_blend && primitive_ && primitive_->primitive_count() <= kMaxExactParts),
+      exact_blend_(exact_blend && primitive_ && primitive_->intersect_cost() <= kMaxExactCost),
       point_(levels.back().table, levels.back().ctx,
              levels.back().ctx.cell * kSnapReach + table_error) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
@@ -77,8 +77,9 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     }
     // Boxes pay for their set-up on a hair of 19 parts, not on a thistle spike of 3 (Plate 2
     // rendered 9 % slower when every sub-ray tested the boxes).
-    if (exact_blend_ && primitive_->pieces_are_union() &&
-        primitive_->primitive_count() >= kMinBoxedParts)
+    if (exact_blend_ && primitive_->intersects_parts_in_order() &&
+        primitive_->primitive_count() >= kMinBoxedParts &&
+        primitive_->primitive_count() <= kMaxNearParts)
         part_boxes_ = std::make_unique<const PartBoxes>(*primitive_, bounds());
 }
 
@@ -251,15 +252,13 @@ void FilteredLatticeShape::add_exact(double weight, double width, int sub_rays, 
     // the width, more than the farthest sub-ray's offset along any axis (sqrt(2) (n - 1) / 2n
     // of it; a single sub-ray is r). Plates 4 and 5 render 6 % faster than with every part
     // intersected by every sub-ray; images identical.
-    std::array<std::uint32_t, kMaxExactParts> near;
+    std::array<std::uint32_t, kMaxNearParts> near;
     const std::size_t n_near =
         part_boxes_ ? part_boxes_->near_parts(r, width * (n - 1) / n, tmin, near) : 0;
     const auto crossing = [&](const Ray& sub, double t0, double t1, Crossing& c) {
-        if (!part_boxes_) return primitive_->intersect(sub, t0, t1, c);
-        bool found = false;  // the union's first crossing, as ChainShape::intersect finds it
-        for (std::size_t k = 0; k < n_near; ++k)
-            if (primitive_->intersect_primitive(near[k], sub, t0, t1, c)) t1 = c.t, found = true;
-        return found;
+        return part_boxes_ ? first_crossing_of_parts(*primitive_, std::span(near.data(), n_near),
+                                                     sub, t0, t1, c)
+                           : primitive_->intersect(sub, t0, t1, c);
     };
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {

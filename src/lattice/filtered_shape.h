@@ -93,10 +93,12 @@ inline double exact_weight(double past, const ExactMode& mode) {
     const double rise = std::clamp((past - mode.from) / (mode.to - mode.from), 0.0, 1.0);
     return mode.base + (1 - mode.base) * rise;
 }
-// Primitives of more parts than this are answered by their tables alone: their exact
-// intersection tests part after part (a chain has no hierarchy of its own), 4 times a camera
-// ray, which is what their lattice is there to spare (a tuft of 2,000 parts).
-inline constexpr std::size_t kMaxExactParts = 64;
+// Primitives whose exact intersection costs more than this many simple tests
+// (Shape::intersect_cost) are answered by their tables alone: a chain tests part after part,
+// 4 times a camera ray, which is what the lattice of a tuft of 2,000 parts is there to spare.
+inline constexpr double kMaxExactCost = 64;
+// Unions of at most this many parts find the parts near a ray first (PartBoxes::near_parts).
+inline constexpr std::size_t kMaxNearParts = 64;
 
 // One level: a coverage table and its lattice.
 struct FilterLevel {
@@ -109,7 +111,7 @@ public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage; the
     // primitive (ctx.primitive) must outlive the shape. table_error: Encoding::error_bound of
     // the finest level. exact_blend: rays blend in the primitive's crossings (exact_weight;
-    // levels of detail on), if it has at most kMaxExactParts parts.
+    // levels of detail on), if its intersect_cost is at most kMaxExactCost.
     FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter, double table_error,
                          bool exact_blend = false);
 

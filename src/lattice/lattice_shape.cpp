@@ -179,8 +179,7 @@ bool LatticeFrame::snap(const Ray& r, Snap& s) const {
     switch (snap_float(o, d, grid_.cells(), s.pa, s.pb)) {
         case FloatSnap::kMiss: return false;
         case FloatSnap::kPair: break;
-        case FloatSnap::kUnsure:
-            if (!snap_points(s)) return false;
+        case FloatSnap::kUnsure: return snap_double(r, s);
     }
     s.a = grid_.id(s.pa);
     s.b = grid_.id(s.pb);

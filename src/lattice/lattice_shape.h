@@ -42,6 +42,7 @@ public:
     // shows the answer is snap_double's (lattice/float_snap.h), else in double: the result is
     // snap_double's, bit for bit.
     bool snap(const Ray& r, Snap& s) const;
+    // The reference: all in double (tests compare snap with it).
     bool snap_double(const Ray& r, Snap& s) const;
 
     // The line's chord through the box, in double: parameters of the ray (lattice units or

@@ -38,7 +38,6 @@ PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box) : center_(box.c
                 -INFINITY},
                {up(f.hi.x - center_.x), up(f.hi.y - center_.y), up(f.hi.z - center_.z), INFINITY}};
         f_.push_back(q);
-        all_.push_back(static_cast<std::uint32_t>(i));
     }
 }
 
@@ -60,20 +59,20 @@ bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint
 
 std::size_t PartBoxes::near_parts(const Ray& r, double grow, double tmin,
                                   std::span<std::uint32_t> out) const {
-    assert(out.size() >= all_.size());
+    assert(out.size() >= f_.size());
     const Ray4 slabs(*this, r);
     const Ray4::Range range = slabs.range(tmin, kInfinity);
     const Ray4::Grow g = Ray4::grow(grow);
     std::size_t n = 0;
-    for (const std::uint32_t part : all_)
+    for (std::uint32_t part = 0; part < f_.size(); ++part)
         if (slabs.meets_grown(part, range, g)) out[n++] = part;
     return n;
 }
 
 // In float, lo - g rounds by at most 2^-24 (D + g) (coordinates relative to the box centre are
-// below D): growing by 1e-6 more covers the part in g, the boxes' padding (1e-4 D) the rest.
+// below D): growing by 1e-5 more covers the part in g, the boxes' padding (1e-4 D) the rest.
 PartBoxes::Ray4::Grow PartBoxes::Ray4::grow(double g) {
-    return {g, up(g * (1 + 1e-6))};
+    return {g, up(g * (1 + 1e-5))};
 }
 
 bool PartBoxes::Ray4::meets_grown(std::uint32_t i, const Range& r, const Grow& g) const {

@@ -33,8 +33,6 @@ public:
     // is intersected, in list order (ties go to the earlier part, as in a loop over them all).
     bool first_crossing(const Shape& primitive, std::span<const std::uint32_t> parts, const Ray& r,
                         double tmin, double tmax, Crossing& hit) const;
-    // 0, 1, ..., the primitive's part count - 1.
-    std::span<const std::uint32_t> all_parts() const { return all_; }
     // The parts, in order, whose box grown by `grow` on every side the ray's line meets after
     // tmin: all that a ray parallel to r within grow of its line can meet there (same t). out
     // holds at least the part count; returns how many were written.
@@ -92,7 +90,6 @@ private:
     struct alignas(16) Box4 {
         float lo[4], hi[4];
     };
-    std::vector<std::uint32_t> all_;
     std::vector<Bounds3> exact_;  // the parts' bounds padded as in double
     std::vector<Box4> f_;         // padded by kPad x D, rounded outward
     Vec3 center_;
