@@ -10,6 +10,7 @@
 
 #include "geometry/chain.h"
 #include "hook_primitive.h"
+#include "lattice/boundary_grid.h"
 #include "lattice/coverage.h"
 #include "lattice/coverage_rays.h"
 #include "lattice/encoding.h"
@@ -391,6 +392,45 @@ TEST(Coverage, AThinPrimitiveHasTheRightBrightness) {
         tbb::task_arena(1).execute([&] { one = render_image(rs, opt).display; });
         EXPECT_EQ(one.rgb, render_image(rs, opt).display.rgb);
     }
+}
+
+// Two beads, one near the camera and one far: levels of detail want 1K, 2K and 4K.
+constexpr const char* kNearAndFar = R"({
+  "format": "lattice-reference/1",
+  "camera": {"eye": [1, -3, 1], "look_at": [1, 0.5, 1], "up": [0, 0, 1], "fov_y_deg": 30,
+             "width": 16, "height": 16},
+  "background": [0, 0, 0], "ambient": [1, 1, 1], "shadows": false, "lights": [],
+  "materials": {"w": {"color": [1, 1, 1], "ka": 1, "kd": 0, "ks": 0, "shininess": 1}},
+  "primitives": {"bead": {"spheres": [[1, 0.5, 1, 0.3]], "cylinders": [],
+                          "lattice": {"sigma": 1, "cells": [2, 1, 2]}}},
+  "objects": [{"type": "instance", "primitive": "bead", "material": "w"},
+              {"type": "instance", "primitive": "bead",
+               "transform": [{"translate": [0, 400, 0]}], "material": "w"}]
+})";
+
+// Levels finer than the coarsest one needed stop at the pair budget (LatticeFiltering::
+// max_pairs); the coarsest needed is built whatever its size.
+TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
+    test::TempDir dir;
+    const std::string path = (dir.path() / "near-and-far.json").string();
+    std::ofstream(path) << kNearAndFar;
+    const Scene s = load_scene(path);
+    const TableCache cache(dir.path().string(), true);
+    TableSpec spec;
+    spec.encoding = "coverage";
+    const auto levels = [&](double max_pairs) {
+        return scene_lattices(s, cache, spec, false, {LatticeFilter::kSmooth, true, 0.01, max_pairs})
+            .paths.size();
+    };
+    const double p0 = static_cast<double>(BoundaryGrid::pair_count({2, 1, 2}));
+    const double p1 = static_cast<double>(BoundaryGrid::pair_count({4, 2, 4}));
+    const double p2 = static_cast<double>(BoundaryGrid::pair_count({8, 4, 8}));
+    EXPECT_EQ(levels(kMaxLodPairs), 3u);
+    EXPECT_EQ(levels(p2), 3u);
+    EXPECT_EQ(levels(p2 - 1), 2u);
+    EXPECT_EQ(levels(p1), 2u);
+    EXPECT_EQ(levels(p1 - 1), 1u);
+    EXPECT_EQ(levels(p0 / 2), 1u);
 }
 
 }  // namespace

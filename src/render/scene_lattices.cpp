@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "csg/csg_shape.h"
+#include "lattice/boundary_grid.h"
 #include "lattice/encoding.h"
 #include "lattice/lattice_shape.h"
 #include "util/error.h"
@@ -51,10 +52,14 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     double error = 0;
     for (int j = range.first; j <= range.second; ++j) {
         TableSpec level = spec;
-        // Levels beyond the largest refinement are left out (the finest one then serves).
+        // Levels beyond the largest refinement, or finer ones beyond the pair budget, are left
+        // out (the finest one built then serves, with the primitive's crossings).
         if (static_cast<long long>(spec.sigma_inv) << j > kMaxSigmaInv) break;
         level.sigma_inv = spec.sigma_inv << j;
         const TablePlan plan = plan_table(p, level, scene.file);
+        if (j > range.first &&
+            BoundaryGrid::pair_count(plan.context.cells) > filtering.max_pairs)
+            break;
         const TableCache::Entry e = cache.get(plan, progress);
         levels.push_back({e.table, plan.context});
         error = plan.error_bound();
