@@ -408,12 +408,18 @@ constexpr const char* kNearAndFar = R"({
                "transform": [{"translate": [0, 400, 0]}], "material": "w"}]
 })";
 
-// Levels finer than the coarsest one needed stop at the pair budget (LatticeFiltering::
-// max_pairs); the coarsest needed is built whatever its size.
-TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
+// Levels of detail stop at the pair budget (LatticeFiltering::max_pairs): the finest level
+// within it serves the rays that want finer; level 0 is built whatever its size. With the far
+// bead the scene wants levels 0 to 2, without it level 2 alone.
+void expect_levels_stop_at_the_pair_budget(bool far_bead) {
     test::TempDir dir;
     const std::string path = (dir.path() / "near-and-far.json").string();
-    std::ofstream(path) << kNearAndFar;
+    std::string text = kNearAndFar;
+    if (!far_bead) {
+        text.erase(text.find(",\n              {\"type\": \"instance\""));
+        text += "]}";
+    }
+    std::ofstream(path) << text;
     const Scene s = load_scene(path);
     const TableCache cache(dir.path().string(), true);
     TableSpec spec;
@@ -425,12 +431,19 @@ TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
     const double p0 = static_cast<double>(BoundaryGrid::pair_count({2, 1, 2}));
     const double p1 = static_cast<double>(BoundaryGrid::pair_count({4, 2, 4}));
     const double p2 = static_cast<double>(BoundaryGrid::pair_count({8, 4, 8}));
-    EXPECT_EQ(levels(kMaxLodPairs), 3u);
-    EXPECT_EQ(levels(p2), 3u);
-    EXPECT_EQ(levels(p2 - 1), 2u);
-    EXPECT_EQ(levels(p1), 2u);
+    // Levels 0-2 (or 2) within the budget; 0-1 (or 1); 0 (or 0).
+    const std::size_t all = far_bead ? 3 : 1;
+    EXPECT_EQ(levels(kMaxLodPairs), all);
+    EXPECT_EQ(levels(p2), all);
+    EXPECT_EQ(levels(p2 - 1), far_bead ? 2u : 1u);
+    EXPECT_EQ(levels(p1), far_bead ? 2u : 1u);
     EXPECT_EQ(levels(p1 - 1), 1u);
     EXPECT_EQ(levels(p0 / 2), 1u);
+}
+
+TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
+    expect_levels_stop_at_the_pair_budget(true);
+    expect_levels_stop_at_the_pair_budget(false);
 }
 
 }  // namespace

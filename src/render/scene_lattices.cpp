@@ -48,18 +48,25 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     std::pair<int, int> range{0, 0};
     if (filtering.lod && filtering.spread > 0)
         range = lod_range(scene, prim, plan_table(p, spec, scene.file).context, filtering.spread);
+    // Levels beyond the largest refinement or the pair budget are left out: the finest level
+    // within both then serves, with the primitive's crossings for rays that want finer. Level 0
+    // (the lattice asked for) is built whatever its size.
+    const auto allowed = [&](int j) {
+        if (static_cast<long long>(spec.sigma_inv) << j > kMaxSigmaInv) return false;
+        TableSpec level = spec;
+        level.sigma_inv = spec.sigma_inv << j;
+        return BoundaryGrid::pair_count(plan_table(p, level, scene.file).context.cells) <=
+               filtering.max_pairs;
+    };
+    int finest = 0;
+    while (finest < range.second && allowed(finest + 1)) ++finest;
+    range = {std::min(range.first, finest), std::min(range.second, finest)};
     std::vector<FilterLevel> levels;
     double error = 0;
     for (int j = range.first; j <= range.second; ++j) {
         TableSpec level = spec;
-        // Levels beyond the largest refinement, or finer ones beyond the pair budget, are left
-        // out (the finest one built then serves, with the primitive's crossings).
-        if (static_cast<long long>(spec.sigma_inv) << j > kMaxSigmaInv) break;
         level.sigma_inv = spec.sigma_inv << j;
         const TablePlan plan = plan_table(p, level, scene.file);
-        if (j > range.first &&
-            BoundaryGrid::pair_count(plan.context.cells) > filtering.max_pairs)
-            break;
         const TableCache::Entry e = cache.get(plan, progress);
         levels.push_back({e.table, plan.context});
         error = plan.error_bound();

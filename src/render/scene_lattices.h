@@ -23,11 +23,12 @@ struct SceneLattices {
 // How lattices are filtered (issue 10): the filter, and whether levels of detail are built. With
 // lod, each primitive gets the levels sigma^-1 = K 2^j whose cells match the footprints of the
 // camera's pixels (spread: a pixel's angle) somewhere on its instances, at most kMaxLodLevels.
-// Levels finer than a primitive's coarsest needed one are built only up to
-// kMaxLodPairs ordered pairs of boundary points: rays that want finer get the primitive's own
-// crossings blended in (FilteredLatticeShape), not a table that takes half an hour to build.
-// 2^27 holds the hair of Plates 4 and 5 at 4K (111 M pairs); `lattice-rings`'s CSG ring (16 x
-// 16 x 8 cells of tori) stops at 2K (17 M pairs; 4K, 268 M pairs, took over 15 minutes and 5 GB).
+// Levels of detail beyond sigma^-1 = K are built only up to kMaxLodPairs ordered pairs of
+// boundary points: rays that want finer get the finest level within it, with the primitive's
+// own crossings blended in (FilteredLatticeShape), not a table that takes half an hour to
+// build. 2^27 holds the hair of Plates 4 and 5 at 4K (111 M pairs); `lattice-rings`'s CSG ring
+// (16 x 16 x 8 cells of a torus) stops at 2K (17 M pairs; 4K, 268 M pairs, was still building
+// after 7 minutes in 5 GB).
 inline constexpr double kMaxLodPairs = 134217728.0;
 struct LatticeFiltering {
     LatticeFilter filter = LatticeFilter::kNone;
