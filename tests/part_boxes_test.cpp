@@ -43,15 +43,22 @@ bool meets_exact(const Bounds3& b, const Ray& r, double tmin, double tmax) {
     return lo <= hi;
 }
 
+// n random boxes in the primitive's box, half-sizes up to (h, h, hz).
+Boxes random_boxes(std::mt19937& rng, int n, double h, double hz) {
+    std::uniform_real_distribution<double> u(0, 1);
+    Boxes prim;
+    for (int i = 0; i < n; ++i) {
+        const Vec3 c{7 * u(rng), 7 * u(rng), 20 * u(rng)};
+        const Vec3 half{h * u(rng), h * u(rng), hz * u(rng)};
+        prim.parts.push_back(lat::intersect(Bounds3{c - half, c + half}, prim.bounds()));
+    }
+    return prim;
+}
+
 TEST(PartBoxes, FloatTestNeverRejectsAPartTheRayMeets) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(0, 1);
-    Boxes prim;
-    for (int i = 0; i < 200; ++i) {
-        const Vec3 c{7 * u(rng), 7 * u(rng), 20 * u(rng)};
-        const Vec3 h{0.3 * u(rng), 0.3 * u(rng), 1.5 * u(rng)};
-        prim.parts.push_back(lat::intersect(Bounds3{c - h, c + h}, prim.bounds()));
-    }
+    const Boxes prim = random_boxes(rng, 200, 0.3, 1.5);
     const PartBoxes boxes(prim, prim.bounds());
     int met = 0;
     for (int n = 0; n < 20000; ++n) {
@@ -83,12 +90,7 @@ TEST(PartBoxes, FloatTestNeverRejectsAPartTheRayMeets) {
 TEST(PartBoxes, NearPartsKeepEveryPartAParallelRayWithinGrowMeets) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(0, 1);
-    Boxes prim;
-    for (int i = 0; i < 60; ++i) {
-        const Vec3 c{7 * u(rng), 7 * u(rng), 20 * u(rng)};
-        const Vec3 h{0.2 * u(rng), 0.2 * u(rng), 1.0 * u(rng)};
-        prim.parts.push_back(lat::intersect(Bounds3{c - h, c + h}, prim.bounds()));
-    }
+    const Boxes prim = random_boxes(rng, 60, 0.2, 1.0);
     const PartBoxes boxes(prim, prim.bounds());
     std::vector<std::uint32_t> near(prim.parts.size());
     int kept = 0, met = 0;
