@@ -19,11 +19,11 @@
 //  - A point x_k = o_k + d_k t then lies within 2.01 u |o_k| + 3.01 u |d_k t| + |d_k| E of the
 //    double one, which is under 1.9 |d_k| E: E >= 6 u (n_k + |o_k|) / |d_k| for every axis k,
 //    and |t| is at most the entry (exit) axis's T. The margin m_k is 3 |d_k| E. A coordinate
-//    whose distance to the nearest
-//    integer is under 1/2 - m_k rounds (and clamps) as the double one does. On the axis of the
-//    face the point lies on, the double snap takes the face's level instead of rounding, and
-//    so does the float one: the coordinate is within m_k of that integer. (When two axes are
-//    nearly tied for the face, the point is on their edge, one grid point either way.)
+//    whose distance to the nearest integer is under 1/2 - m_k rounds (and clamps) as the
+//    double one does. On the axis of the face the point lies on, the double snap takes the
+//    face's level instead of rounding, and so does the float one: the coordinate is within m_k
+//    of that integer. (When two axes are nearly tied for the face, the point is on their edge,
+//    one grid point either way.)
 //  - The ray meets the box (t0 <= t1 in double) surely when t0 + E < t1 - E, and misses it
 //    surely when t0 - E > t1 + E (tested with 2 E, for the rounding of the sums).
 #include <immintrin.h>
