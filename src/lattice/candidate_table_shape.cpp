@@ -25,6 +25,7 @@ bool CandidateTableShape::listed_spans(const Ray& r, const CandidateList& list,
                                        const LatticeFrame::Snap& s, SpanList& out) const {
     const std::size_t first = out.size();
     primitive_->pieces_spans({list.parts, static_cast<std::size_t>(list.count)}, r, out);
+    if (out.size() == first) return true;  // no spans: no chord to keep them in
     LatticeFrame::Chord c;
     if (!frame_.chord(s.o, s.d, c)) return false;
     for (std::size_t k = first; k < out.size(); ++k)

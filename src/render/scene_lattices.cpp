@@ -51,12 +51,14 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     // Levels beyond the largest refinement or the pair budget are left out: the finest level
     // within both then serves, with the primitive's crossings for rays that want finer. Level 0
     // (the lattice asked for) is built whatever its size.
-    const auto allowed = [&](int j) {
-        if (static_cast<long long>(spec.sigma_inv) << j > kMaxSigmaInv) return false;
+    const auto level_plan = [&](int j) {
         TableSpec level = spec;
         level.sigma_inv = spec.sigma_inv << j;
-        return BoundaryGrid::pair_count(plan_table(p, level, scene.file).context.cells) <=
-               filtering.max_pairs;
+        return plan_table(p, level, scene.file);
+    };
+    const auto allowed = [&](int j) {
+        return (static_cast<long long>(spec.sigma_inv) << j) <= kMaxSigmaInv &&
+               BoundaryGrid::pair_count(level_plan(j).context.cells) <= filtering.max_pairs;
     };
     int finest = 0;
     while (finest < range.second && allowed(finest + 1)) ++finest;
@@ -64,9 +66,7 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     std::vector<FilterLevel> levels;
     double error = 0;
     for (int j = range.first; j <= range.second; ++j) {
-        TableSpec level = spec;
-        level.sigma_inv = spec.sigma_inv << j;
-        const TablePlan plan = plan_table(p, level, scene.file);
+        const TablePlan plan = level_plan(j);
         const TableCache::Entry e = cache.get(plan, progress);
         levels.push_back({e.table, plan.context});
         error = plan.error_bound();
