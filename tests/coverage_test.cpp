@@ -394,56 +394,77 @@ TEST(Coverage, AThinPrimitiveHasTheRightBrightness) {
     }
 }
 
-// Two beads, one near the camera and one far: levels of detail want 1K, 2K and 4K.
+// Two copies of a primitive, one near the camera and one far: levels of detail want 1K, 2K and
+// 4K. The primitive is a bead, or a row of 65 beads, which costs more to intersect than
+// kMaxExactCost and so is answered by its tables and their levels.
 constexpr const char* kNearAndFar = R"({
   "format": "lattice-reference/1",
   "camera": {"eye": [1, -3, 1], "look_at": [1, 0.5, 1], "up": [0, 0, 1], "fov_y_deg": 30,
              "width": 16, "height": 16},
   "background": [0, 0, 0], "ambient": [1, 1, 1], "shadows": false, "lights": [],
   "materials": {"w": {"color": [1, 1, 1], "ka": 1, "kd": 0, "ks": 0, "shininess": 1}},
-  "primitives": {"bead": {"spheres": [[1, 0.5, 1, 0.3]], "cylinders": [],
+  "primitives": {"bead": {"spheres": [SPHERES], "cylinders": [],
                           "lattice": {"sigma": 1, "cells": [2, 1, 2]}}},
   "objects": [{"type": "instance", "primitive": "bead", "material": "w"},
               {"type": "instance", "primitive": "bead",
                "transform": [{"translate": [0, 400, 0]}], "material": "w"}]
 })";
 
-// Levels of detail stop at the pair budget (LatticeFiltering::max_pairs): the finest level
-// within it serves the rays that want finer; level 0 is built whatever its size. With the far
-// bead the scene wants levels 0 to 2, without it level 2 alone.
-void expect_levels_stop_at_the_pair_budget(bool far_bead) {
-    test::TempDir dir;
-    const std::string path = (dir.path() / "near-and-far.json").string();
+std::string near_and_far(bool row, bool far_bead) {
+    std::string spheres = "[1, 0.5, 1, 0.3]";
+    if (row) {
+        constexpr double kBeads = kMaxExactCost + 1;
+        spheres.clear();
+        for (int i = 0; i < int(kBeads); ++i)
+            spheres += (i ? ", [" : "[") + std::to_string(0.2 + 1.6 * i / (kBeads - 1)) + ", 0.5, 1, 0.05]";
+    }
     std::string text = kNearAndFar;
+    text.replace(text.find("SPHERES"), 7, spheres);
     if (!far_bead) {
         text.erase(text.find(",\n              {\"type\": \"instance\""));
         text += "]}";
     }
-    std::ofstream(path) << text;
+    return text;
+}
+
+// How many levels scene_lattices builds for a primitive's near and far copies, with levels of
+// detail on, within a pair budget.
+std::size_t levels_built(bool row, bool far_bead, double max_pairs) {
+    test::TempDir dir;
+    const std::string path = (dir.path() / "near-and-far.json").string();
+    std::ofstream(path) << near_and_far(row, far_bead);
     const Scene s = load_scene(path);
     const TableCache cache(dir.path().string(), true);
     TableSpec spec;
     spec.encoding = "coverage";
-    const auto levels = [&](double max_pairs) {
-        return scene_lattices(s, cache, spec, false, {LatticeFilter::kSmooth, true, 0.01, max_pairs})
-            .paths.size();
-    };
+    return scene_lattices(s, cache, spec, false, {LatticeFilter::kSmooth, true, 0.01, max_pairs})
+        .paths.size();
+}
+
+// Levels of detail stop at the pair budget (LatticeFiltering::max_pairs): the finest level
+// within it serves the rays that want finer; level 0 is built whatever its size. With the far
+// copy the scene wants levels 0 to 2, without it level 2 alone.
+TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
     const double p0 = static_cast<double>(BoundaryGrid::pair_count({2, 1, 2}));
     const double p1 = static_cast<double>(BoundaryGrid::pair_count({4, 2, 4}));
     const double p2 = static_cast<double>(BoundaryGrid::pair_count({8, 4, 8}));
-    // Levels 0-2 (or 2) within the budget; 0-1 (or 1); 0 (or 0).
-    const std::size_t all = far_bead ? 3 : 1;
-    EXPECT_EQ(levels(kMaxLodPairs), all);
-    EXPECT_EQ(levels(p2), all);
-    EXPECT_EQ(levels(p2 - 1), far_bead ? 2u : 1u);
-    EXPECT_EQ(levels(p1), far_bead ? 2u : 1u);
-    EXPECT_EQ(levels(p1 - 1), 1u);
-    EXPECT_EQ(levels(p0 / 2), 1u);
+    for (const bool far_bead : {true, false}) {
+        const auto levels = [&](double max_pairs) { return levels_built(true, far_bead, max_pairs); };
+        // Levels 0-2 (or 2) within the budget; 0-1 (or 1); 0 (or 0).
+        const std::size_t all = far_bead ? 3 : 1;
+        EXPECT_EQ(levels(kMaxLodPairs), all);
+        EXPECT_EQ(levels(p2), all);
+        EXPECT_EQ(levels(p2 - 1), far_bead ? 2u : 1u);
+        EXPECT_EQ(levels(p1), far_bead ? 2u : 1u);
+        EXPECT_EQ(levels(p1 - 1), 1u);
+        EXPECT_EQ(levels(p0 / 2), 1u);
+    }
 }
 
-TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
-    expect_levels_stop_at_the_pair_budget(true);
-    expect_levels_stop_at_the_pair_budget(false);
+// A primitive cheap to intersect is answered by its own crossings: only the lattice asked for
+// is built, however near and far its copies.
+TEST(Coverage, PrimitivesAnsweredByTheirCrossingsBuildOneLevel) {
+    EXPECT_EQ(levels_built(false, true, kMaxLodPairs), 1u);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
-// The primitive as the level after the finest table (issue 10): with levels of detail, a ray's
-// sheet blends the primitive's own crossings with the tables' answer (exact_weight).
+// Filtered lattices answered from the primitive's own crossings (issue 10): with levels of
+// detail, a primitive cheap to intersect answers each ray with the crossings of sub-rays
+// across its footprint (answered_by_primitive), not with its tables.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,6 +8,7 @@
 
 #include "csg/csg_shape.h"
 #include "geometry/chain.h"
+#include "geometry/named_shapes.h"
 #include "geometry/triangle_mesh.h"
 #include "hook_primitive.h"
 #include "lattice/encoding.h"
@@ -20,14 +22,17 @@ using test::hook;
 const TableContext& kFine = test::kHookContext;  // cells of 0.5
 const TableContext kCoarse{{4, 2, 4}, 1.0, 1.0, &hook()};
 
-// The hook's coverage tables behind the smooth filter, with and without exact close-ups: one
-// level (kFine), or two (kCoarse, then kFine).
+// The hook's coverage tables behind the smooth filter, answered from the primitive's own
+// crossings or by the tables alone: one level (kFine), or two (kCoarse, then kFine).
 struct HookLattice {
     std::vector<ByteBuffer> payloads;  // the tables read them in place
-    std::unique_ptr<FilteredLatticeShape> blended, tables_only;
+    std::unique_ptr<FilteredLatticeShape> exact, tables_only;
 };
 
-// The hook with a fifth bead: 9 parts, enough for the blend to find the parts near a ray
+// The widest footprint the exact hook's sub-rays span (kFine cells of 0.5).
+constexpr double kExactWidth = 3.0;
+
+// The hook with a fifth bead: 9 parts, enough for the sub-rays to find the parts near a ray
 // first (PartBoxes::near_parts), in the hook's box.
 const ChainShape& long_hook() {
     static const ChainShape s(
@@ -50,17 +55,9 @@ HookLattice hook_lattice(bool two_levels, const Shape& primitive = hook()) {
         levels.push_back({e.open(h.payloads.back().data(), h.payloads.back().size(), r.hits, ctx), ctx});
     }
     const double error = e.error_bound(kFine, {});
-    h.blended = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, true);
-    h.tables_only = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, false);
+    h.exact = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, kExactWidth);
+    h.tables_only = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, 0.0);
     return h;
-}
-
-// The footprint width (unit directions, no spread) whose level lies `past` levels beyond the
-// finest one's (lod_level counts from the coarsest, cell0).
-double width_past(double past, bool two_levels) {
-    const double cell0 = two_levels ? kCoarse.cell : kFine.cell;
-    const double top = two_levels ? 1 : 0;
-    return cell0 / (kCellPerFootprint * std::exp2(top + past));
 }
 
 // Rays through the hook's box: lines from outside it, or rays starting inside it.
@@ -78,20 +75,20 @@ std::vector<Ray> rays(int n, bool inside = false) {
     return out;
 }
 
-// Shadow rays (coverage only) far past the finest level get the primitive's crossing itself,
+// Shadow rays (coverage only) of a vanishing footprint get the primitive's crossing itself,
 // from outside the box or from inside it, after tmin; occluded() says whether there is one.
-TEST(FilteredCloseUps, ShadowRaysFarPastTheFinestLevelGetThePrimitivesCrossing) {
+TEST(FilteredCloseUps, ShadowRaysGetThePrimitivesCrossing) {
     for (const bool two : {false, true}) {
         const HookLattice h = hook_lattice(two);
-        set_ray_footprint({width_past(kShadowExact.to + 0.5, two), 0, true});
+        set_ray_footprint({1e-9, 0, true});
         int hits = 0;
         for (const bool inside : {false, true})
             for (const Ray& r : rays(3000, inside)) {
                 const double tmin = inside ? 0.3 : 0.0;
                 Crossing exact, got;
                 const bool e = hook().intersect(r, tmin, kInfinity, exact);
-                ASSERT_EQ(h.blended->intersect(r, tmin, kInfinity, got), e);
-                EXPECT_EQ(h.blended->occluded(r, tmin, 20.0), e && exact.t < 20.0);
+                ASSERT_EQ(h.exact->intersect(r, tmin, kInfinity, got), e);
+                EXPECT_EQ(h.exact->occluded(r, tmin, 20.0), e && exact.t < 20.0);
                 if (!e) continue;
                 ++hits;
                 EXPECT_NEAR(got.t, exact.t, 1e-9);
@@ -104,15 +101,15 @@ TEST(FilteredCloseUps, ShadowRaysFarPastTheFinestLevelGetThePrimitivesCrossing) 
 
 // Camera rays: a vanishing footprint puts all their sub-rays on the ray, so the sheet is the
 // crossing and its normal; a footprint a few cells wide covers the hook's edges in part, in
-// steps of one sub-ray. The tables alone answer otherwise.
-TEST(FilteredCloseUps, CameraRaysFarPastTheFinestLevelGetTheirSubRaysCrossings) {
+// steps of one sub-ray.
+TEST(FilteredCloseUps, CameraRaysGetTheirSubRaysCrossings) {
     const HookLattice h = hook_lattice(false);
     set_ray_footprint({1e-9, 0, false});
     int hits = 0, tables_differ = 0;
     for (const Ray& r : rays(5000)) {
         Crossing exact, got, table;
         const bool e = hook().intersect(r, 0.0, kInfinity, exact);
-        ASSERT_EQ(h.blended->intersect(r, 0.0, kInfinity, got), e);
+        ASSERT_EQ(h.exact->intersect(r, 0.0, kInfinity, got), e);
         if (!e) continue;
         ++hits;
         EXPECT_NEAR(got.t, exact.t, 1e-6);
@@ -124,12 +121,12 @@ TEST(FilteredCloseUps, CameraRaysFarPastTheFinestLevelGetTheirSubRaysCrossings) 
     EXPECT_GT(hits, 500);
     EXPECT_GT(tables_differ, hits / 2);  // the test can tell the tables from the primitive
 
-    set_ray_footprint({width_past(kCameraExact.to + 0.1, false), 0, false});
-    const int n = kCameraExact.sub_rays * kCameraExact.sub_rays;
+    set_ray_footprint({1.0, 0, false});
+    const int n = kExactSubRays * kExactSubRays;
     int partial = 0;
     for (const Ray& r : rays(20000)) {
         Crossing got;
-        if (!h.blended->intersect(r, 0.0, kInfinity, got)) continue;
+        if (!h.exact->intersect(r, 0.0, kInfinity, got)) continue;
         const double k = double(got.coverage) * n;
         EXPECT_NEAR(k, std::round(k), 1e-5);
         partial += got.coverage < 1.0f;
@@ -138,81 +135,88 @@ TEST(FilteredCloseUps, CameraRaysFarPastTheFinestLevelGetTheirSubRaysCrossings) 
     set_ray_footprint({});
 }
 
-TEST(FilteredCloseUps, TheRampBlendsTheTablesSheetWithTheCrossing) {
-    const HookLattice h = hook_lattice(false);
-    const double past = 0.5 * (kShadowExact.from + kShadowExact.to);
-    ASSERT_EQ(exact_weight(past, kShadowExact), 0.5);
-    set_ray_footprint({width_past(past, false), 0, true});
-    int blended = 0;
-    for (const Ray& r : rays(5000)) {
-        Crossing exact, got, table;
-        const double e = hook().intersect(r, 0.0, kInfinity, exact) ? 1.0 : 0.0;
-        const double a = h.tables_only->intersect(r, 0.0, kInfinity, table) ? double(table.coverage) : 0.0;
-        const double want = 0.5 * a + 0.5 * e;
-        const bool hit = h.blended->intersect(r, 0.0, kInfinity, got);
-        if (want > 0 && want < 1) ++blended;
-        if (!hit) {
-            EXPECT_LT(want, 1e-6);
-            continue;
-        }
-        EXPECT_NEAR(got.coverage, want >= 1 - 1e-6 ? 1.0 : want, 1e-6);
-        // The sheet's point is the blend of both: between them along the ray.
-        if (a > 0 && e > 0) {
-            EXPECT_LE(got.t, std::max(table.t, exact.t) + 1e-9);
-            EXPECT_GE(got.t, std::min(table.t, exact.t) - 1e-9);
-        }
-    }
-    set_ray_footprint({});
-    EXPECT_GT(blended, 200);
-}
-
-// Camera rays at the finest level: half the tables' sheet, half the crossings of their sub-rays
-// (a grid across the footprint, recomputed here), in coverage and in the normal.
-// (With the hook, and with a hook of 9 parts, whose sub-rays meet only the parts found near
-// the ray first: the same crossings as the whole primitive's.)
-void expect_camera_rays_blend_half_their_sub_rays(const ChainShape& prim) {
+// A ray's sheet is the crossings of its sub-rays (a grid across the footprint, recomputed
+// here): their share as the coverage, the mean of their unit normals as the normal (camera
+// rays), the mean of their points as the point. Footprints wider than the shape's exact width
+// are narrowed to it. (With the hook, and with a hook of 9 parts, whose sub-rays meet only the
+// parts found near the ray first: the same crossings as the whole primitive's.)
+void expect_sheets_are_their_sub_rays_crossings(const ChainShape& prim, bool shadow) {
     const HookLattice h = hook_lattice(false, prim);
-    ASSERT_EQ(exact_weight(0.0, kCameraExact), 0.5);
-    const double width = width_past(0.0, false);
-    set_ray_footprint({width, 0, false});
-    const int n = kCameraExact.sub_rays;
+    const int n = kExactSubRays;
     const Bounds3 box{{0, 0, 0}, Vec3{4, 2, 4}};
     int checked = 0;
-    for (const Ray& r : rays(3000)) {
-        Crossing table, got;
-        const bool ht = h.tables_only->intersect(r, 0.0, kInfinity, table);
-        double alpha = ht ? 0.5 * double(table.coverage) : 0.0;
-        Vec3 normal = ht ? table.stored.n * (0.5 * double(table.coverage)) : Vec3{};
-        Vec3 u, v;
-        orthonormal_basis(r.d, u, v);
-        for (int i = 0; i < n; ++i)
-            for (int j = 0; j < n; ++j) {
-                const Ray sub{r.o + u * (((i + 0.5) / n - 0.5) * width) + v * (((j + 0.5) / n - 0.5) * width), r.d};
-                double t0 = 0, t1 = kInfinity;
-                Crossing c;
-                if (!clip_ray(box, sub, t0, t1) || !prim.intersect(sub, t0, t1, c)) continue;
-                alpha += 0.5 / (n * n);
-                normal += normalize(prim.normal(sub, c)) * (0.5 / (n * n));
+    for (const double footprint : {0.4, 1.0, 2 * kExactWidth}) {
+        const double width = std::min(footprint, kExactWidth);
+        set_ray_footprint({footprint, 0, shadow});
+        for (const Ray& r : rays(2000)) {
+            double alpha = 0;
+            Vec3 normal, point;
+            Vec3 u, v;
+            orthonormal_basis(r.d, u, v);
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j) {
+                    const Vec3 offset = u * (((i + 0.5) / n - 0.5) * width) + v * (((j + 0.5) / n - 0.5) * width);
+                    const Ray sub{r.o + offset, r.d};
+                    double t0 = 0, t1 = kInfinity;
+                    Crossing c;
+                    if (!clip_ray(box, sub, t0, t1) || !prim.intersect(sub, t0, t1, c)) continue;
+                    alpha += 1.0 / (n * n);
+                    normal += normalize(prim.normal(sub, c)) * (1.0 / (n * n));
+                    point += sub.at(c.t) * (1.0 / (n * n));
+                }
+            Crossing got;
+            const bool hit = h.exact->intersect(r, 0.0, kInfinity, got);
+            ASSERT_EQ(hit, alpha > 0) << "footprint " << footprint;
+            if (!hit) continue;
+            ++checked;
+            EXPECT_NEAR(got.coverage, alpha, 1e-6);
+            EXPECT_NEAR(length(got.stored.p - point / alpha), 0.0, 1e-6);
+            if (!shadow) {
+                EXPECT_NEAR(length(got.stored.n - normal / alpha), 0.0, 1e-6);
             }
-        const bool hit = h.blended->intersect(r, 0.0, kInfinity, got);
-        if (alpha <= 1e-6) {
-            EXPECT_FALSE(hit);
-            continue;
         }
-        ASSERT_TRUE(hit);
-        ++checked;
-        EXPECT_NEAR(got.coverage, alpha >= 1 - 1e-6 ? 1.0 : alpha, 1e-6);
-        EXPECT_NEAR(length(got.stored.n - normal / alpha), 0.0, 1e-6);
     }
     set_ray_footprint({});
-    EXPECT_GT(checked, 500);
+    EXPECT_GT(checked, 1500);
 }
 
-TEST(FilteredCloseUps, CameraRaysBlendHalfTheirSubRaysCrossings) {
+TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
     ASSERT_LT(hook().primitive_count(), 8u);
-    expect_camera_rays_blend_half_their_sub_rays(hook());
     ASSERT_GE(long_hook().primitive_count(), 8u);
-    expect_camera_rays_blend_half_their_sub_rays(long_hook());
+    for (const bool shadow : {false, true}) {
+        expect_sheets_are_their_sub_rays_crossings(hook(), shadow);
+        expect_sheets_are_their_sub_rays_crossings(long_hook(), shadow);
+    }
+}
+
+// Culling reaches as far as each ray's own sub-rays: a ray whose sheet has a crossing meets
+// one of the cull parts, whatever its footprint (narrowed to the exact width or not); rays
+// clear of the hook by more than their sub-rays' reach are culled.
+TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
+    const HookLattice h = hook_lattice(false, long_hook());
+    const FilteredLatticeShape& s = *h.exact;
+    ASSERT_GT(s.cull_count(), 0u);
+    const auto meets_a_part = [&](const Ray& r) {
+        for (std::size_t i = 0; i < s.cull_count(); ++i)
+            if (s.cull_meets(i, r)) return true;
+        return false;
+    };
+    int hits = 0, culled = 0;
+    for (const double footprint : {0.05, 0.5, 2.0, kExactWidth, 3 * kExactWidth}) {
+        set_ray_footprint({footprint, 0, false});
+        for (const Ray& r : rays(4000)) {
+            Crossing c;
+            if (s.intersect(r, 0.0, kInfinity, c)) {
+                ++hits;
+                EXPECT_TRUE(meets_a_part(r)) << "footprint " << footprint;
+            } else {
+                culled += !meets_a_part(r);
+            }
+        }
+    }
+    set_ray_footprint({});
+    EXPECT_GT(hits, 3000);
+    EXPECT_GT(culled, 3000);
 }
 
 // A ray's direction need not be a unit vector in the primitive's frame (scaled instances): the
@@ -220,17 +224,16 @@ TEST(FilteredCloseUps, CameraRaysBlendHalfTheirSubRaysCrossings) {
 // footprint, answered at half the parameter.
 TEST(FilteredCloseUps, LongerDirectionsAreTheSameRay) {
     const HookLattice h = hook_lattice(false);
-    for (const double past : {0.0, 1.0, kCameraExact.to + 0.5}) {
-        const double width = width_past(past, false);
+    for (const double width : {1e-9, 0.5, 2.0}) {
         for (const bool shadow : {false, true}) {
             int hits = 0;
             for (const Ray& r : rays(2000)) {
                 Crossing a, b;
                 set_ray_footprint({width, 0, shadow});
-                const bool ha = h.blended->intersect(r, 0.0, kInfinity, a);
+                const bool ha = h.exact->intersect(r, 0.0, kInfinity, a);
                 set_ray_footprint({width / 2, 0, shadow});
-                const bool hb = h.blended->intersect({r.o, r.d * 2.0}, 0.0, kInfinity, b);
-                ASSERT_EQ(ha, hb) << "past " << past;
+                const bool hb = h.exact->intersect({r.o, r.d * 2.0}, 0.0, kInfinity, b);
+                ASSERT_EQ(ha, hb) << "width " << width;
                 if (!ha) continue;
                 ++hits;
                 EXPECT_NEAR(b.t, a.t / 2, 1e-9);
@@ -248,13 +251,13 @@ TEST(FilteredCloseUps, LongerDirectionsAreTheSameRay) {
 // accelerator meets objects in.
 TEST(FilteredCloseUps, TheSheetIsCutAtTmaxNotMadeOfWhatLiesBeforeIt) {
     const HookLattice h = hook_lattice(false);
-    for (const double past : {0.0, kCameraExact.to + 0.5}) {
-        set_ray_footprint({width_past(past, false), 0, false});
+    for (const double width : {1e-9, 1.0}) {
+        set_ray_footprint({width, 0, false});
         for (const Ray& r : rays(3000)) {
             Crossing whole, cut;
-            if (!h.blended->intersect(r, 0.0, kInfinity, whole)) continue;
+            if (!h.exact->intersect(r, 0.0, kInfinity, whole)) continue;
             for (const double tmax : {whole.t - 0.01, whole.t + 0.01}) {
-                const bool hit = h.blended->intersect(r, 0.0, tmax, cut);
+                const bool hit = h.exact->intersect(r, 0.0, tmax, cut);
                 ASSERT_EQ(hit, whole.t < tmax);
                 if (!hit) continue;
                 EXPECT_EQ(cut.t, whole.t);
@@ -265,29 +268,18 @@ TEST(FilteredCloseUps, TheSheetIsCutAtTmaxNotMadeOfWhatLiesBeforeIt) {
     set_ray_footprint({});
 }
 
-// Shadow rays short of their ramp, and rays without a footprint (width 0 asks for the finest
-// level), read the tables alone: the same answers, to the bit, as without the blend. With two
-// levels, "past" counts from the finest one.
-TEST(FilteredCloseUps, FootprintsShortOfTheRampReadTheTablesAlone) {
-    struct Case {
-        bool shadow;
-        double past;  // NaN: no footprint
-    };
-    const double none = std::nan("");
-    const std::vector<Case> cases{{false, none},
-                                  {true, none},
-                                  {true, kShadowExact.from - 0.01},
-                                  {true, 0.0}};
+// Rays without a footprint (width 0) read the tables: the same answers, to the bit, as a
+// lattice answered by its tables alone, camera or shadow rays, of one level or two.
+TEST(FilteredCloseUps, RaysWithoutAFootprintReadTheTables) {
     for (const bool two : {false, true}) {
         const HookLattice h = hook_lattice(two);
-        for (const Case& c : cases) {
-            const double width = std::isnan(c.past) ? 0.0 : width_past(c.past, two);
-            set_ray_footprint({width, 0, c.shadow});
+        for (const bool shadow : {false, true}) {
+            set_ray_footprint({0, 0, shadow});
             for (const Ray& r : rays(2000)) {
                 Crossing a, b;
-                const bool ha = h.blended->intersect(r, 0.0, kInfinity, a);
+                const bool ha = h.exact->intersect(r, 0.0, kInfinity, a);
                 ASSERT_EQ(ha, h.tables_only->intersect(r, 0.0, kInfinity, b))
-                    << "past " << c.past << (c.shadow ? ", shadow ray" : ", camera ray");
+                    << (shadow ? "shadow ray" : "camera ray");
                 if (!ha) continue;
                 EXPECT_EQ(a.t, b.t);
                 EXPECT_EQ(a.coverage, b.coverage);
@@ -300,8 +292,8 @@ TEST(FilteredCloseUps, FootprintsShortOfTheRampReadTheTablesAlone) {
     set_ray_footprint({});
 }
 
-// How many of 3000 rays far past the finest level a primitive in a {4, 2, 4} box answers
-// differently with the exact blend asked for than without it.
+// How many of 3000 rays of a vanishing footprint a primitive in a {4, 2, 4} box answers
+// differently with its own crossings asked for than without them.
 int differing_answers(const Shape& primitive) {
     const TableContext ctx{{4, 2, 4}, 1.0, 1.0, &primitive};
     const Encoding& e = find_encoding("coverage");
@@ -309,9 +301,9 @@ int differing_answers(const Shape& primitive) {
     const ByteBuffer payload = e.build(raster.raw, ctx, {});
     const std::vector<FilterLevel> levels{
         {e.open(payload.data(), payload.size(), raster.hits, ctx), ctx}};
-    const FilteredLatticeShape asked(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), true);
-    const FilteredLatticeShape tables(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), false);
-    set_ray_footprint({1e-9, 0, false});  // far past the finest level
+    const FilteredLatticeShape asked(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), kExactWidth);
+    const FilteredLatticeShape tables(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), 0.0);
+    set_ray_footprint({1e-9, 0, false});
     int differ = 0;
     for (const Ray& r : rays(3000)) {
         Crossing a, b;
@@ -335,13 +327,14 @@ ChainShape beads(std::size_t parts) {
 TEST(FilteredCloseUps, PrimitivesOfManyPartsKeepToTheirTables) {
     const auto most = static_cast<std::size_t>(kMaxExactCost);
     EXPECT_EQ(differing_answers(beads(most + 1)), 0);
-    EXPECT_GT(differing_answers(beads(most)), 500);  // the blend shows where it is allowed
+    EXPECT_GT(differing_answers(beads(most)), 500);  // the crossings show where they are allowed
 }
 
-// A mesh descends its own hierarchy: one of many more triangles than kMaxExactCost is blended
-// (a sheet of 2 x 12 x 8 triangles); and a CSG tree costs its leaves' costs, so one with such
-// a chain as a leaf keeps to its tables.
-TEST(FilteredCloseUps, MeshesAreBlendedAndTreesCostTheirLeaves) {
+// A mesh descends its own hierarchy: one of many more triangles than kMaxExactCost is answered
+// from its crossings (a sheet of 2 x 12 x 8 triangles); a CSG tree costs its leaves' costs, so
+// one with such a chain as a leaf keeps to its tables, and so does one of six tori (a quartic
+// costs 12), where one of five does not.
+TEST(FilteredCloseUps, MeshesAnswerExactlyAndTreesCostTheirLeaves) {
     std::vector<Vec3> positions;
     std::vector<TriangleMeshShape::Triangle> triangles;
     const int nu = 12, nv = 8;
@@ -366,6 +359,20 @@ TEST(FilteredCloseUps, MeshesAreBlendedAndTreesCostTheirLeaves) {
     tree.set_root(tree.add_node(CsgOp::kUnion, {a, b}));
     EXPECT_EQ(tree.intersect_cost(), double(2 * small + 1));
     EXPECT_EQ(differing_answers(tree), 0);
+
+    const auto tori = [](int count) {
+        CsgShape t;
+        std::vector<int> leaves;
+        for (int i = 0; i < count; ++i) {
+            const PlacedShape torus = make_torus({0.7 + 0.65 * i, 1, 2}, {1, 0.3 * i, 0.5}, 0.5, 0.15);
+            leaves.push_back(t.add_leaf({torus.shape, torus.placement, static_cast<std::uint32_t>(i + 1)}));
+        }
+        t.set_root(t.add_node(CsgOp::kUnion, leaves));
+        return t;
+    };
+    EXPECT_EQ(tori(5).intersect_cost(), 60.0);
+    EXPECT_GT(differing_answers(tori(5)), 300);
+    EXPECT_EQ(differing_answers(tori(6)), 0);
 }
 
 }  // namespace

@@ -32,11 +32,13 @@ struct Capsule {
     // a + s u is |s pu - pw|^2, minimised over s in [0, 1]; the interior case is compared
     // multiplied through by |pu|^2, so the one division is 1 / |d|^2 (lattice culling calls
     // this for every ray that meets a capsule's box).
-    bool meets_line(Vec3 o, Vec3 d) const {
+    bool meets_line(Vec3 o, Vec3 d) const { return meets_line(o, d, r); }
+    // The same, for the capsule of this segment and radius `radius`.
+    bool meets_line(Vec3 o, Vec3 d, double radius) const {
         const double inv_dd = 1.0 / dot(d, d);
         const Vec3 w = o - a, u = b - a;
         const Vec3 pw = w - d * (dot(w, d) * inv_dd), pu = u - d * (dot(u, d) * inv_dd);
-        const double uu = dot(pu, pu), wu = dot(pw, pu), ww = dot(pw, pw), rr = r * r;
+        const double uu = dot(pu, pu), wu = dot(pw, pu), ww = dot(pw, pw), rr = radius * radius;
         if (wu <= 0) return ww <= rr;                      // nearest at a
         if (wu >= uu) return uu - 2 * wu + ww <= rr;       // nearest at b
         return ww * uu - wu * wu <= rr * uu;               // nearest inside

@@ -42,17 +42,24 @@ double lod_level(double cell0, double width) {
 }
 const RayFootprint& ray_footprint() { return t_footprint; }
 
+bool answered_by_primitive(const Shape& primitive) {
+    return primitive.intersect_cost() <= kMaxExactCost;
+}
+
 double lod_blend(double f, double band) {
     if (band <= 0) return f < 0.5 ? 0.0 : 1.0;
     return std::clamp((f - 0.5) / band + 0.5, 0.0, 1.0);
 }
 
 FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
-                                           double table_error, bool exact_blend)
+                                           double table_error, double exact_width)
     // The point-sampled finest level reaches as far as make_lattice_shape's lattices do.
     : filter_(filter),
       primitive_(levels.back().ctx.primitive),
-      exact_blend_(exact_blend && primitive_ && primitive_->intersect_cost() <= kMaxExactCost),
+      exact_(exact_width > 0 && primitive_ && answered_by_primitive(*primitive_)),
+      exact_width_(exact_width),
+      // The farthest of n x n sub-rays across a footprint w: sqrt(2) (n - 1) / 2n w.
+      sub_ray_reach_(exact_width * std::sqrt(2.0) * (kExactSubRays - 1) / (2 * kExactSubRays)),
       point_(levels.back().table, levels.back().ctx,
              levels.back().ctx.cell * kSnapReach + table_error) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
@@ -68,16 +75,19 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // Both cuts, smooth, 1 spp: Plates 4 and 5 render 18 % and 23 % faster, the furry bunny
     // and grass 37 % and 44 %, with the same PSNR against exact ground truth to 0.06 dB
     // (docs/filtering.md, "Culling").
-    cull_level_ = std::min<std::size_t>(1, levels.size() - 1);
+    // A primitive answered by its own crossings needs its parts grown by the farthest sub-ray's
+    // distance from the ray only (a bound), and each ray by its own (cull_meets).
+    cull_level_ = exact_ ? 0 : std::min<std::size_t>(1, levels.size() - 1);
     for (std::size_t i = 0; i < levels.size(); ++i) {
         const FilterLevel& l = levels[i];
+        const double table_reach = cull_cells(filter) * l.ctx.cell + table_error;
         const double reach =
-            i == cull_level_ ? cull_cells(filter) * l.ctx.cell + table_error : kInfinity;
+            i != cull_level_ ? kInfinity : exact_ ? sub_ray_reach_ : table_reach;
         levels_.push_back({l.table, LatticeFrame(l.ctx, reach), BoundaryGrid(l.ctx.cells)});
     }
     // Boxes pay for their set-up on a hair of 19 parts, not on a thistle spike of 3 (Plate 2
     // rendered 9 % slower when every sub-ray tested the boxes).
-    if (exact_blend_ && primitive_->intersects_parts_in_order() &&
+    if (exact_ && primitive_->intersects_parts_in_order() &&
         primitive_->primitive_count() >= kMinBoxedParts &&
         primitive_->primitive_count() <= kMaxNearParts)
         part_boxes_ = std::make_unique<const PartBoxes>(*primitive_, bounds());
@@ -169,28 +179,24 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
 
 bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
                                  Crossing& hit) const {
-    // The level whose cell is the footprint wide, at the box's centre along the ray.
+    // Rays without a footprint read the finest table.
     const double dd = dot(r.d, r.d);
-    const RayFootprint& fp = t_footprint;
-    const double tc = dot(bounds().center() - r.o, r.d) / dd;
-    const double width = (fp.width0 + fp.spread * std::max(0.0, tc)) * std::sqrt(dd);
+    const double width = footprint_width(r);
+    const bool exact = exact_ && width > 0;  // (rays without a footprint read the tables)
     const double top = double(levels_.size() - 1);
     const double wanted = width > 0 ? lod_level(levels_.front().frame.cell(), width) : top;
     const double level = std::clamp(wanted, 0.0, top);
-    // The primitive's own crossings (exact_weight); rays without a footprint ask for the
-    // finest table alone.
-    const ExactMode& mode = normal ? kCameraExact : kShadowExact;
-    const double w_exact = exact_blend_ && width > 0 ? exact_weight(wanted - top, mode) : 0.0;
-    Sheet tables, exact;
-    if (w_exact < 1) add_tables(level, 1 - w_exact, normal, r, tmin, tables);
-    if (w_exact > 0) add_exact(w_exact, width, mode.sub_rays, normal, r, tmin, exact);
-    const double alpha = tables.alpha + exact.alpha;
-    if (alpha <= 1e-6) return false;
-    const Vec3 p = (tables.p + exact.p) / alpha;
+    Sheet s;
+    if (exact)
+        add_exact(std::min(width, exact_width_), normal, r, tmin, s);
+    else
+        add_tables(level, normal, r, tmin, s);
+    if (s.alpha <= 1e-6) return false;
+    const Vec3 p = s.p / s.alpha;
     const double t = dot(p - r.o, r.d) / dd;
     if (!(t > tmin && t < tmax)) return false;
     // Blends of full pairs round to just under 1: they are opaque (and end the ray's traversal).
-    const float coverage = alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(alpha);
+    const float coverage = s.alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(s.alpha);
     const Vec3 facing = -r.d / std::sqrt(dd);
     if (!normal) {
         hit = Crossing(t, 0, SurfacePoint{p, facing});
@@ -199,26 +205,40 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     }
     // The normal is the coverage-weighted mean of unit normals, left unnormalised: its length
     // (below 1 where they diverge) tells the shading how much the normals under the footprint
-    // spread (SurfaceHit::normal_length). The tables' pairs give their spread over the filter's
-    // tent, about a cell of the level wide; a footprint narrower than the finest level's cell
-    // (close-ups) covers less of it, and for smooth surfaces the spread, 1 - length, goes as
-    // the width squared (unscaled, scaled, without normal filtering: Plate 2, thistles, 36.3,
-    // 39.6, 39.6 dB; Plate 3, a hair close up, 42.2, 43.1, 43.1 dB; Plates 4 and 5 need no
-    // scaling). The exact crossings' normals spread over the footprint itself: as they are.
-    Vec3 n;
-    if (const double ln = length(tables.n); ln > 0) {
+    // spread (SurfaceHit::normal_length). The sub-rays' normals spread over the footprint
+    // itself: as they are. The tables' pairs give their spread over the filter's tent, about a
+    // cell of the level wide; a footprint narrower than the finest level's cell (close-ups)
+    // covers less of it, and for smooth surfaces the spread, 1 - length, goes as the width
+    // squared (unscaled, scaled, without normal filtering: Plate 2, thistles, 36.3, 39.6,
+    // 39.6 dB; Plate 3, a hair close up, 42.2, 43.1, 43.1 dB; Plates 4 and 5 need no scaling).
+    Vec3 n = s.n / s.alpha;
+    if (const double ln = length(s.n); !exact && ln > 0) {
         const double narrower = std::max(0.0, wanted - level);  // in levels, each half as wide
-        const double len = 1 - (1 - std::min(1.0, ln / tables.alpha)) * std::exp2(-2 * narrower);
-        n = tables.n / ln * len;
+        const double len = 1 - (1 - std::min(1.0, ln / s.alpha)) * std::exp2(-2 * narrower);
+        n = s.n / ln * len;
     }
-    if (exact.alpha > 0) n = (n * tables.alpha + exact.n) / alpha;
     hit = Crossing(t, 0, SurfacePoint{p, length(n) > 0 ? n : facing});
     hit.coverage = coverage;
     return true;
 }
 
-void FilteredLatticeShape::add_tables(double level, double weight, bool normal, const Ray& r,
-                                      double tmin, Sheet& s) const {
+double FilteredLatticeShape::footprint_width(const Ray& r) const {
+    // At the box's centre along the ray.
+    const double dd = dot(r.d, r.d);
+    const double tc = dot(bounds().center() - r.o, r.d) / dd;
+    return (t_footprint.width0 + t_footprint.spread * std::max(0.0, tc)) * std::sqrt(dd);
+}
+
+bool FilteredLatticeShape::cull_meets(std::size_t i, const Ray& r) const {
+    if (!exact_) return cull_frame().cull_meets(i, r);
+    const double width = footprint_width(r);
+    if (!(width > 0)) return cull_frame().cull_meets(i, r);
+    const double reach = sub_ray_reach_ * std::min(width, exact_width_) / exact_width_;
+    return cull_frame().cull_meets(i, r, sub_ray_reach_ - reach);
+}
+
+void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, double tmin,
+                                      Sheet& s) const {
     const auto lo = static_cast<std::size_t>(std::floor(level));
     // The box filter, constant over a pair's cells, gets its smoothness from blending levels:
     // it blends them all the way (Plate 4: 33.6 dB, in the band only 32.6 dB).
@@ -230,24 +250,24 @@ void FilteredLatticeShape::add_tables(double level, double weight, bool normal, 
     Blend b[2];
     for (std::size_t i = first; i <= last; ++i) {
         Blend& bi = b[i - first];
-        blend(levels_[i], r, (i == lo ? 1 - w_hi : w_hi) * weight, smooth, bi);
+        blend(levels_[i], r, i == lo ? 1 - w_hi : w_hi, smooth, bi);
         levels_[i].table->locate_coverage(bi.ia, bi.ib, bi.n, bi.ref);
     }
     for (std::size_t i = first; i <= last; ++i) add_blend(levels_[i], b[i - first], normal, r, tmin, s);
 }
 
-// The crossings of sub_rays^2 sub-rays parallel to r, on a grid across its footprint (for
+// The crossings of kExactSubRays^2 sub-rays parallel to r, on a grid across its footprint (for
 // camera rays the pixel's box filter, as exact mode at that many samples would, but on this
 // primitive only and shaded once). They are those of the sub-rays' chords through the box,
 // however far r may go (tmax): what the tables answer does not depend on the order in which
 // the accelerator meets objects either, and the sheet is cut at tmax after. The footprint's
 // width is taken across the ray as along it (instances scaled uniformly, as lod_range assumes).
-void FilteredLatticeShape::add_exact(double weight, double width, int sub_rays, bool normal,
-                                     const Ray& r, double tmin, Sheet& s) const {
-    const int n = sub_rays;
+void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, double tmin,
+                                     Sheet& s) const {
+    constexpr int n = kExactSubRays;
     Vec3 u, v;
     orthonormal_basis(r.d / length(r.d), u, v);
-    const double w = weight / (n * n);
+    constexpr double w = 1.0 / (n * n);
     // A union's sub-rays meet only parts near r: found once, with boxes grown by (n - 1) / n of
     // the width, more than the farthest sub-ray's offset along any axis (sqrt(2) (n - 1) / 2n
     // of it; a single sub-ray is r). Plates 4 and 5 render 6 % faster than with every part

@@ -8,8 +8,8 @@
 //           linearly over a simplex of the 4-D (entry, exit) grid: continuous in ray space.
 // Levels of detail: tables of the same box at sigma^-1 doubling from level to level; each ray
 // takes the level whose cell matches its footprint (ray_footprint()), blending the two nearest.
-// The primitive itself is the level after the finest table: its exact crossings are blended
-// into every camera ray's answer, and into shadow rays' past the finest table (exact_weight).
+// With levels of detail, a primitive cheap to intersect answers rays with a footprint from its
+// own crossings instead (answered_by_primitive).
 // As a CSG leaf, for `inside` and for spans, the lattice is point-sampled through the finest
 // level's own hits, exactly as without filtering.
 #include <algorithm>
@@ -58,45 +58,41 @@ double lod_level(double cell0, double width);
 inline constexpr double kLodBlendBand = 0.25;
 // The weight of the finer of two levels at fraction f (0 to 1) of the way to it.
 double lod_blend(double f, double band);
-// With levels of detail, the primitive itself is the level after the finest table (the finest
-// built: at most 4K): a ray's sheet blends the primitive's own crossings (exact, full coverage)
-// with the tables' answer, at weight exact_weight(past, mode), `past` being how many levels
-// beyond the finest table's the ray's level (lod_level) lies. The tables blur edges and
-// highlights over a cell (several pixels wide in close-ups, where the finest table is
-// coarser than the footprint); exact crossings at 1 spp are sharp but aliased; the two errors
-// differ enough that their blend beats both.
-//   Camera rays take the crossings of 2 x 2 sub-rays across their footprint (add_exact), at
-//   half weight wherever the tables match the footprint, rising to all of it at 2 levels past
-//   the finest table. Half at every level makes a ray's answer independent of which levels
-//   the scene's other instances made the finest (a ramp tied to the finest level was not), and
-//   was as good or better: 1 spp, PSNR against 256-spp exact (64 for the furry bunny and
-//   grass), Plates 2 / 3 / 4 / 5, bunny, grass (exact 4 spp: 44.45 / 52.81 / 36.92 / 39.46 /
-//   31.03 / 35.73 dB); no exact crossings: 39.68 / 43.12 / 38.55 / 39.38 / 31.62 / 37.60; a
-//   ramp from 0 at 2 levels before the finest to 1 at 2 past: 45.98 / 51.64 / 39.35 / 40.33 /
-//   32.61 / 38.03; half, rising from 1 to 3 past: 45.52 / 51.52 / 39.35 / 40.32 / 33.01 /
-//   38.45; half, rising from 0 to 2 past (kept): 45.98 / 51.64 / 39.35 / 40.33 / 33.01 / 38.45
-//   (docs/filtering.md, "The primitive as the level after the finest table"). One crossing a
-//   ray instead of sub-rays lost (Plate 5 39.26 dB over a ramp [-1, 3]): the sub-rays'
-//   coverage antialiases edges at the pixel's own scale.
-//   Shadow rays, which want only the coverage, take their own crossing, from 0 at 1 level
-//   past the finest to all at 3: sub-rays for them changed no PSNR, and starting at -1 cost
-//   Plate 5 0.09 dB in 12 % more time; without them Plates 2 and 3 lost 1.1 and 2 dB.
-struct ExactMode {
-    double base;      // the weight at and before `from`
-    double from, to;  // levels past the finest table where the weight rises from base to 1
-    int sub_rays;     // a side: sub_rays^2 crossings across the footprint
-};
-inline constexpr ExactMode kCameraExact{0.5, 0, 2, 2}, kShadowExact{0, 1, 3, 1};
-static_assert(kCameraExact.from < kCameraExact.to && kShadowExact.from < kShadowExact.to);
-// The weight of the primitive's crossings for a ray `past` levels beyond the finest table.
-inline double exact_weight(double past, const ExactMode& mode) {
-    const double rise = std::clamp((past - mode.from) / (mode.to - mode.from), 0.0, 1.0);
-    return mode.base + (1 - mode.base) * rise;
-}
+// With levels of detail, a primitive cheap to intersect (answered_by_primitive) is answered by
+// its own crossings, not its tables, for every ray with a footprint: those of kExactSubRays^2
+// sub-rays parallel to the ray across its footprint (add_exact), for camera rays shaded once
+// with their mean point and normal (the pixel's box filter on this primitive), for shadow rays
+// their share as the coverage. Its tables then serve rays without a footprint, CSG and
+// `inside` only, and no finer level is built (scene_lattices). A costly primitive is answered
+// by its tables and their levels alone.
+//   Why: where intersecting the primitive is cheap, its sub-rays give a better image than the
+// tables in less time, at every footprint tried. 1 spp, 2 threads, ms and PSNR against exact
+// ground truth (256 spp; 64 for the bunny and grass), on Plates 2 / 3 / 4 / 5, the furry bunny,
+// grass, and Plates 5 and 4 at 128^2 (their hairs a few pixels long, read from the tables'
+// coarsest level):
+//     sub-rays (kept)           133 / 37 / 236 / 402 / 857 / 977 / 247 / 66 ms
+//                               47.25 / 53.14 / 38.29 / 40.12 / 32.71 / 37.43 / 35.75 / 33.69 dB
+//     tables, with half the     238 / 39 / 439 / 934 / 1720 / 2103 / 480 / 106 ms
+//     sub-rays' weight blended  45.98 / 51.64 / 39.35 / 40.33 / 33.01 / 38.45 / 35.95 / 34.09 dB
+//     in (camera rays) and one
+//     crossing past the finest
+//     table (shadow rays)
+//     exact, 4 spp              160 / 94 / 240 / 293 / 377 / 236 / 22 / 18 ms
+//                               44.45 / 52.81 / 36.92 / 39.46 / 30.97 / 35.65 / 33.82 / 31.68 dB
+// Shadow rays through the tables cost most of the difference: with the camera rays on
+// sub-rays, tables for shadows took Plates 4 and 5 331 and 628 ms for 38.52 and 40.10 dB.
+// 3 x 3 sub-rays: Plates 4 and 5 39.21 and 40.49 dB in 281 and 510 ms; one (point sampling)
+// 32.68 and 35.00 dB. docs/filtering.md, "The primitive's own crossings".
+inline constexpr int kExactSubRays = 2;
 // Primitives whose exact intersection costs more than this many simple tests
-// (Shape::intersect_cost) are answered by their tables alone: a chain tests part after part,
-// 4 times a camera ray, which is what the lattice of a tuft of 2,000 parts is there to spare.
+// (Shape::intersect_cost) are answered by their tables: a chain tests part after part, 4 times
+// a ray, which is what the lattice of a tuft of 2,000 parts is there to spare. The ball of
+// CSG tori (6 tori and a sphere, cost 73): tables 34.49 dB in 262 ms, with the half blend of
+// sub-rays 36.55 dB in 628 ms, sub-rays alone 37.48 dB in 1055 ms; exact 1 spp 32.80 dB in
+// 240 ms, 4 spp 38.73 dB in 876 ms (the tables are ahead of exact at equal time).
 inline constexpr double kMaxExactCost = 64;
+// Whether a filtered lattice with levels of detail answers its rays from the primitive itself.
+bool answered_by_primitive(const Shape& primitive);
 // Unions of at most this many parts find the parts near a ray first (PartBoxes::near_parts).
 inline constexpr std::size_t kMaxNearParts = 64;
 
@@ -110,10 +106,12 @@ class FilteredLatticeShape final : public Shape {
 public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage; the
     // primitive (ctx.primitive) must outlive the shape. table_error: Encoding::error_bound of
-    // the finest level. exact_blend: rays blend in the primitive's crossings (exact_weight;
-    // levels of detail on), if its intersect_cost is at most kMaxExactCost.
+    // the finest level. exact_width: above 0, rays with a footprint take the primitive's own
+    // crossings (levels of detail on) if it is answered_by_primitive; their footprints are
+    // narrowed to at most exact_width (primitive units), which bounds how far from a ray its
+    // sub-rays go and so how far culling must reach.
     FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter, double table_error,
-                         bool exact_blend = false);
+                         double exact_width = 0);
 
     Bounds3 bounds() const override { return point_.bounds(); }
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
@@ -129,9 +127,8 @@ public:
     Bounds3 cull_bounds(std::size_t i, const Transform& xf) const override {
         return cull_frame().cull_bounds(i, xf);
     }
-    bool cull_meets(std::size_t i, const Ray& r) const override {
-        return cull_frame().cull_meets(i, r);
-    }
+    // With the primitive's crossings, by the reach of the ray's own sub-rays.
+    bool cull_meets(std::size_t i, const Ray& r) const override;
     double surface_tolerance() const override { return 2.0 * levels_.front().frame.cell(); }
 
 private:
@@ -171,26 +168,28 @@ private:
     std::vector<Level> levels_;
     std::size_t cull_level_ = 0;
     LatticeFilter filter_;
-    const Shape* primitive_;  // its crossings are blended in when exact_blend_
-    bool exact_blend_;
+    const Shape* primitive_;  // its crossings answer rays with a footprint when exact_
+    bool exact_;
+    double exact_width_;    // the widest footprint its sub-rays span
+    double sub_ray_reach_;  // how far from a ray its sub-rays lie, at most (culling's reach)
     // A union's parts' boxes: a sub-ray is intersected with the parts whose box it meets only.
     std::unique_ptr<const PartBoxes> part_boxes_;
     HitTableShape point_;  // the finest level, point-sampled
 
     const LatticeFrame& cull_frame() const { return levels_[cull_level_].frame; }
+    // The ray's footprint's width at the box (primitive units; 0 without one).
+    double footprint_width(const Ray& r) const;
     // intersect, with or without the sheet's normal.
     bool sheet(const Ray& r, double tmin, double tmax, bool normal, Crossing& hit) const;
     void blend(const Level& l, const Ray& r, double weight, bool smooth, Blend& b) const;
     // Looks the blend's pairs up and adds those that r meets after tmin to the sheet.
     void add_blend(const Level& l, const Blend& b, bool normals, const Ray& r, double tmin,
                    Sheet& s) const;
-    // Adds the levels' blends around `level` (0 to the finest), at weight `weight` in all.
-    void add_tables(double level, double weight, bool normal, const Ray& r, double tmin,
-                    Sheet& s) const;
-    // Adds the primitive's own crossings of r past tmin, at weight `weight` in all (see the
-    // definition); width: the ray's footprint at the box, primitive units; sub_rays a side.
-    void add_exact(double weight, double width, int sub_rays, bool normal, const Ray& r,
-                   double tmin, Sheet& s) const;
+    // Adds the levels' blends around `level` (0 to the finest).
+    void add_tables(double level, bool normal, const Ray& r, double tmin, Sheet& s) const;
+    // Adds the primitive's own crossings of r past tmin (see the definition); width: the ray's
+    // footprint at the box, primitive units.
+    void add_exact(double width, bool normal, const Ray& r, double tmin, Sheet& s) const;
 };
 
 }  // namespace lat

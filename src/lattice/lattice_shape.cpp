@@ -142,11 +142,12 @@ void LatticeFrame::split_in_halves() {
     cull_ = {{low, 0, 0, first, count}, {high, 0, 0, first, count}};
 }
 
-bool LatticeFrame::cull_meets(std::size_t i, const Ray& r) const {
+bool LatticeFrame::cull_meets(std::size_t i, const Ray& r, double narrower) const {
+    assert(narrower >= 0);  // and at most the reach the frame was made with
     const CullPart& p = cull_[i];
     if (p.count == 0) return true;
     for (std::uint32_t k = p.first; k < p.first + p.count; ++k)
-        if (capsules_[k].meets_line(r.o, r.d)) return true;
+        if (capsules_[k].meets_line(r.o, r.d, capsules_[k].r - narrower)) return true;
     return false;
 }
 

@@ -30,7 +30,9 @@ public:
     // See Shape::cull_count, cull_bounds and cull_meets.
     std::size_t cull_count() const { return cull_.size(); }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf) const;
-    bool cull_meets(std::size_t i, const Ray& r) const;
+    // narrower: for a ray known to need less reach, by how much (at most the reach) to narrow
+    // the capsules (still around the parts grown by the rest, capsules being convex).
+    bool cull_meets(std::size_t i, const Ray& r, double narrower = 0) const;
 
     // The ray's line in lattice units, and its snapped entry and exit points.
     struct Snap {

@@ -12,12 +12,13 @@ namespace {
 // surface, width / cos_v long across and width wide (cos_v: the camera ray's cosine with the
 // normal n), seen from the light (times cos_l) is an ellipse of area width^2 cos_l / cos_v; the
 // isotropic filter of a lattice's level gets the width of the same area, within 1/4 to 4
-// times the camera's (a surface seen edge-on). Fur scenes: +0.0 to +0.25 dB against the
-// camera's width (the floor and the sphere seen at a slant, the hairs' sides).
+// times the camera's (kMaxShadowWidening; a surface seen edge-on). Fur scenes: +0.0 to
+// +0.25 dB against the camera's width (the floor and the sphere seen at a slant, the hairs'
+// sides).
 double shadow_width(const Ray& ray, const SurfaceHit& hit, const Ray& shadow, double width) {
     const double cv = std::max(1.0 / 16, std::abs(dot(hit.n, ray.d)) / length(ray.d));
     const double cl = std::abs(dot(hit.n, shadow.d)) / length(shadow.d);
-    return width * std::clamp(std::sqrt(cl / cv), 0.25, 4.0);
+    return width * std::clamp(std::sqrt(cl / cv), 1 / kMaxShadowWidening, kMaxShadowWidening);
 }
 
 // Radiance at a layer; `width`: its footprint (world units), which picks the lattices' levels

@@ -17,6 +17,10 @@ inline constexpr int kMaxLayers = 8;
 // Below this share left uncovered, the rest of a ray is not traced.
 inline constexpr double kMinTransmittance = 1.0 / 1024;
 
+// A shadow ray's footprint leaving a surface is at most this many times the camera ray's there
+// (and at least its inverse): the pixel's footprint on the surface seen from the light.
+inline constexpr double kMaxShadowWidening = 4;
+
 // Radiance along a camera ray; `spread`: the width of its footprint per unit of distance (the
 // pixel's angle), which picks the lattices' levels of detail (lattice/filtered_shape.h).
 Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCounters& counters);
