@@ -12,6 +12,7 @@
 #include "dist/timeline.h"
 #include "io/image.h"
 #include "lattice/encoding.h"
+#include "lattice/filtered_shape.h"
 #include "render/render_modes.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
@@ -242,10 +243,13 @@ Command add_render_command(CLI::App& parent) {
                       "coverage encoding")
         ->check(CLI::IsMember(kFilters));
     c.app->add_option("--lod", args->lod,
-                      "lattice mode with a filter: levels of detail, sigma^-1 = K, 2K, 4K as "
-                      "the pixels' footprints need, with the primitive's exact crossings blended in "
-                      "(camera rays: half, all where the footprints are far finer than the "
-                      "finest level's cells) (on); or only K, tables alone (off)")
+                      "lattice mode with a filter: a primitive cheap to intersect (at most " +
+                          std::to_string(static_cast<int>(kMaxExactCost)) +
+                          " simple tests) answered by the crossings of " +
+                          std::to_string(kExactSubRays) + " x " + std::to_string(kExactSubRays) +
+                          " sub-rays across each ray's footprint, a costlier one by levels of detail, sigma^-1 = "
+                          "K, 2K, 4K as the pixels' footprints need (on); or only K, tables "
+                          "alone (off)")
         ->check(CLI::IsMember(kOnOff));
     c.app->add_option("--instancing", args->instancing,
                       "Multi-part objects as Embree instances (always), flattened into one "

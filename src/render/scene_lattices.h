@@ -25,11 +25,10 @@ struct SceneLattices {
 // camera's pixels (spread: a pixel's angle) somewhere on its instances, at most kMaxLodLevels;
 // a primitive answered_by_primitive gets the lattice asked for alone.
 // Levels of detail beyond sigma^-1 = K are built only up to kMaxLodPairs ordered pairs of
-// boundary points: rays that want finer get the finest level within it, with the primitive's
-// own crossings blended in (FilteredLatticeShape), not a table that takes half an hour to
-// build. 2^27 holds the hair of Plates 4 and 5 at 4K (111 M pairs); `lattice-rings`'s CSG ring
-// (16 x 16 x 8 cells of a torus) stops at 2K (17 M pairs; 4K, 268 M pairs, was still building
-// after 7 minutes in 5 GB).
+// boundary points: rays that want finer get the finest level within it, not a table that takes
+// half an hour to build. 2^27 holds the hair of Plates 4 and 5 at 4K (111 M pairs); a CSG ring
+// of 16 x 16 x 8 cells (`lattice-rings`, before its torus was answered by its crossings) stopped
+// at 2K (17 M pairs; 4K, 268 M pairs, was still building after 7 minutes in 5 GB).
 inline constexpr double kMaxLodPairs = 134217728.0;
 struct LatticeFiltering {
     LatticeFilter filter = LatticeFilter::kNone;
