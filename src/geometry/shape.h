@@ -230,6 +230,14 @@ bool first_crossing_of_parts(const S& s, const Parts& parts, const Ray& r, doubl
     return found;
 }
 
+// Whether any of the listed primitives of s blocks r within (tmin, tmax) (occluded_primitive).
+template <class S, class Parts>
+bool any_part_occludes(const S& s, const Parts& parts, const Ray& r, double tmin, double tmax) {
+    for (const auto part : parts)
+        if (s.occluded_primitive(part, r, tmin, tmax)) return true;
+    return false;
+}
+
 // The first crossing of a span list with tmin < t < tmax, if any.
 bool first_crossing(const SpanList& spans, double tmin, double tmax, Crossing& hit);
 

@@ -91,6 +91,7 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
         primitive_->primitive_count() >= kMinBoxedParts &&
         primitive_->primitive_count() <= kMaxNearParts)
         part_boxes_ = std::make_unique<const PartBoxes>(*primitive_, bounds());
+    chain_ = dynamic_cast<const ChainShape*>(primitive_);
 }
 
 void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bool smooth,
@@ -184,11 +185,12 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     const double width = footprint_width(r);
     const bool exact = exact_ && width > 0;  // (rays without a footprint read the tables)
     const double top = double(levels_.size() - 1);
-    const double wanted = width > 0 ? lod_level(levels_.front().frame.cell(), width) : top;
+    const double wanted =
+        width > 0 && !exact ? lod_level(levels_.front().frame.cell(), width) : top;
     const double level = std::clamp(wanted, 0.0, top);
     Sheet s;
     if (exact)
-        add_exact(std::min(width, exact_width_), normal, r, tmin, s);
+        add_exact(std::min(width, exact_width_), normal, r, tmin, tmax, s);
     else
         add_tables(level, normal, r, tmin, s);
     if (s.alpha <= 1e-6) return false;
@@ -258,12 +260,15 @@ void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, d
 
 // The crossings of kExactSubRays^2 sub-rays parallel to r, on a grid across its footprint (for
 // camera rays the pixel's box filter, as exact mode at that many samples would, but on this
-// primitive only and shaded once). They are those of the sub-rays' chords through the box,
-// however far r may go (tmax): what the tables answer does not depend on the order in which
-// the accelerator meets objects either, and the sheet is cut at tmax after. The footprint's
-// width is taken across the ray as along it (instances scaled uniformly, as lod_range assumes).
+// primitive only and shaded once). A camera ray's are those of the sub-rays' chords through the
+// box, however far r may go (tmax): what the tables answer does not depend on the order in
+// which the accelerator meets objects either, and the sheet is cut at tmax after. A shadow ray
+// wants only the share of its sub-rays blocked before tmax (the light), not where: any part's
+// crossing ends a sub-ray's tests, and the sheet lies halfway along the blocked ones' chords.
+// The footprint's width is taken across the ray as along it (instances scaled uniformly, as
+// lod_range assumes).
 void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, double tmin,
-                                     Sheet& s) const {
+                                     double tmax, Sheet& s) const {
     constexpr int n = kExactSubRays;
     Vec3 u, v;
     orthonormal_basis(r.d / length(r.d), u, v);
@@ -275,26 +280,40 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
     std::array<std::uint32_t, kMaxNearParts> near;
     const std::size_t n_near =
         part_boxes_ ? part_boxes_->near_parts(r, width * (n - 1) / n, tmin, near) : 0;
-    const auto crossing = [&](const Ray& sub, double t0, double t1, Crossing& c) {
-        return part_boxes_ ? first_crossing_of_parts(*primitive_, std::span(near.data(), n_near),
-                                                     sub, t0, t1, c)
-                           : primitive_->intersect(sub, t0, t1, c);
-    };
+    const std::span parts(near.data(), n_near);
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
             const double a = ((i + 0.5) / n - 0.5) * width, b = ((j + 0.5) / n - 0.5) * width;
             const Ray sub{r.o + u * a + v * b, r.d};
             double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
-            Crossing c;
-            if (!clip_ray(bounds(), sub, t0, t1) || !crossing(sub, t0, t1, c)) continue;
+            if (!clip_ray(bounds(), sub, t0, t1)) continue;
             if (!normal) {
-                s.add_opaque(w, c.has_stored ? c.stored.p : sub.at(c.t), {});
+                t1 = std::min(t1, tmax);
+                if (t0 < t1 && blocked(parts, sub, t0, t1))
+                    s.add_opaque(w, sub.at(0.5 * (t0 + t1)), {});
                 continue;
             }
+            Crossing c;
+            if (!crossing(parts, sub, t0, t1, c)) continue;
             const SurfacePoint sp = primitive_->surface(sub, c);
             const double ln = length(sp.n);
             s.add_opaque(w, sp.p, ln > 0 ? sp.n / ln : Vec3{});
         }
+}
+
+// Chains' parts are tested through the chain's own type, inline.
+bool FilteredLatticeShape::crossing(std::span<const std::uint32_t> parts, const Ray& sub, double t0,
+                                    double t1, Crossing& c) const {
+    if (!part_boxes_) return primitive_->intersect(sub, t0, t1, c);
+    return chain_ ? first_crossing_of_parts(*chain_, parts, sub, t0, t1, c)
+                  : first_crossing_of_parts(*primitive_, parts, sub, t0, t1, c);
+}
+
+bool FilteredLatticeShape::blocked(std::span<const std::uint32_t> parts, const Ray& sub, double t0,
+                                   double t1) const {
+    if (!part_boxes_) return primitive_->occluded(sub, t0, t1);
+    return chain_ ? any_part_occludes(*chain_, parts, sub, t0, t1)
+                  : any_part_occludes(*primitive_, parts, sub, t0, t1);
 }
 
 bool FilteredLatticeShape::occluded(const Ray& r, double tmin, double tmax) const {

@@ -14,9 +14,11 @@
 // level's own hits, exactly as without filtering.
 #include <algorithm>
 #include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
+#include "geometry/chain.h"
 #include "lattice/hit_table_shape.h"
 #include "lattice/part_boxes.h"
 
@@ -174,6 +176,7 @@ private:
     double sub_ray_reach_;  // how far from a ray its sub-rays lie, at most (culling's reach)
     // A union's parts' boxes: a sub-ray is intersected with the parts whose box it meets only.
     std::unique_ptr<const PartBoxes> part_boxes_;
+    const ChainShape* chain_ = nullptr;  // primitive_, when it is a chain
     HitTableShape point_;  // the finest level, point-sampled
 
     const LatticeFrame& cull_frame() const { return levels_[cull_level_].frame; }
@@ -189,7 +192,13 @@ private:
     void add_tables(double level, bool normal, const Ray& r, double tmin, Sheet& s) const;
     // Adds the primitive's own crossings of r past tmin (see the definition); width: the ray's
     // footprint at the box, primitive units.
-    void add_exact(double width, bool normal, const Ray& r, double tmin, Sheet& s) const;
+    void add_exact(double width, bool normal, const Ray& r, double tmin, double tmax,
+                   Sheet& s) const;
+    // A sub-ray's first crossing, and whether it is blocked, over the parts near its ray (all
+    // of the primitive without part boxes).
+    bool crossing(std::span<const std::uint32_t> parts, const Ray& sub, double t0, double t1,
+                  Crossing& c) const;
+    bool blocked(std::span<const std::uint32_t> parts, const Ray& sub, double t0, double t1) const;
 };
 
 }  // namespace lat
