@@ -461,6 +461,37 @@ TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
     }
 }
 
+// The footprints on a primitive's copies: from the nearest point of the nearest box to the
+// farthest of the farthest, in the primitive's units (a copy scaled by 1/2 doubles them); none
+// for a primitive without copies.
+TEST(Coverage, FootprintsRangeOverTheCopiesBoxesInPrimitiveUnits) {
+    test::TempDir dir;
+    const std::string path = (dir.path() / "copies.json").string();
+    std::ofstream(path) << R"({
+  "camera": {"eye": [1, -10, 1], "look_at": [1, 0, 1], "up": [0, 0, 1], "fov_y_deg": 30,
+             "width": 16, "height": 16},
+  "background": [0, 0, 0], "ambient": [1, 1, 1], "shadows": false, "lights": [],
+  "materials": {"w": {"color": [1, 1, 1], "ka": 1, "kd": 0, "ks": 0, "shininess": 1}},
+  "primitives": {"bead": {"spheres": [[1, 0.5, 1, 0.3]], "cylinders": [],
+                          "lattice": {"sigma": 1, "cells": [2, 1, 2]}},
+                 "unused": {"spheres": [[1, 0.5, 1, 0.3]], "cylinders": [],
+                            "lattice": {"sigma": 1, "cells": [2, 1, 2]}}},
+  "objects": [{"type": "instance", "primitive": "bead", "material": "w"},
+              {"type": "instance", "primitive": "bead", "material": "w",
+               "transform": [{"scale": 0.5}, {"translate": [0, 100, 0]}]}]
+})";
+    const Scene s = load_scene(path);
+    const TableContext base{{2, 1, 2}, 1.0, 1.0, nullptr};
+    const double spread = 0.01;
+    const auto [lo, hi] = footprint_range(s, 0, base, spread);
+    // The near copy's box: centre 10.5 from the eye, half-diagonal 1.5; the far one's: centre
+    // (0.5, 100.25, 0.5), half-diagonal 0.75, 2 primitive units a world unit.
+    EXPECT_NEAR(lo, (10.5 - 1.5) * spread, 1e-12);
+    EXPECT_NEAR(hi, (std::sqrt(0.5 + 110.25 * 110.25) + 0.75) * spread * 2, 1e-12);
+    const auto [none_lo, none_hi] = footprint_range(s, 1, base, spread);
+    EXPECT_GT(none_lo, none_hi);
+}
+
 // A primitive cheap to intersect is answered by its own crossings: only the lattice asked for
 // is built, however near and far its copies.
 TEST(Coverage, PrimitivesAnsweredByTheirCrossingsBuildOneLevel) {

@@ -20,10 +20,9 @@ namespace {
 
 using test::hook;
 const TableContext& kFine = test::kHookContext;  // cells of 0.5
-const TableContext kCoarse{{4, 2, 4}, 1.0, 1.0, &hook()};
 
-// The hook's coverage tables behind the smooth filter, answered from the primitive's own
-// crossings or by the tables alone: one level (kFine), or two (kCoarse, then kFine).
+// The hook's coverage table (kFine) behind the smooth filter, answered from the primitive's own
+// crossings or by the table alone.
 struct HookLattice {
     std::vector<ByteBuffer> payloads;  // the tables read them in place
     std::unique_ptr<FilteredLatticeShape> exact, tables_only;
@@ -41,19 +40,15 @@ const ChainShape& long_hook() {
     return s;
 }
 
-HookLattice hook_lattice(bool two_levels, const Shape& primitive = hook()) {
+HookLattice hook_lattice(const Shape& primitive = hook()) {
     const Encoding& e = find_encoding("coverage");
+    TableContext ctx = kFine;
+    ctx.primitive = &primitive;
     HookLattice h;
-    std::vector<FilterLevel> levels;
-    std::vector<TableContext> contexts{kFine};
-    if (two_levels) contexts.insert(contexts.begin(), kCoarse);
-    for (TableContext& ctx : contexts) ctx.primitive = &primitive;
-    h.payloads.reserve(contexts.size());
-    for (const TableContext& ctx : contexts) {
-        const RasterizeResult r = rasterize(ctx);
-        h.payloads.push_back(e.build(r.raw, ctx, {}));
-        levels.push_back({e.open(h.payloads.back().data(), h.payloads.back().size(), r.hits, ctx), ctx});
-    }
+    const RasterizeResult r = rasterize(ctx);
+    h.payloads.push_back(e.build(r.raw, ctx, {}));
+    const std::vector<FilterLevel> levels{
+        {e.open(h.payloads.back().data(), h.payloads.back().size(), r.hits, ctx), ctx}};
     const double error = e.error_bound(kFine, {});
     h.exact = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, kExactWidth);
     h.tables_only = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, 0.0);
@@ -79,9 +74,9 @@ std::vector<Ray> rays(int n, bool inside = false) {
 // the primitive crosses them between tmin and tmax, from outside the box or from inside it,
 // with the sheet in that range; occluded() says the same.
 TEST(FilteredCloseUps, ShadowRaysAreBlockedWhereThePrimitiveCrossesThem) {
-    for (const bool two : {false, true}) {
-        const HookLattice h = hook_lattice(two);
-        set_ray_footprint({1e-9, 0, true});
+    const HookLattice h = hook_lattice();
+    for (const double footprint : {1e-9, 0.0}) {
+        set_ray_footprint({footprint, 0, true});
         int hits = 0;
         for (const bool inside : {false, true})
             for (const Ray& r : rays(3000, inside)) {
@@ -109,7 +104,7 @@ TEST(FilteredCloseUps, ShadowRaysAreBlockedWhereThePrimitiveCrossesThem) {
 // crossing and its normal; a footprint a few cells wide covers the hook's edges in part, in
 // steps of one sub-ray.
 TEST(FilteredCloseUps, CameraRaysGetTheirSubRaysCrossings) {
-    const HookLattice h = hook_lattice(false);
+    const HookLattice h = hook_lattice();
     set_ray_footprint({1e-9, 0, false});
     int hits = 0, tables_differ = 0;
     for (const Ray& r : rays(5000)) {
@@ -148,7 +143,7 @@ TEST(FilteredCloseUps, CameraRaysGetTheirSubRaysCrossings) {
 // to it. (With the hook, and with a hook of 9 parts, whose sub-rays meet only the parts found
 // near the ray first: the same crossings as the whole primitive's.)
 void expect_sheets_are_their_sub_rays_crossings(const ChainShape& prim, bool shadow) {
-    const HookLattice h = hook_lattice(false, prim);
+    const HookLattice h = hook_lattice(prim);
     const int n = kExactSubRays;
     const Bounds3 box{{0, 0, 0}, Vec3{4, 2, 4}};
     int checked = 0;
@@ -199,10 +194,11 @@ TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
 }
 
 // Culling reaches as far as each ray's own sub-rays: a ray whose sheet has a crossing meets
-// one of the cull parts, whatever its footprint (narrowed to the exact width or not); rays
-// clear of the hook by more than their sub-rays' reach are culled.
+// one of the cull parts and the accelerator's boxes, whatever its footprint (none, narrowed to
+// the exact width or not; its line through the lattice box or past it); rays clear of the hook
+// by more than their sub-rays' reach are culled.
 TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
-    const HookLattice h = hook_lattice(false, long_hook());
+    const HookLattice h = hook_lattice(long_hook());
     const FilteredLatticeShape& s = *h.exact;
     ASSERT_GT(s.cull_count(), 0u);
     const auto meets_a_part = [&](const Ray& r) {
@@ -210,14 +206,25 @@ TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
             if (s.cull_meets(i, r)) return true;
         return false;
     };
-    int hits = 0, culled = 0;
-    for (const double footprint : {0.05, 0.5, 2.0, kExactWidth, 3 * kExactWidth}) {
+    // The accelerator's boxes: the parts' (their lines start outside them), and the shape's.
+    const auto meets_a_box = [&](const Ray& r) {
+        double t0 = 0, t1 = kInfinity;
+        if (!clip_ray(s.bounds(), r, t0, t1)) return false;
+        for (std::size_t i = 0; i < s.cull_count(); ++i)
+            if (t0 = 0, t1 = kInfinity; clip_ray(s.cull_bounds(i, Transform{}), r, t0, t1)) return true;
+        return false;
+    };
+    int hits = 0, culled = 0, outside = 0;
+    for (const double footprint : {0.0, 0.05, 0.5, 2.0, kExactWidth, 3 * kExactWidth}) {
         set_ray_footprint({footprint, 0, false});
         for (const Ray& r : rays(4000)) {
             Crossing c;
             if (s.intersect(r, 0.0, kInfinity, c)) {
                 ++hits;
                 EXPECT_TRUE(meets_a_part(r)) << "footprint " << footprint;
+                EXPECT_TRUE(meets_a_box(r)) << "footprint " << footprint;
+                double t0 = 0, t1 = kInfinity;
+                outside += !clip_ray(Bounds3{{0, 0, 0}, Vec3{4, 2, 4}}, r, t0, t1);
             } else {
                 culled += !meets_a_part(r);
             }
@@ -226,13 +233,14 @@ TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
     set_ray_footprint({});
     EXPECT_GT(hits, 3000);
     EXPECT_GT(culled, 3000);
+    EXPECT_GT(outside, 20);  // rays whose lines miss the lattice box, answered by sub-rays
 }
 
 // A ray's direction need not be a unit vector in the primitive's frame (scaled instances): the
 // footprint scales with it, so twice the direction and half the footprint is the same ray and
 // footprint, answered at half the parameter.
 TEST(FilteredCloseUps, LongerDirectionsAreTheSameRay) {
-    const HookLattice h = hook_lattice(false);
+    const HookLattice h = hook_lattice();
     for (const double width : {1e-9, 0.5, 2.0}) {
         for (const bool shadow : {false, true}) {
             int hits = 0;
@@ -259,7 +267,7 @@ TEST(FilteredCloseUps, LongerDirectionsAreTheSameRay) {
 // so far) only cuts the sheet, as for the tables: the answer is the same whatever order the
 // accelerator meets objects in.
 TEST(FilteredCloseUps, TheSheetIsCutAtTmaxNotMadeOfWhatLiesBeforeIt) {
-    const HookLattice h = hook_lattice(false);
+    const HookLattice h = hook_lattice();
     for (const double width : {1e-9, 1.0}) {
         set_ray_footprint({width, 0, false});
         for (const Ray& r : rays(3000)) {
@@ -277,28 +285,24 @@ TEST(FilteredCloseUps, TheSheetIsCutAtTmaxNotMadeOfWhatLiesBeforeIt) {
     set_ray_footprint({});
 }
 
-// Rays without a footprint (width 0) read the tables: the same answers, to the bit, as a
-// lattice answered by its tables alone, camera or shadow rays, of one level or two.
-TEST(FilteredCloseUps, RaysWithoutAFootprintReadTheTables) {
-    for (const bool two : {false, true}) {
-        const HookLattice h = hook_lattice(two);
-        for (const bool shadow : {false, true}) {
-            set_ray_footprint({0, 0, shadow});
-            for (const Ray& r : rays(2000)) {
-                Crossing a, b;
-                const bool ha = h.exact->intersect(r, 0.0, kInfinity, a);
-                ASSERT_EQ(ha, h.tables_only->intersect(r, 0.0, kInfinity, b))
-                    << (shadow ? "shadow ray" : "camera ray");
-                if (!ha) continue;
-                EXPECT_EQ(a.t, b.t);
-                EXPECT_EQ(a.coverage, b.coverage);
-                EXPECT_EQ(a.stored.n.x, b.stored.n.x);
-                EXPECT_EQ(a.stored.n.y, b.stored.n.y);
-                EXPECT_EQ(a.stored.n.z, b.stored.n.z);
-            }
-        }
+// Camera rays without a footprint (width 0: the camera in the box, say) get their own line's
+// crossing and normal from a primitive that answers, the continuous limit of a vanishing one.
+TEST(FilteredCloseUps, RaysWithoutAFootprintGetTheirLinesCrossing) {
+    const HookLattice h = hook_lattice();
+    set_ray_footprint({0, 0, false});
+    int hits = 0;
+    for (const Ray& r : rays(3000)) {
+        Crossing exact, got;
+        const bool e = hook().intersect(r, 0.0, kInfinity, exact);
+        ASSERT_EQ(h.exact->intersect(r, 0.0, kInfinity, got), e);
+        if (!e) continue;
+        ++hits;
+        EXPECT_NEAR(got.t, exact.t, 1e-9);
+        EXPECT_EQ(got.coverage, 1.0f);
+        EXPECT_NEAR(length(got.stored.n - normalize(hook().normal(r, exact))), 0.0, 1e-9);
     }
     set_ray_footprint({});
+    EXPECT_GT(hits, 500);
 }
 
 // How many of 3000 rays of a vanishing footprint a primitive in a {4, 2, 4} box answers

@@ -75,22 +75,27 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // Both cuts, smooth, 1 spp: Plates 4 and 5 render 18 % and 23 % faster, the furry bunny
     // and grass 37 % and 44 %, with the same PSNR against exact ground truth to 0.06 dB
     // (docs/filtering.md, "Culling").
-    // A primitive answered by its own crossings needs its parts grown by the farthest sub-ray's
-    // distance from the ray only (a bound), and each ray by its own (cull_meets).
+    // A primitive answered by its own crossings reads no table (but point_): its one level's
+    // frame culls, with the parts grown by the farthest sub-ray's distance from the ray (a
+    // bound; each ray by its own, cull_meets), and a ray whose line passes that close outside
+    // the box can have sub-rays that enter it.
+    assert(!exact_ || levels.size() == 1);
     cull_level_ = exact_ ? 0 : std::min<std::size_t>(1, levels.size() - 1);
     for (std::size_t i = 0; i < levels.size(); ++i) {
         const FilterLevel& l = levels[i];
-        const double table_reach = cull_cells(filter) * l.ctx.cell + table_error;
-        const double reach =
-            i != cull_level_ ? kInfinity : exact_ ? sub_ray_reach_ : table_reach;
-        levels_.push_back({l.table, LatticeFrame(l.ctx, reach), BoundaryGrid(l.ctx.cells)});
+        const double reach = i != cull_level_ ? kInfinity
+                             : exact_         ? sub_ray_reach_
+                                              : cull_cells(filter) * l.ctx.cell + table_error;
+        levels_.push_back({l.table, LatticeFrame(l.ctx, reach, exact_ ? sub_ray_reach_ : 0.0),
+                           BoundaryGrid(l.ctx.cells)});
     }
+    bounds_ = exact_ ? expand(point_.bounds(), sub_ray_reach_) : point_.bounds();
     // Boxes pay for their set-up on a hair of 19 parts, not on a thistle spike of 3 (Plate 2
     // rendered 9 % slower when every sub-ray tested the boxes).
     if (exact_ && primitive_->intersects_parts_in_order() &&
         primitive_->primitive_count() >= kMinBoxedParts &&
         primitive_->primitive_count() <= kMaxNearParts)
-        part_boxes_ = std::make_unique<const PartBoxes>(*primitive_, bounds());
+        part_boxes_ = std::make_unique<const PartBoxes>(*primitive_, point_.bounds());
     chain_ = dynamic_cast<const ChainShape*>(primitive_);
 }
 
@@ -180,19 +185,20 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
 
 bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
                                  Crossing& hit) const {
-    // Rays without a footprint read the finest table.
     const double dd = dot(r.d, r.d);
     const double width = footprint_width(r);
-    const bool exact = exact_ && width > 0;  // (rays without a footprint read the tables)
-    const double top = double(levels_.size() - 1);
-    const double wanted =
-        width > 0 && !exact ? lod_level(levels_.front().frame.cell(), width) : top;
-    const double level = std::clamp(wanted, 0.0, top);
     Sheet s;
-    if (exact)
+    double finer = 0;  // how many levels finer than the finest table the footprint is
+    if (exact_) {
         add_exact(std::min(width, exact_width_), normal, r, tmin, tmax, s);
-    else
+    } else {
+        // Rays without a footprint read the finest table.
+        const double top = double(levels_.size() - 1);
+        const double wanted = width > 0 ? lod_level(levels_.front().frame.cell(), width) : top;
+        const double level = std::clamp(wanted, 0.0, top);
+        finer = std::max(0.0, wanted - level);
         add_tables(level, normal, r, tmin, s);
+    }
     if (s.alpha <= 1e-6) return false;
     const Vec3 p = s.p / s.alpha;
     const double t = dot(p - r.o, r.d) / dd;
@@ -214,9 +220,8 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     // squared (unscaled, scaled, without normal filtering: Plate 2, thistles, 36.3, 39.6,
     // 39.6 dB; Plate 3, a hair close up, 42.2, 43.1, 43.1 dB; Plates 4 and 5 need no scaling).
     Vec3 n = s.n / s.alpha;
-    if (const double ln = length(s.n); !exact && ln > 0) {
-        const double narrower = std::max(0.0, wanted - level);  // in levels, each half as wide
-        const double len = 1 - (1 - std::min(1.0, ln / s.alpha)) * std::exp2(-2 * narrower);
+    if (const double ln = length(s.n); !exact_ && ln > 0) {
+        const double len = 1 - (1 - std::min(1.0, ln / s.alpha)) * std::exp2(-2 * finer);
         n = s.n / ln * len;
     }
     hit = Crossing(t, 0, SurfacePoint{p, length(n) > 0 ? n : facing});
@@ -233,10 +238,11 @@ double FilteredLatticeShape::footprint_width(const Ray& r) const {
 
 bool FilteredLatticeShape::cull_meets(std::size_t i, const Ray& r) const {
     if (!exact_) return cull_frame().cull_meets(i, r);
+    // The capsules less the part of the reach this ray's sub-rays do not span (0 when it is
+    // narrowed to the exact width; written so that rounding never makes it negative).
     const double width = footprint_width(r);
-    if (!(width > 0)) return cull_frame().cull_meets(i, r);
-    const double reach = sub_ray_reach_ * std::min(width, exact_width_) / exact_width_;
-    return cull_frame().cull_meets(i, r, sub_ray_reach_ - reach);
+    const double unspanned = width >= exact_width_ ? 0.0 : sub_ray_reach_ * (1 - width / exact_width_);
+    return cull_frame().cull_meets(i, r, unspanned);
 }
 
 void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, double tmin,
@@ -266,7 +272,7 @@ void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, d
 // wants only the share of its sub-rays blocked before tmax (the light), not where: any part's
 // crossing ends a sub-ray's tests, and the sheet lies halfway along the blocked ones' chords.
 // The footprint's width is taken across the ray as along it (instances scaled uniformly, as
-// lod_range assumes).
+// footprint_range assumes).
 void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, double tmin,
                                      double tmax, Sheet& s) const {
     constexpr int n = kExactSubRays;
@@ -286,7 +292,7 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
             const double a = ((i + 0.5) / n - 0.5) * width, b = ((j + 0.5) / n - 0.5) * width;
             const Ray sub{r.o + u * a + v * b, r.d};
             double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
-            if (!clip_ray(bounds(), sub, t0, t1)) continue;
+            if (!clip_ray(point_.bounds(), sub, t0, t1)) continue;
             if (!normal) {
                 t1 = std::min(t1, tmax);
                 if (t0 < t1 && blocked(parts, sub, t0, t1))

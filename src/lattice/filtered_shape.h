@@ -108,14 +108,15 @@ class FilteredLatticeShape final : public Shape {
 public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage; the
     // primitive (ctx.primitive) must outlive the shape. table_error: Encoding::error_bound of
-    // the finest level. exact_width: above 0, rays with a footprint take the primitive's own
-    // crossings (levels of detail on) if it is answered_by_primitive; their footprints are
-    // narrowed to at most exact_width (primitive units), which bounds how far from a ray its
-    // sub-rays go and so how far culling must reach.
+    // the finest level. exact_width: above 0, rays take the primitive's own crossings (levels
+    // of detail on; one level) if it is answered_by_primitive; their footprints are narrowed to
+    // at most exact_width (primitive units), which bounds how far from a ray its sub-rays go and
+    // so how far culling must reach. A ray without a footprint gets the crossing of its own line.
     FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter, double table_error,
                          double exact_width = 0);
 
-    Bounds3 bounds() const override { return point_.bounds(); }
+    // The lattice box, grown by the sub-rays' reach when the primitive answers.
+    Bounds3 bounds() const override { return bounds_; }
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     // Shadow rays that need transmittance ask intersect for the coverage; as an any-hit test, a
     // sheet occludes when it covers at least half.
@@ -174,6 +175,7 @@ private:
     bool exact_;
     double exact_width_;    // the widest footprint its sub-rays span
     double sub_ray_reach_;  // how far from a ray its sub-rays lie, at most (culling's reach)
+    Bounds3 bounds_;
     // A union's parts' boxes: a sub-ray is intersected with the parts whose box it meets only.
     std::unique_ptr<const PartBoxes> part_boxes_;
     const ChainShape* chain_ = nullptr;  // primitive_, when it is a chain

@@ -17,13 +17,13 @@ std::uint64_t lattice_visits_this_thread() {
     return t_visits;
 }
 
-LatticeFrame::LatticeFrame(const TableContext& ctx, double reach)
+LatticeFrame::LatticeFrame(const TableContext& ctx, double reach, double beyond_box)
     : grid_(ctx.cells),
       cell_(ctx.cell),
       inv_cell_(1.0 / ctx.cell),
       box_{{0, 0, 0},
            Vec3{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])} * ctx.cell} {
-    make_cull_parts(ctx.primitive, reach);
+    make_cull_parts(ctx.primitive, reach, expand(box_, beyond_box));
 }
 
 // Every answer's ray point lies within the reach of the primitive (make_lattice_shape), so
@@ -34,10 +34,10 @@ LatticeFrame::LatticeFrame(const TableContext& ctx, double reach)
 // capsules (a hair), each is a cull part of its own and its capsule grown by the reach is
 // tested too, a few dot products before any snapping: on the fur plates four in five rays
 // that met the boxes found no stored hit.
-void LatticeFrame::make_cull_parts(const Shape* primitive, double reach) {
+void LatticeFrame::make_cull_parts(const Shape* primitive, double reach, const Bounds3& region) {
     const std::size_t n = primitive ? primitive->primitive_count() : 0;
     if (!std::isfinite(reach) || n == 0) {
-        cull_.push_back({box_, 0, 0});
+        cull_.push_back({region, 0, 0});
         return;
     }
     const Vec3 ext = box_.extent();
@@ -47,7 +47,7 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach) {
     for (std::size_t i = 0; i < n; ++i) {
         Piece p;
         p.part = static_cast<std::uint32_t>(i);
-        p.box = lat::intersect(expand(primitive->primitive_bounds(i), reach), box_);
+        p.box = lat::intersect(expand(primitive->primitive_bounds(i), reach), region);
         capsules = capsules && primitive->primitive_capsule(i, p.capsule);
         p.capsule.r += reach;
         if (!p.box.empty()) pieces.push_back(p);
@@ -60,7 +60,7 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach) {
     if (capsules && pieces.size() <= 4 * kMaxCullParts) {
         few = pieces;
         // A kept capsule stands for those it covers, so its box is its own (not its part's).
-        for (Piece& p : few) p.box = lat::intersect(p.capsule.placed_bounds(Transform{}), box_);
+        for (Piece& p : few) p.box = lat::intersect(p.capsule.placed_bounds(Transform{}), region);
         drop_covered(few);
     }
     capsules = capsules && !few.empty() && few.size() <= kMaxCullParts;
@@ -72,7 +72,7 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach) {
     for (Piece& p : pieces) p.key = p.box.center()[axis];
     std::stable_sort(pieces.begin(), pieces.end(),
                      [](const Piece& a, const Piece& b) { return a.key < b.key; });
-    group(pieces, capsules);
+    group(pieces, capsules, region);
 }
 
 // A chain's joint sphere lies inside its cylinders' grown capsules: every culling part costs a
@@ -91,7 +91,8 @@ void LatticeFrame::drop_covered(std::vector<Piece>& pieces) {
     pieces = std::move(kept);
 }
 
-void LatticeFrame::group(const std::vector<Piece>& pieces, bool capsules) {
+void LatticeFrame::group(const std::vector<Piece>& pieces, bool capsules,
+                         const Bounds3& region) {
     // Boxes alone: two neighbouring parts a box (for a chain, a sphere and its cylinder) was
     // fastest on the plates among 1, 3, 6, 10 and 19 boxes for the 19-part hair. Capsules pay
     // only one to a part: groups of them (tufts of 200 parts in 16 groups) cost 1.5x the
@@ -120,8 +121,8 @@ void LatticeFrame::group(const std::vector<Piece>& pieces, bool capsules) {
         total += volume(part.box);
     }
     // A primitive that fills its box (a thin spike) gains nothing from several boxes.
-    if (!tested && total >= volume(box_))
-        cull_.assign(1, {box_, 0, 0, 0, static_cast<std::uint32_t>(parts_.size())});
+    if (!tested && total >= volume(region))
+        cull_.assign(1, {region, 0, 0, 0, static_cast<std::uint32_t>(parts_.size())});
     if (cull_.size() == 1 && !tested) split_in_halves();
 }
 

@@ -21,8 +21,10 @@ class LatticeFrame {
 public:
     // reach: how far from the primitive (primitive units) the ray's point at an answer can lie,
     // infinity when unknown, which culls with the lattice box alone. ctx.primitive, when set,
-    // lets the cull parts hug the primitive.
-    LatticeFrame(const TableContext& ctx, double reach);
+    // lets the cull parts hug the primitive. beyond_box: how far outside the box a ray's line
+    // can pass and still be answered (a filtered lattice's sub-rays); the cull parts are
+    // clipped to the box grown by it.
+    LatticeFrame(const TableContext& ctx, double reach, double beyond_box = 0);
 
     const Bounds3& box() const { return box_; }
     double cell() const { return cell_; }
@@ -90,9 +92,9 @@ private:
         std::uint32_t part = 0;
     };
     Bounds3 placed_parts(const CullPart& p, const Transform& xf) const;
-    void make_cull_parts(const Shape* primitive, double reach);
+    void make_cull_parts(const Shape* primitive, double reach, const Bounds3& region);
     static void drop_covered(std::vector<Piece>& pieces);
-    void group(const std::vector<Piece>& pieces, bool capsules);
+    void group(const std::vector<Piece>& pieces, bool capsules, const Bounds3& region);
     void split_in_halves();
 };
 

@@ -21,29 +21,6 @@ namespace {
 // (1 leaves Plate 3 under exact at 4 spp, 52.81 dB.)
 constexpr double kSubRayWidening = 2;
 
-// The narrowest and widest footprints (primitive units) of the camera's pixels on a primitive's
-// instances: at the nearest and farthest points of their boxes. Empty (lo > hi) when it has no
-// instance of its own (only in CSG).
-std::pair<double, double> footprint_range(const Scene& scene, int prim, const TableContext& base,
-                                          double spread) {
-    const Vec3 eye = scene.camera.eye;
-    const Bounds3 box{{0, 0, 0}, Vec3{double(base.cells[0]), double(base.cells[1]),
-                                      double(base.cells[2])} * base.cell};
-    double lo = kInfinity, hi = -kInfinity;
-    for (const SceneObject& o : scene.objects) {
-        if (o.primitive != prim) continue;
-        const Bounds3 wb = o.xf.bounds(box);
-        const double r = 0.5 * length(wb.extent());
-        const double d = length(wb.center() - eye);
-        // Object units per world unit along a ray (rigid or uniformly scaled instances).
-        const double scale = 1 / std::cbrt(length(o.xf.vector({1, 0, 0})) *
-                                           length(o.xf.vector({0, 1, 0})) *
-                                           length(o.xf.vector({0, 0, 1})));
-        lo = std::min(lo, std::max(d - r, 1e-9) * spread * scale);
-        hi = std::max(hi, (d + r) * spread * scale);
-    }
-    return {lo, hi};
-}
 
 // The levels j (sigma^-1 = K 2^j) a primitive's instances need: from the level whose cell
 // matches the widest footprint to that of the narrowest.
@@ -107,6 +84,27 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
 }
 
 }  // namespace
+
+std::pair<double, double> footprint_range(const Scene& scene, int prim, const TableContext& base,
+                                          double spread) {
+    const Vec3 eye = scene.camera.eye;
+    const Bounds3 box{{0, 0, 0}, Vec3{double(base.cells[0]), double(base.cells[1]),
+                                      double(base.cells[2])} * base.cell};
+    double lo = kInfinity, hi = -kInfinity;
+    for (const SceneObject& o : scene.objects) {
+        if (o.primitive != prim) continue;
+        const Bounds3 wb = o.xf.bounds(box);
+        const double r = 0.5 * length(wb.extent());
+        const double d = length(wb.center() - eye);
+        // Object units per world unit along a ray (rigid or uniformly scaled instances).
+        const double scale = 1 / std::cbrt(length(o.xf.vector({1, 0, 0})) *
+                                           length(o.xf.vector({0, 1, 0})) *
+                                           length(o.xf.vector({0, 0, 1})));
+        lo = std::min(lo, std::max(d - r, 1e-9) * spread * scale);
+        hi = std::max(hi, (d + r) * spread * scale);
+    }
+    return {lo, hi};
+}
 
 SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const TableSpec& spec,
                              bool progress, const LatticeFiltering& filtering) {

@@ -39,6 +39,13 @@ struct LatticeFiltering {
 // Three levels, K to 4K: the next (8K) of the paper's hair would take 28 GB to build.
 inline constexpr int kMaxLodLevels = 3;
 
+// The narrowest and widest footprints (primitive units; spread: a pixel's angle) of the
+// camera's pixels on a primitive's instances, at the nearest and farthest points of their
+// lattice boxes (base: the lattice asked for). Empty (first > second) when it has no instance
+// of its own (only in CSG).
+std::pair<double, double> footprint_range(const Scene& scene, int prim, const TableContext& base,
+                                          double spread);
+
 // With filtering, spec's encoding must store coverage (Encoding::coverage; else InputError).
 SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const TableSpec& spec,
                              bool progress, const LatticeFiltering& filtering = {});
