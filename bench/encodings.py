@@ -58,7 +58,8 @@ def main():
                                    "peak_memory_bytes": e["peak_memory_bytes"], "psnr_db": None})
         # Every encoding point-sampled (--filter none: with the coverage encoding the default
         # filter would be smooth, with its levels of detail), then coverage with the default
-        # filter (smooth, levels sigma^-1 = 2 and 4 at these plates' distance) as its own row.
+        # filter (smooth: this hair, 19 parts, is answered from sub-rays, with one table) as
+        # its own row.
         for enc, filt, label in [(e, "none", e) for e in encodings()] + [
                 ("coverage", "smooth", "coverage smooth")]:
             img = os.path.join(work, f"{plate}-{enc}-{filt}.png")

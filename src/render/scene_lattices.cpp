@@ -51,7 +51,7 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     else if (lod)
         range = lod_range(scene, prim, base, filtering.spread);
     // Levels beyond the largest refinement or the pair budget are left out: the finest level
-    // within both then serves, with the primitive's crossings for rays that want finer. Level 0
+    // within both then serves the rays that want finer. Level 0
     // (the lattice asked for) is built whatever its size.
     const auto level_plan = [&](int j) {
         TableSpec level = spec;
