@@ -236,6 +236,15 @@ TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
     EXPECT_GT(outside, 20);  // rays whose lines miss the lattice box, answered by sub-rays
 }
 
+// A ray leaving a sheet skips its own lattice for the sheet's distance from the surface: with
+// the primitive's crossings, the sub-rays' widest footprint (points on the surface averaged
+// across it; in renders far less than the tables' 2 cells, so that strands shadow strands).
+TEST(FilteredCloseUps, SheetsOfThePrimitivesCrossingsSkipThemselvesForTheirWidthOnly) {
+    const HookLattice h = hook_lattice();
+    EXPECT_EQ(h.exact->surface_tolerance(), kExactWidth);
+    EXPECT_EQ(h.tables_only->surface_tolerance(), 2 * kFine.cell);
+}
+
 // A ray's direction need not be a unit vector in the primitive's frame (scaled instances): the
 // footprint scales with it, so twice the direction and half the footprint is the same ray and
 // footprint, answered at half the parameter.
