@@ -86,6 +86,8 @@ double lod_blend(double f, double band);
 // 3 x 3 sub-rays: Plates 4 and 5 39.21 and 40.49 dB in 281 and 510 ms; one (point sampling)
 // 32.68 and 35.00 dB. docs/filtering.md, "The primitive's own crossings".
 inline constexpr int kExactSubRays = 2;
+// How far from a ray its farthest sub-ray lies, for a footprint this wide.
+double farthest_sub_ray(double width);
 // Primitives whose exact intersection costs more than this many simple tests
 // (Shape::intersect_cost) are answered by their tables: a chain tests part after part, 4 times
 // a ray, which is what the lattice of a tuft of 2,000 parts is there to spare. The ball of
