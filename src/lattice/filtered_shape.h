@@ -71,20 +71,20 @@ double lod_blend(double f, double band);
 // tables in less time, at every footprint tried. 1 spp, 2 threads, ms and PSNR against exact
 // ground truth (256 spp; 64 for the bunny and grass), on Plates 2 / 3 / 4 / 5, the furry bunny,
 // grass, and Plates 5 and 4 at 128^2 (their hairs a few pixels long, read from the tables'
-// coarsest level):
-//     sub-rays (kept)           133 / 37 / 236 / 402 / 857 / 977 / 247 / 66 ms
-//                               47.25 / 53.14 / 38.29 / 40.12 / 32.71 / 37.43 / 35.75 / 33.69 dB
+// coarsest level); one run of the final code, the tables' row from an earlier one that day:
+//     sub-rays (kept)           118 / 35 / 203 / 313 / 734 / 893 / 147 / 42 ms
+//                               47.25 / 53.15 / 38.28 / 40.12 / 32.90 / 37.43 / 35.80 / 33.75 dB
 //     tables, with half the     238 / 39 / 439 / 934 / 1720 / 2103 / 480 / 106 ms
 //     sub-rays' weight blended  45.98 / 51.64 / 39.35 / 40.33 / 33.01 / 38.45 / 35.95 / 34.09 dB
 //     in (camera rays) and one
 //     crossing past the finest
 //     table (shadow rays)
-//     exact, 4 spp              160 / 94 / 240 / 293 / 377 / 236 / 22 / 18 ms
+//     exact, 4 spp              163 / 89 / 237 / 289 / 371 / 228 / 22 / 25 ms
 //                               44.45 / 52.81 / 36.92 / 39.46 / 30.97 / 35.65 / 33.82 / 31.68 dB
 // Shadow rays through the tables cost most of the difference: with the camera rays on
 // sub-rays, tables for shadows took Plates 4 and 5 331 and 628 ms for 38.52 and 40.10 dB.
 // 3 x 3 sub-rays: Plates 4 and 5 39.21 and 40.49 dB in 281 and 510 ms; one (point sampling)
-// 32.68 and 35.00 dB. docs/filtering.md, "The primitive's own crossings".
+// 32.68 and 35.00 dB. docs/filtering.md, "The primitive's own crossings, for every ray".
 inline constexpr int kExactSubRays = 2;
 // How far from a ray its farthest sub-ray lies, for a footprint this wide.
 double farthest_sub_ray(double width);
