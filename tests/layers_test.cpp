@@ -11,6 +11,7 @@
 #include <random>
 
 #include "accel/embree_accel.h"
+#include "geometry/sub_rays.h"
 #include "render/shading.h"
 
 namespace lat {
@@ -139,6 +140,37 @@ double specular_integral(double normal_length) {
                std::sin(theta) * (M_PI / 2) / steps;
     }
     return sum;
+}
+
+// Partial crossings compose: without sub-rays as independent draws (what is left is the
+// product of 1 - coverage, in any order); with sub-rays as the sub-rays themselves (a sub-ray
+// blocked once is not blocked again, and a ray whose sub-rays are all blocked is covered).
+TEST(Layers, CrossingsWithSubRaysBlockEachSubRayOnce) {
+    LayerComposite c;
+    EXPECT_EQ(c.left(), 1.0);
+    EXPECT_DOUBLE_EQ(c.add(0.5, 0b0011), 0.5);
+    EXPECT_DOUBLE_EQ(c.add(0.5, 0b0011), 0.0);  // the same sub-rays: nothing new
+    EXPECT_DOUBLE_EQ(c.add(0.5, 0b0110), 0.5);  // one of the two left
+    EXPECT_DOUBLE_EQ(c.left(), 0.25);
+    EXPECT_DOUBLE_EQ(c.add(0.5, 0), 0.5);  // no sub-rays: half of what is left
+    EXPECT_DOUBLE_EQ(c.left(), 0.125);
+    EXPECT_DOUBLE_EQ(c.add(0.25, 0b1000), 1.0);
+    EXPECT_EQ(c.left(), 0.0);
+    EXPECT_EQ(c.add(0.5, 0), 1.0);  // nothing left to cover
+
+    // Any order, the same left.
+    const std::vector<std::pair<double, std::uint8_t>> layers{
+        {0.3, 0}, {0.5, 0b0101}, {0.25, 0b0001}, {0.6, 0}, {0.5, 0b1100}};
+    std::vector<int> order(layers.size());
+    std::iota(order.begin(), order.end(), 0);
+    double first = -1;
+    do {
+        LayerComposite d;
+        for (const int i : order) d.add(layers[i].first, layers[i].second);
+        if (first < 0) first = d.left();
+        EXPECT_NEAR(d.left(), first, 1e-15);
+    } while (std::next_permutation(order.begin(), order.end()));
+    EXPECT_NEAR(first, 0.7 * 0.4 * 0.25, 1e-15);
 }
 
 TEST(Layers, AMeanNormalWidensTheSpecularLobeKeepingItsLight) {

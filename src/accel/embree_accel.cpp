@@ -1,5 +1,7 @@
 #include "accel/embree_accel.h"
 
+#include "geometry/sub_rays.h"
+
 #include <embree3/rtcore.h>
 
 #include <algorithm>
@@ -29,6 +31,19 @@ float float_above(double t) {
     return static_cast<double>(f) > t ? f : next_up(f);
 }
 
+// The directions across the ray being traced, in an object's space.
+AcrossRay across_in_object(const Transform& xf) {
+    AcrossRay a = across_ray();
+    if (a.set && !xf.is_identity()) a.u = xf.inverse_vector(a.u), a.v = xf.inverse_vector(a.v);
+    return a;
+}
+
+// The object-space ray for objects tested outside Embree, with the directions across it.
+Ray object_ray(const Transform& xf, const Ray& r) {
+    set_across_ray_in_object(across_in_object(xf));
+    return xf.is_identity() ? r : xf.inverse_ray(r);
+}
+
 // Partial crossings in ray order, ties by object: the same for any traversal order.
 bool in_ray_order(const AccelHit& a, const AccelHit& b) {
     return a.t != b.t ? a.t < b.t : a.object < b.object;
@@ -55,7 +70,7 @@ struct QueryContext {
     // on the order they are met in).
     std::vector<AccelHit>* partial = nullptr;
     LayerStop stop;
-    double transmitted = 1;
+    LayerComposite transmitted;
     // A partial crossing met; whether it blocks a shadow ray. For camera rays the crossings are
     // kept in ray order and cut where compositing will stop (LayerStop), and tmax and the
     // traversal's tfar come down to the last one kept.
@@ -66,15 +81,15 @@ struct QueryContext {
             if (p.object == h.object) return false;
         if (stop.blocked_below > 0) {
             partial->push_back(h);
-            transmitted *= 1.0 - double(h.crossing.coverage);
-            return transmitted < stop.blocked_below;
+            transmitted.add(h.crossing);
+            return transmitted.left() < stop.blocked_below;
         }
         partial->insert(std::upper_bound(partial->begin(), partial->end(), h, in_ray_order), h);
         if (stop.max_layers <= 0) return false;
-        double left = 1;
+        LayerComposite seen;
         for (std::size_t i = 0; i < partial->size(); ++i) {
-            left *= 1.0 - double((*partial)[i].crossing.coverage);
-            if (static_cast<int>(i) + 1 == stop.max_layers || left <= stop.min_left) {
+            seen.add((*partial)[i].crossing);
+            if (static_cast<int>(i) + 1 == stop.max_layers || seen.left() <= stop.min_left) {
                 partial->resize(i + 1);
                 tmax = std::min(tmax, partial->back().t);
                 tfar = std::min(tfar, float_above(tmax));
@@ -86,6 +101,7 @@ struct QueryContext {
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;
+    AcrossRay cached_across;
     // Objects culled by several parts that this query has already tested: a second part of
     // the same object can add nothing (its answer for a shorter range is no closer). A small
     // ring; an object that falls out of it is merely tested again.
@@ -210,11 +226,14 @@ struct EmbreeAccel::Impl {
         return tol > 0 ? ctx->tmin + tol / length(local.d) : ctx->tmin;
     }
 
+    // The object-space ray, and (geometry/sub_rays.h) the directions across it handed on.
     const Ray& local_ray(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->cached_obj != obj) {
             ctx->cached_obj = obj;
             ctx->cached_local = objects[obj].xf->inverse_ray(ctx->ray);
+            ctx->cached_across = across_in_object(*objects[obj].xf);
         }
+        set_across_ray_in_object(ctx->cached_across);
         return ctx->cached_local;
     }
 
@@ -430,7 +449,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
-        const Ray local = o.xf->is_identity() ? r : o.xf->inverse_ray(r);
+        const Ray local = object_ray(*o.xf, r);
         Crossing c;
         if (o.shape->intersect(local, tmin, ctx.found ? hit.t : tmax, c)) {
             ctx.found = true;
@@ -456,7 +475,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;
         const AccelObject& o = m.objects[i];
-        const Ray local = o.xf->is_identity() ? r : o.xf->inverse_ray(r);
+        const Ray local = object_ray(*o.xf, r);
         Crossing c;
         const double t1 = ctx.found ? std::min(hit.t, ctx.tmax) : ctx.tmax;
         if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), t1, c)) continue;
@@ -483,7 +502,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     ctx.self = self;
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
-        const Ray local = o.xf->is_identity() ? r : o.xf->inverse_ray(r);
+        const Ray local = object_ray(*o.xf, r);
         if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) return true;
     }
 

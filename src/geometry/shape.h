@@ -83,6 +83,9 @@ struct Crossing {
     std::uint32_t part = 0;
     std::uint32_t leaf = 0;
     bool has_stored = false;
+    // Of the ray's sub-rays (geometry/sub_rays.h), bit k when the k-th meets the surface here,
+    // where the coverage is their share; 0 otherwise. (In the padding, as coverage.)
+    std::uint8_t sub_rays = 0;
     // The share of the rays around this one that meet the surface here (prefiltered lattices,
     // issue 10: a partial hit lets the rest of the ray go on behind it); 1 for every exact shape.
     // (In the padding after has_stored: a Crossing is no larger for it.)

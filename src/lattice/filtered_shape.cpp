@@ -5,6 +5,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "geometry/sub_rays.h"
+
 namespace lat {
 namespace {
 
@@ -211,9 +213,13 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     // Blends of full pairs round to just under 1: they are opaque (and end the ray's traversal).
     const float coverage = s.alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(s.alpha);
     const Vec3 facing = -r.d / std::sqrt(dd);
+    // The sub-rays of a ray whose directions across are the world's compose with the other
+    // lattices' (LayerComposite); otherwise the coverage alone, as the tables'.
+    const std::uint8_t sub_rays = exact_ && across_ray_in_object().set ? s.sub_rays : 0;
     if (!normal) {
         hit = Crossing(t, 0, SurfacePoint{p, facing});
         hit.coverage = coverage;
+        hit.sub_rays = sub_rays;
         return true;
     }
     // The normal is the coverage-weighted mean of unit normals, left unnormalised: its length
@@ -231,6 +237,7 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     }
     hit = Crossing(t, 0, SurfacePoint{p, length(n) > 0 ? n : facing});
     hit.coverage = coverage;
+    hit.sub_rays = sub_rays;
     return true;
 }
 
@@ -281,8 +288,15 @@ void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, d
 void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, double tmin,
                                      double tmax, Sheet& s) const {
     constexpr int n = kExactSubRays;
+    // Along the world's directions across the ray where the renderer set them, so that the
+    // k-th sub-ray is the same in every lattice (geometry/sub_rays.h).
+    const AcrossRay& across = across_ray_in_object();
     Vec3 u, v;
-    orthonormal_basis(r.d / length(r.d), u, v);
+    if (across.set) {
+        u = normalize(across.u), v = normalize(across.v);
+    } else {
+        orthonormal_basis(r.d / length(r.d), u, v);
+    }
     constexpr double w = 1.0 / (n * n);
     // A union's sub-rays meet only parts near r: found once, with boxes grown by the farthest
     // sub-ray's distance from r, at least its offset along any axis. Plates 4 and 5 render 6 %
@@ -298,10 +312,11 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
             const Ray sub{r.o + u * a + v * b, r.d};
             double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
             if (!clip_ray(point_.bounds(), sub, t0, t1)) continue;
+            const auto bit = static_cast<std::uint8_t>(1u << (i * n + j));
             if (!normal) {
                 t1 = std::min(t1, tmax);
                 if (t0 < t1 && blocked(parts, sub, t0, t1))
-                    s.add_opaque(w, sub.at(0.5 * (t0 + t1)), {});
+                    s.add_opaque(w, sub.at(0.5 * (t0 + t1)), {}), s.sub_rays |= bit;
                 continue;
             }
             Crossing c;
@@ -309,6 +324,7 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
             const SurfacePoint sp = primitive_->surface(sub, c);
             const double ln = length(sp.n);
             s.add_opaque(w, sp.p, ln > 0 ? sp.n / ln : Vec3{});
+            s.sub_rays |= bit;
         }
 }
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "geometry/chain.h"
+#include "geometry/sub_rays.h"
 #include "lattice/hit_table_shape.h"
 #include "lattice/part_boxes.h"
 
@@ -86,6 +87,7 @@ double lod_blend(double f, double band);
 // 3 x 3 sub-rays: Plates 4 and 5 39.21 and 40.49 dB in 281 and 510 ms; one (point sampling)
 // 32.68 and 35.00 dB. docs/filtering.md, "The primitive's own crossings, for every ray".
 inline constexpr int kExactSubRays = 2;
+static_assert(kExactSubRays * kExactSubRays == kSubRays);
 // How far from a ray its farthest sub-ray lies, for a footprint this wide.
 double farthest_sub_ray(double width);
 // Primitives whose exact intersection costs more than this many simple tests
@@ -156,6 +158,7 @@ private:
     struct Sheet {
         double alpha = 0;
         Vec3 p, n;
+        std::uint8_t sub_rays = 0;  // add_exact's: which sub-rays met the primitive
         void add(double w, const CoverageHit& h, const Vec3& p_prim) {
             alpha += w * h.alpha;
             p += p_prim * (w * h.alpha);

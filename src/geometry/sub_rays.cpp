@@ -1,0 +1,27 @@
+#include "geometry/sub_rays.h"
+
+#include <bit>
+
+namespace lat {
+namespace {
+
+thread_local AcrossRay t_world, t_object;
+
+}  // namespace
+
+void set_across_ray(const AcrossRay& world) { t_world = world; }
+const AcrossRay& across_ray() { return t_world; }
+const AcrossRay& across_ray_in_object() { return t_object; }
+void set_across_ray_in_object(const AcrossRay& in_object) { t_object = in_object; }
+
+double LayerComposite::add(double coverage, std::uint8_t sub_rays) {
+    const double before = left();
+    if (sub_rays == 0) {
+        free_ *= 1.0 - coverage;
+    } else {
+        covered_ |= sub_rays;
+    }
+    return before > 0 ? 1.0 - left() / before : 1.0;
+}
+
+}  // namespace lat

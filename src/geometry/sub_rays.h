@@ -1,0 +1,54 @@
+#pragma once
+// Sub-rays: a filtered lattice answered by its primitive's crossings (lattice/filtered_shape.h)
+// offsets kSubRays rays across a ray's footprint and reports which of them met it
+// (Crossing::sub_rays). Where every lattice offsets them along the same world directions, the
+// k-th sub-ray is one ray from object to object, so the partial crossings of a ray compose as
+// its sub-rays' own would: a sub-ray blocked by one crossing is not blocked again by the next
+// (LayerComposite). Offsets along each object's own axes (as the first version did) made the
+// crossings independent draws, and a stack of them let through or covered the wrong share.
+#include <bit>
+#include <cstdint>
+
+#include "geometry/shape.h"
+
+namespace lat {
+
+inline constexpr int kSubRays = 4;  // a 2 x 2 grid
+inline constexpr std::uint8_t kAllSubRays = (1u << kSubRays) - 1;
+
+// The directions across a ray along which its sub-rays are offset: unit, perpendicular to the
+// ray and to each other, in world space as the renderer set them (`set`: whether it did), and
+// in the space of the object being tested, as the accelerator hands them on per object (its
+// inverse transform applied; no longer unit under a scaled instance).
+struct AcrossRay {
+    Vec3 u, v;
+    bool set = false;
+};
+void set_across_ray(const AcrossRay& world);
+const AcrossRay& across_ray();
+// The accelerator: before testing an object, its own copy (the world one's directions through
+// the object's inverse linear map, when set).
+void set_across_ray_in_object(const AcrossRay& in_object);
+const AcrossRay& across_ray_in_object();
+
+// Partial crossings of one ray composed: what is left of it after each, front to back (camera
+// rays), or in any order (a shadow ray's transmittance, which does not depend on it).
+// Crossings without sub-rays are taken as independent of the rest; those with sub-rays block
+// only sub-rays not blocked already.
+class LayerComposite {
+public:
+    // The share of what was left that a crossing of this coverage and these sub-rays
+    // (Crossing::sub_rays) covers, and adds it.
+    double add(double coverage, std::uint8_t sub_rays);
+    double add(const Crossing& c) { return add(double(c.coverage), c.sub_rays); }
+    // The share of the ray left.
+    double left() const {
+        return free_ * double(kSubRays - std::popcount(unsigned(covered_))) / kSubRays;
+    }
+
+private:
+    double free_ = 1;            // the product of (1 - coverage) of crossings without sub-rays
+    std::uint8_t covered_ = 0;  // the sub-rays blocked
+};
+
+}  // namespace lat
