@@ -66,8 +66,8 @@ struct QueryContext {
     bool found = false;
     std::uint32_t self = EmbreeAccel::kNoObject;  // occlusion: the object the ray leaves
     // intersect_layers: where crossings of partial coverage go (they do not end the ray), how
-    // far to look, and for shadow rays the product of their 1 - coverage (which does not depend
-    // on the order they are met in).
+    // far to look, and for shadow rays what they let through (LayerComposite, which does not
+    // depend on the order they are met in).
     std::vector<AccelHit>* partial = nullptr;
     LayerStop stop;
     LayerComposite transmitted;

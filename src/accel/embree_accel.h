@@ -43,7 +43,7 @@ struct LayerStop {
     // closest crossing; only "blocked" is meant). 0: not a shadow ray.
     double blocked_below = 0;
     // Camera rays, composited front to back: the first max_layers partial crossings, or
-    // those up to where the product of their (1 - coverage) falls to min_left or below,
+    // those up to where what they leave (LayerComposite) falls to min_left or below,
     // are all that is seen; the traversal looks no farther. max_layers 0: no limit.
     int max_layers = 0;
     double min_left = 0;

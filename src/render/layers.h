@@ -2,17 +2,20 @@
 // Tracing through prefiltered lattices (issue 10): a lattice answers a ray with a sheet of
 // coverage alpha < 1 (SurfaceHit::alpha), so a ray is traced front to back: each surface met
 // adds alpha of its shade, weighted by what is still uncovered, and the ray goes on behind it.
-// Shadow rays likewise get the transmittance prod (1 - alpha) of what they cross instead of a
-// yes/no. Exact shapes have alpha = 1, so a scene without lattices shades as shade() does.
+// Shadow rays likewise get the transmittance of what they cross instead of a yes/no. What is
+// left of a ray is composed by LayerComposite (geometry/sub_rays.h): sheets of sub-rays block
+// each sub-ray once, the tables' sheets are independent draws (the product of 1 - alpha).
+// Exact shapes have alpha = 1, so a scene without lattices shades as shade() does.
 #include "render/render_scene.h"
 #include "render/shading.h"
 
 namespace lat {
 
 // Partial surfaces shaded along a camera ray, at most: the last one is taken as opaque. A
-// pixel's share left behind eight hairs of coverage 1/2 is 1/256, under an 8-bit step; deeper
-// stacks of partial sheets are rare (the edges of overlapping hairs). One traversal finds them
-// all (EmbreeAccel::intersect_layers).
+// pixel's share left behind eight tables' sheets of coverage 1/2 is 1/256, under an 8-bit
+// step; deeper stacks of partial sheets are rare (the edges of overlapping hairs), and sheets
+// of 4 sub-rays end a ray after 4 at most. One traversal finds them all
+// (EmbreeAccel::intersect_layers).
 inline constexpr int kMaxLayers = 8;
 // Below this share left uncovered, the rest of a ray is not traced.
 inline constexpr double kMinTransmittance = 1.0 / 1024;
