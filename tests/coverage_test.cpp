@@ -430,7 +430,12 @@ Image8 render_turned_copies(const std::string& copies) {
     const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
     RenderOptions opt;
     opt.layered = true;
-    return render_image(rs, opt).display;
+    const Image8 image = render_image(rs, opt).display;
+    // The same bytes on one thread (the directions across are per ray, not per thread).
+    Image8 one;
+    tbb::task_arena(1).execute([&] { one = render_image(rs, opt).display; });
+    EXPECT_EQ(one.rgb, image.rgb);
+    return image;
 }
 
 TEST(Coverage, TurnedCopiesOfABeadRenderAsOne) {

@@ -157,6 +157,7 @@ TEST(Layers, CrossingsWithSubRaysBlockEachSubRayOnce) {
     EXPECT_DOUBLE_EQ(c.add(0.25, 0b1000), 1.0);
     EXPECT_EQ(c.left(), 0.0);
     EXPECT_EQ(c.add(0.5, 0), 1.0);  // nothing left to cover
+    EXPECT_EQ(c.draws(), 2);        // crossings without sub-rays: what a layer limit counts
 
     // Any order, the same left.
     const std::vector<std::pair<double, std::uint8_t>> layers{
@@ -171,6 +172,54 @@ TEST(Layers, CrossingsWithSubRaysBlockEachSubRayOnce) {
         EXPECT_NEAR(d.left(), first, 1e-15);
     } while (std::next_permutation(order.begin(), order.end()));
     EXPECT_NEAR(first, 0.7 * 0.4 * 0.25, 1e-15);
+}
+
+// A shape that records the directions across the ray the accelerator handed it.
+class Probe final : public Shape {
+public:
+    Bounds3 bounds() const override { return {{-1, -1, -1}, {1, 1, 1}}; }
+    bool intersect(const Ray& r, double, double, Crossing&) const override {
+        seen = across_ray_in_object();
+        local_d = r.d;
+        return false;
+    }
+    void spans(const Ray&, SpanList&) const override {}
+    Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
+    bool inside(Vec3) const override { return false; }
+    mutable AcrossRay seen;
+    mutable Vec3 local_d;
+};
+
+// The accelerator hands an object the world's directions across the ray in its own space
+// where its map is a similarity (turned and evenly scaled: still across the ray, as long as
+// its direction), and none where it is not (sheared or unevenly scaled); outside a scope, none.
+TEST(Layers, ObjectsGetTheDirectionsAcrossTheRayInTheirSpace) {
+    const Probe probe;
+    const Ray r{{0.3, -0.2, -5}, normalize(Vec3{0.1, 0.2, 1})};
+    const auto handed = [&](const Transform& xf) {
+        const std::vector<AccelObject> objects{{&probe, &xf}};
+        const EmbreeAccel accel(objects);
+        AccelHit hit;
+        probe.seen = {};
+        accel.intersect(r, 0.0, kInfinity, hit);
+        return probe.seen;
+    };
+    const Transform similar = Transform::rotate({1, 2, 3}, 0.7) * Transform::scale({3, 3, 3});
+    const Transform uneven = Transform::scale({1, 1.01, 1});
+    {
+        const ScopedAcrossRay across(r.d);
+        const AcrossRay world = across_ray();
+        const AcrossRay a = handed(similar);
+        ASSERT_TRUE(a.set);
+        EXPECT_NEAR(length(similar.vector(a.u) - world.u), 0.0, 1e-12);
+        EXPECT_NEAR(length(similar.vector(a.v) - world.v), 0.0, 1e-12);
+        EXPECT_NEAR(dot(a.u, probe.local_d), 0.0, 1e-12);
+        EXPECT_NEAR(length(a.u), length(probe.local_d), 1e-12);
+        EXPECT_FALSE(handed(uneven).set);
+        EXPECT_TRUE(handed(Transform{}).set);
+    }
+    EXPECT_FALSE(across_ray().set);
+    EXPECT_FALSE(across_ray_in_object().set);
 }
 
 TEST(Layers, AMeanNormalWidensTheSpecularLobeKeepingItsLight) {

@@ -31,16 +31,31 @@ float float_above(double t) {
     return static_cast<double>(f) > t ? f : next_up(f);
 }
 
-// The directions across the ray being traced, in an object's space.
-AcrossRay across_in_object(const Transform& xf) {
+// Whether a map keeps the directions across a ray across it and as long as its direction (a
+// similarity: turned and evenly scaled), within 1e-3 (scenes give rotations to 6 digits). A
+// sheared or unevenly scaled object offsets its sub-rays along its own directions
+// (geometry/sub_rays.h).
+bool keeps_directions_across(const Transform& xf) {
+    const Vec3 c[3] = {xf.vector({1, 0, 0}), xf.vector({0, 1, 0}), xf.vector({0, 0, 1})};
+    const double s2 = dot(c[0], c[0]), tol = 1e-3 * s2;
+    return std::abs(dot(c[1], c[1]) - s2) <= tol && std::abs(dot(c[2], c[2]) - s2) <= tol &&
+           std::abs(dot(c[0], c[1])) <= tol && std::abs(dot(c[0], c[2])) <= tol &&
+           std::abs(dot(c[1], c[2])) <= tol;
+}
+
+// The directions across the ray being traced, in an object's space (unset where its map does
+// not keep them, `similar`).
+AcrossRay across_in_object(const Transform& xf, bool similar) {
     AcrossRay a = across_ray();
-    if (a.set && !xf.is_identity()) a.u = xf.inverse_vector(a.u), a.v = xf.inverse_vector(a.v);
+    if (!a.set || xf.is_identity()) return a;
+    a.set = similar;
+    if (similar) a.u = xf.inverse_vector(a.u), a.v = xf.inverse_vector(a.v);
     return a;
 }
 
 // The object-space ray for objects tested outside Embree, with the directions across it.
-Ray object_ray(const Transform& xf, const Ray& r) {
-    set_across_ray_in_object(across_in_object(xf));
+Ray object_ray(const Transform& xf, bool similar, const Ray& r) {
+    set_across_ray_in_object(across_in_object(xf, similar));
     return xf.is_identity() ? r : xf.inverse_ray(r);
 }
 
@@ -89,7 +104,7 @@ struct QueryContext {
         LayerComposite seen;
         for (std::size_t i = 0; i < partial->size(); ++i) {
             seen.add((*partial)[i].crossing);
-            if (static_cast<int>(i) + 1 == stop.max_layers || seen.left() <= stop.min_left) {
+            if (seen.draws() == stop.max_layers || seen.left() <= stop.min_left) {
                 partial->resize(i + 1);
                 tmax = std::min(tmax, partial->back().t);
                 tfar = std::min(tfar, float_above(tmax));
@@ -190,6 +205,7 @@ struct EmbreeAccel::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<AccelObject> objects;
+    std::vector<bool> similar;  // per object: keeps_directions_across
     // The top-level user geometry of single-part objects: one primitive per cull part
     // (Shape::cull_count).
     struct DirectPrim {
@@ -231,7 +247,7 @@ struct EmbreeAccel::Impl {
         if (ctx->cached_obj != obj) {
             ctx->cached_obj = obj;
             ctx->cached_local = objects[obj].xf->inverse_ray(ctx->ray);
-            ctx->cached_across = across_in_object(*objects[obj].xf);
+            ctx->cached_across = across_in_object(*objects[obj].xf, similar[obj]);
         }
         set_across_ray_in_object(ctx->cached_across);
         return ctx->cached_local;
@@ -378,6 +394,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.objects.assign(objects.begin(), objects.end());
+    for (const AccelObject& o : m.objects) m.similar.push_back(keeps_directions_across(*o.xf));
     m.device = rtcNewDevice(nullptr);
     if (!m.device) throw std::runtime_error("Embree: cannot create a device");
     rtcSetDeviceErrorFunction(m.device, on_embree_error, &m);
@@ -449,7 +466,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
-        const Ray local = object_ray(*o.xf, r);
+        const Ray local = object_ray(*o.xf, m.similar[i], r);
         Crossing c;
         if (o.shape->intersect(local, tmin, ctx.found ? hit.t : tmax, c)) {
             ctx.found = true;
@@ -475,7 +492,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;
         const AccelObject& o = m.objects[i];
-        const Ray local = object_ray(*o.xf, r);
+        const Ray local = object_ray(*o.xf, m.similar[i], r);
         Crossing c;
         const double t1 = ctx.found ? std::min(hit.t, ctx.tmax) : ctx.tmax;
         if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), t1, c)) continue;
@@ -502,7 +519,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     ctx.self = self;
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
-        const Ray local = object_ray(*o.xf, r);
+        const Ray local = object_ray(*o.xf, m.similar[i], r);
         if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) return true;
     }
 

@@ -42,8 +42,9 @@ struct LayerStop {
     // one is met, the ray is blocked and the traversal ends at once (`hit` is then no
     // closest crossing; only "blocked" is meant). 0: not a shadow ray.
     double blocked_below = 0;
-    // Camera rays, composited front to back: the first max_layers partial crossings, or
-    // those up to where what they leave (LayerComposite) falls to min_left or below,
+    // Camera rays, composited front to back: the partial crossings up to the max_layers-th
+    // without sub-rays (LayerComposite::draws), or to where what they leave falls to min_left
+    // or below,
     // are all that is seen; the traversal looks no farther. max_layers 0: no limit.
     int max_layers = 0;
     double min_left = 0;

@@ -84,7 +84,7 @@ void CsgShape::set_root(int ref) {
     compute_bounds(root_);
     tolerance_ = 0;
     for (const Leaf& l : leaves_) {
-        const double t = l.leaf.shape->surface_tolerance();
+        const double t = l.leaf.shape->span_tolerance();
         if (t == 0) continue;
         tolerance_ = std::max(tolerance_, t * l.leaf.xf.max_stretch());
     }

@@ -130,6 +130,9 @@ public:
     // Shadow rays leaving a surface point of this shape ignore this shape's crossings closer
     // than this (object units): zero for exact shapes, the table error for lattices.
     virtual double surface_tolerance() const { return 0.0; }
+    // The same for the points of its spans, which a CSG tree with this shape as a leaf answers
+    // with (they can come from elsewhere than its intersect's: a filtered lattice's).
+    virtual double span_tolerance() const { return surface_tolerance(); }
     // Whether p is inside the solid (boundary counts as either).
     virtual bool inside(Vec3 p) const = 0;
     // Whether c's part (and CSG leaf) name a surface of this shape, so that normal() may be

@@ -1,6 +1,5 @@
 #include "geometry/sub_rays.h"
 
-#include <bit>
 
 namespace lat {
 namespace {
@@ -10,6 +9,18 @@ thread_local AcrossRay t_world, t_object;
 }  // namespace
 
 void set_across_ray(const AcrossRay& world) { t_world = world; }
+
+ScopedAcrossRay::ScopedAcrossRay(Vec3 unit_direction) : previous_(t_world) {
+    AcrossRay a;
+    orthonormal_basis(unit_direction, a.u, a.v);
+    a.set = true;
+    t_world = a;
+}
+
+ScopedAcrossRay::~ScopedAcrossRay() {
+    t_world = previous_;
+    t_object = {};
+}
 const AcrossRay& across_ray() { return t_world; }
 const AcrossRay& across_ray_in_object() { return t_object; }
 void set_across_ray_in_object(const AcrossRay& in_object) { t_object = in_object; }
@@ -18,6 +29,7 @@ double LayerComposite::add(double coverage, std::uint8_t sub_rays) {
     const double before = left();
     if (sub_rays == 0) {
         free_ *= 1.0 - coverage;
+        ++draws_;
     } else {
         covered_ |= sub_rays;
     }

@@ -26,8 +26,22 @@ struct AcrossRay {
 };
 void set_across_ray(const AcrossRay& world);
 const AcrossRay& across_ray();
+// Sets the directions across a ray (unit direction) for a scope: the previous ones after it,
+// and no object copy (so that a shape tested directly, outside a traversal, never sees a
+// stale one).
+class ScopedAcrossRay {
+public:
+    explicit ScopedAcrossRay(Vec3 unit_direction);
+    ~ScopedAcrossRay();
+    ScopedAcrossRay(const ScopedAcrossRay&) = delete;
+    ScopedAcrossRay& operator=(const ScopedAcrossRay&) = delete;
+
+private:
+    AcrossRay previous_;
+};
 // The accelerator: before testing an object, its own copy (the world one's directions through
-// the object's inverse linear map, when set).
+// the object's inverse linear map, when set and when the map keeps them across the ray and as
+// long as it, a similarity, within 1e-3; else unset, and the object uses its own directions).
 void set_across_ray_in_object(const AcrossRay& in_object);
 const AcrossRay& across_ray_in_object();
 
@@ -45,10 +59,15 @@ public:
     double left() const {
         return free_ * double(kSubRays - std::popcount(unsigned(covered_))) / kSubRays;
     }
+    // How many crossings without sub-rays were added: what a limit on the layers of a ray
+    // counts (one with sub-rays that blocks none not blocked already adds nothing, and all its
+    // sub-rays blocked end a ray).
+    int draws() const { return draws_; }
 
 private:
     double free_ = 1;            // the product of (1 - coverage) of crossings without sub-rays
     std::uint8_t covered_ = 0;  // the sub-rays blocked
+    int draws_ = 0;
 };
 
 }  // namespace lat

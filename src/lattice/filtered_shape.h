@@ -147,6 +147,9 @@ public:
     double surface_tolerance() const override {
         return exact_ ? exact_width_ : 2.0 * levels_.front().frame.cell();
     }
+    // Spans are point_'s, point-sampled from a table: its sheets' 2 cells (of the coarsest
+    // level, as for every filtered lattice before sub-rays).
+    double span_tolerance() const override { return 2.0 * levels_.front().frame.cell(); }
 
 private:
     struct Level {

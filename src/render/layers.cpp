@@ -22,14 +22,6 @@ double shadow_width(const Ray& ray, const SurfaceHit& hit, const Ray& shadow, do
     return width * std::clamp(std::sqrt(cl / cv), 1 / kMaxShadowWidening, kMaxShadowWidening);
 }
 
-// Sub-rays along the same world directions in every lattice the ray meets (geometry/sub_rays.h).
-void set_across(const Ray& r) {
-    AcrossRay a;
-    orthonormal_basis(normalize(r.d), a.u, a.v);
-    a.set = true;
-    set_across_ray(a);
-}
-
 // Radiance at a layer; `width`: its footprint (world units), which picks the lattices' levels
 // of detail for its shadow rays, narrowing to the point light.
 Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, double width,
@@ -37,7 +29,6 @@ Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, d
     return shade_with(rs, ray, hit, counters, [&](const Ray& r, double tmin, double tmax, double dist) {
         const double w = shadow_width(ray, hit, r, width);
         set_ray_footprint({w, -w / dist, true});
-        set_across(r);
         return transmittance(rs, r, tmin, tmax, hit.object);
     });
 }
@@ -47,6 +38,8 @@ Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, d
 double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tmax,
                      std::uint32_t self) {
     thread_local std::vector<SurfaceHit> partial;
+    // Sub-rays along the same world directions in every lattice (geometry/sub_rays.h).
+    const ScopedAcrossRay across(normalize(r.d));
     SurfaceHit opaque;
     if (rs.intersect_layers(r, tmin, tmax, self, opaque, partial, {.blocked_below = kMinTransmittance}))
         return 0;
@@ -59,7 +52,7 @@ double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tm
 Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCounters& counters) {
     thread_local std::vector<SurfaceHit> partial;
     set_ray_footprint({0, spread});
-    set_across(ray);
+    const ScopedAcrossRay across(normalize(ray.d));
     SurfaceHit opaque;
     const bool found = rs.intersect_layers(ray, 0.0, kInfinity, EmbreeAccel::kNoObject, opaque, partial,
                                            {.max_layers = kMaxLayers, .min_left = kMinTransmittance});
@@ -70,10 +63,13 @@ Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCou
     for (std::size_t i = 0; i < layers.size(); ++i) {
         const SurfaceHit& h = layers[i];
         const double left = seen.left();
-        // A layer whose sub-rays were all blocked in front of it adds nothing (not shaded).
-        const double alpha = i + 1 == kMaxLayers ? 1.0 : seen.add(h.alpha, h.sub_rays);
+        // A layer whose sub-rays were all blocked in front of it adds nothing (not shaded);
+        // the last one counted (the traversal looked no farther) is taken as opaque.
+        double alpha = seen.add(h.alpha, h.sub_rays);
+        const bool last = h.sub_rays == 0 && seen.draws() == kMaxLayers;
+        if (last) alpha = 1;
         if (alpha > 0) c += shade_layer(rs, ray, h, spread * h.t, counters) * (left * alpha);
-        if (i + 1 == kMaxLayers || seen.left() <= kMinTransmittance) return c;
+        if (last || seen.left() <= kMinTransmittance) return c;
     }
     return c + (found ? shade_layer(rs, ray, opaque, spread * opaque.t, counters)
                       : rs.scene().background) * seen.left();

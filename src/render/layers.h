@@ -11,10 +11,11 @@
 
 namespace lat {
 
-// Partial surfaces shaded along a camera ray, at most: the last one is taken as opaque. A
-// pixel's share left behind eight tables' sheets of coverage 1/2 is 1/256, under an 8-bit
-// step; deeper stacks of partial sheets are rare (the edges of overlapping hairs), and sheets
-// of 4 sub-rays end a ray after 4 at most. One traversal finds them all
+// Partial surfaces without sub-rays (the tables') composited along a camera ray, at most: the
+// last one is taken as opaque. A pixel's share left behind eight sheets of coverage 1/2 is
+// 1/256, under an 8-bit step; deeper stacks of partial sheets are rare (the edges of
+// overlapping hairs). Sheets of sub-rays are not counted: at most 4 of them add something, and
+// once all 4 sub-rays are blocked the ray ends. One traversal finds them all
 // (EmbreeAccel::intersect_layers).
 inline constexpr int kMaxLayers = 8;
 // Below this share left uncovered, the rest of a ray is not traced.
