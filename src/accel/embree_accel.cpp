@@ -1,7 +1,5 @@
 #include "accel/embree_accel.h"
 
-#include "geometry/sub_rays.h"
-
 #include <embree3/rtcore.h>
 
 #include <algorithm>
@@ -14,6 +12,8 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+
+#include "geometry/sub_rays.h"
 
 namespace lat {
 namespace {

@@ -75,6 +75,8 @@ double lod_blend(double f, double band);
 // coarsest level); one run of the final code, the tables' row from an earlier one that day:
 //     sub-rays (kept)           118 / 35 / 203 / 313 / 734 / 893 / 147 / 42 ms
 //                               47.25 / 53.15 / 38.28 / 40.12 / 32.90 / 37.43 / 35.80 / 33.75 dB
+//       composed from lattice   120 / 42 / 197 / 300 / 593 / 449 / 56 / -- ms
+//       to lattice (sub_rays.h) 47.18 / 53.15 / 38.47 / 40.27 / 32.92 / 37.45 / 36.16 / -- dB
 //     tables, with half the     238 / 39 / 439 / 934 / 1720 / 2103 / 480 / 106 ms
 //     sub-rays' weight blended  45.98 / 51.64 / 39.35 / 40.33 / 33.01 / 38.45 / 35.95 / 34.09 dB
 //     in (camera rays) and one
