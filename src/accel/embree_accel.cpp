@@ -116,7 +116,6 @@ struct QueryContext {
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;
-    AcrossRay cached_across;
     // Objects culled by several parts that this query has already tested: a second part of
     // the same object can add nothing (its answer for a shorter range is no closer). A small
     // ring; an object that falls out of it is merely tested again.
@@ -242,14 +241,14 @@ struct EmbreeAccel::Impl {
         return tol > 0 ? ctx->tmin + tol / length(local.d) : ctx->tmin;
     }
 
-    // The object-space ray, and (geometry/sub_rays.h) the directions across it handed on.
+    // The object-space ray, and (geometry/sub_rays.h) the directions across it handed on. Both
+    // are set again only when the object changes: within one query nothing else sets them.
     const Ray& local_ray(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->cached_obj != obj) {
             ctx->cached_obj = obj;
             ctx->cached_local = objects[obj].xf->inverse_ray(ctx->ray);
-            ctx->cached_across = across_in_object(*objects[obj].xf, similar[obj]);
+            set_across_ray_in_object(across_in_object(*objects[obj].xf, similar[obj]));
         }
-        set_across_ray_in_object(ctx->cached_across);
         return ctx->cached_local;
     }
 

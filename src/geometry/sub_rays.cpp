@@ -1,14 +1,11 @@
 #include "geometry/sub_rays.h"
 
-
 namespace lat {
 namespace {
 
 thread_local AcrossRay t_world, t_object;
 
 }  // namespace
-
-void set_across_ray(const AcrossRay& world) { t_world = world; }
 
 ScopedAcrossRay::ScopedAcrossRay(Vec3 unit_direction) : previous_(t_world) {
     AcrossRay a;

@@ -14,7 +14,6 @@
 namespace lat {
 
 inline constexpr int kSubRays = 4;  // a 2 x 2 grid
-inline constexpr std::uint8_t kAllSubRays = (1u << kSubRays) - 1;
 
 // The directions across a ray along which its sub-rays are offset: unit, perpendicular to the
 // ray and to each other, in world space as the renderer set them (`set`: whether it did), and
@@ -24,7 +23,6 @@ struct AcrossRay {
     Vec3 u, v;
     bool set = false;
 };
-void set_across_ray(const AcrossRay& world);
 const AcrossRay& across_ray();
 // Sets the directions across a ray (unit direction) for a scope: the previous ones after it,
 // and no object copy (so that a shape tested directly, outside a traversal, never sees a

@@ -88,7 +88,7 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // bound; each ray by its own, cull_meets), and a ray whose line passes that close outside
     // the box can have sub-rays that enter it.
     assert(!exact_ || levels.size() == 1);
-    cull_level_ = exact_ ? 0 : std::min<std::size_t>(1, levels.size() - 1);
+    cull_level_ = std::min<std::size_t>(1, levels.size() - 1);
     for (std::size_t i = 0; i < levels.size(); ++i) {
         const FilterLevel& l = levels[i];
         const double reach = i != cull_level_ ? kInfinity

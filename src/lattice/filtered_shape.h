@@ -146,9 +146,7 @@ public:
     // half of it (the furry bunny 32.71, 32.90, 32.66 dB; Plate 3 52.98, 53.15, 53.04; Plates 2,
     // 4, 5 and grass within 0.05 dB). The tables' own sheets want their 2 cells (the tuft's
     // tables: 31.01 dB with 2 cells, 30.97 with 1, 30.55 with 1/2).
-    double surface_tolerance() const override {
-        return exact_ ? exact_width_ : 2.0 * levels_.front().frame.cell();
-    }
+    double surface_tolerance() const override { return exact_ ? exact_width_ : span_tolerance(); }
     // Spans are point_'s, point-sampled from a table: its sheets' 2 cells (of the coarsest
     // level, as for every filtered lattice before sub-rays).
     double span_tolerance() const override { return 2.0 * levels_.front().frame.cell(); }
