@@ -3,6 +3,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "geometry/ray_quad.h"
+
 namespace lat {
 
 CappedCylinderShape::CappedCylinderShape(Vec3 a, Vec3 b, double radius)
@@ -108,6 +110,95 @@ bool CappedCylinderShape::inside(Vec3 p) const {
     const Vec3 w = p - a_;
     const double wa = dot(w, axis_);
     return wa >= 0.0 && wa <= len_ && length_squared(w - axis_ * wa) <= r_ * r_;
+}
+
+namespace {
+
+// Lanes of solve()'s crossings in and out, with their surfaces (as doubles).
+struct QuadSpan {
+    quad::V tin, tout, pin, pout;
+};
+
+// solve() for lanes h, h + 1 of q: the lanes where the line meets the cylinder, and their
+// span. What depends on the direction alone, shared by the lanes, is tested once.
+quad::V solve_pair(const RayQuad& q, int h, Vec3 a, Vec3 axis, double len, double radius,
+                          QuadSpan& span) {
+    using namespace quad;
+    const V3 w = origins_minus(q, h, a);
+    const V wa = dot(w, axis);
+    const double da = dot(q.d, axis);
+    const V3 wp{w.x - splat(axis.x) * wa, w.y - splat(axis.y) * wa, w.z - splat(axis.z) * wa};
+    const Vec3 dp = q.d - axis * da;
+    V met = all_lanes();
+
+    // Slab between the two end planes.
+    V s0 = splat(-kInfinity), s1 = splat(kInfinity), s0part = splat(1), s1part = splat(2);
+    if (da != 0.0) {
+        const V n0 = -wa / splat(da), n1 = (splat(len) - wa) / splat(da);
+        const V swap = _mm_cmpgt_pd(n0, n1);
+        s0 = pick(swap, n1, n0), s1 = pick(swap, n0, n1);
+        s0part = pick(swap, splat(2), splat(1)), s1part = pick(swap, splat(1), splat(2));
+    } else {
+        met = _mm_andnot_pd(_mm_or_pd(_mm_cmplt_pd(wa, _mm_setzero_pd()), _mm_cmpgt_pd(wa, splat(len))), met);
+    }
+
+    // Infinite cylinder.
+    V c0 = splat(-kInfinity), c1 = splat(kInfinity);
+    const double A = length_squared(dp), rr = radius * radius;
+    if (A > 0.0) {
+        const V b = -dot(wp, dp) / splat(A);
+        const V3 p{wp.x + splat(dp.x) * b, wp.y + splat(dp.y) * b, wp.z + splat(dp.z) * b};
+        const V disc = splat(rr) - dot(p, p);
+        met = _mm_and_pd(met, _mm_cmpnlt_pd(disc, splat(-kTouchTolerance * radius * radius)));
+        const V hh = _mm_sqrt_pd(max0(disc) / splat(A));
+        const V c = (dot(wp, wp) - splat(rr)) / splat(A);
+        const V qq = b + copysign(hh, b);
+        const V other = c / qq;
+        const V swap = _mm_cmpgt_pd(qq, other);
+        const V on_axis = _mm_cmpeq_pd(qq, _mm_setzero_pd());
+        c0 = _mm_andnot_pd(on_axis, pick(swap, other, qq));
+        c1 = _mm_andnot_pd(on_axis, pick(swap, qq, other));
+    } else {
+        met = _mm_andnot_pd(_mm_cmpgt_pd(dot(wp, wp), splat(rr)), met);
+    }
+
+    const V side_in = _mm_cmpgt_pd(c0, s0), side_out = _mm_cmplt_pd(c1, s1);
+    span.tin = pick(side_in, c0, s0), span.pin = _mm_andnot_pd(side_in, s0part);
+    span.tout = pick(side_out, c1, s1), span.pout = _mm_andnot_pd(side_out, s1part);
+    return _mm_and_pd(met, _mm_cmple_pd(span.tin, span.tout));
+}
+
+}  // namespace
+
+unsigned CappedCylinderShape::intersect_quad(RayQuad& q, unsigned live, QuadCrossings& hits) const {
+    using namespace quad;
+    unsigned found = 0;
+    for (int h = 0; h < 4; h += 2) {
+        if ((live >> h & 3u) == 0) continue;
+        QuadSpan sp;
+        const V met = _mm_and_pd(solve_pair(q, h, a_, axis_, len_, r_, sp), mask_of(live >> h & 3u));
+        const V tmin = load(q.tmin + h), tmax = load(q.tmax + h);
+        const V in_ok = _mm_and_pd(_mm_cmpgt_pd(sp.tin, tmin), _mm_cmplt_pd(sp.tin, tmax));
+        const V out_ok = _mm_and_pd(_mm_cmpgt_pd(sp.tout, tmin), _mm_cmplt_pd(sp.tout, tmax));
+        const V t = pick(in_ok, sp.tin, sp.tout), part = pick(in_ok, sp.pin, sp.pout);
+        found |= keep(q, hits, h, _mm_and_pd(met, _mm_or_pd(in_ok, out_ok)), t, part);
+    }
+    return found;
+}
+
+unsigned CappedCylinderShape::occluded_quad(const RayQuad& q, unsigned live) const {
+    using namespace quad;
+    unsigned blocked = 0;
+    for (int h = 0; h < 4; h += 2) {
+        if ((live >> h & 3u) == 0) continue;
+        QuadSpan sp;
+        const V met = _mm_and_pd(solve_pair(q, h, a_, axis_, len_, r_, sp), mask_of(live >> h & 3u));
+        const V tmin = load(q.tmin + h), tmax = load(q.tmax + h);
+        const V in_ok = _mm_and_pd(_mm_cmpgt_pd(sp.tin, tmin), _mm_cmplt_pd(sp.tin, tmax));
+        const V out_ok = _mm_and_pd(_mm_cmpgt_pd(sp.tout, tmin), _mm_cmplt_pd(sp.tout, tmax));
+        blocked |= bits(_mm_and_pd(met, _mm_or_pd(in_ok, out_ok))) << h;
+    }
+    return blocked;
 }
 
 }  // namespace lat

@@ -3,6 +3,9 @@
 
 namespace lat {
 
+struct RayQuad;
+struct QuadCrossings;
+
 // A finite cylinder of radius r whose axis runs from a to b, with flat ends.
 // Crossing::part: 0 the side, 1 the end at a, 2 the end at b.
 class CappedCylinderShape final : public Shape {
@@ -20,6 +23,12 @@ public:
 
     // The span of the ray's line inside the cylinder, if any (t0 < t1, parts as above).
     bool solve(const Ray& r, Crossing& in, Crossing& out) const;
+
+    // Four parallel rays at once (geometry/ray_quad.h), each lane as the scalar test answers it:
+    // the lanes in `live` that intersect() finds a crossing for, their crossings kept in hits
+    // and their tmax narrowed to them; and the lanes in `live` that occluded() blocks.
+    unsigned intersect_quad(RayQuad& q, unsigned live, QuadCrossings& hits) const;
+    unsigned occluded_quad(const RayQuad& q, unsigned live) const;
 
 private:
     Vec3 a_, b_, axis_;  // axis_ is the unit vector from a to b

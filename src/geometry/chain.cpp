@@ -4,6 +4,8 @@
 #include <cmath>
 #include <ranges>
 
+#include "geometry/ray_quad.h"
+
 namespace lat {
 
 ChainShape::ChainShape(std::vector<ChainSphere> spheres, std::vector<ChainCylinder> cylinders)
@@ -49,6 +51,32 @@ bool ChainShape::occluded(const Ray& r, double tmin, double tmax) const {
     for (std::size_t i = 0; i < primitive_count(); ++i)
         if (part(i).occluded(r, tmin, tmax)) return true;
     return false;
+}
+
+unsigned ChainShape::first_crossings(std::span<const std::uint32_t> parts, RayQuad& q,
+                                     unsigned live, QuadCrossings& hits) const {
+    unsigned found = 0;
+    for (const std::uint32_t i : parts) {
+        const unsigned m = i < sphere_parts_.size()
+                               ? sphere_parts_[i].intersect_quad(q, live, hits)
+                               : cyl_parts_[i - sphere_parts_.size()].intersect_quad(q, live, hits);
+        for (int k = 0; k < 4; ++k)
+            if (m >> k & 1) hits.part[k] = i << 2 | hits.part[k];
+        found |= m;
+    }
+    return found;
+}
+
+unsigned ChainShape::blocked_lanes(std::span<const std::uint32_t> parts, const RayQuad& q,
+                                   unsigned live) const {
+    unsigned blocked = 0;
+    for (const std::uint32_t i : parts) {
+        const unsigned open = live & ~blocked;
+        if (open == 0) break;
+        blocked |= i < sphere_parts_.size() ? sphere_parts_[i].occluded_quad(q, open)
+                                            : cyl_parts_[i - sphere_parts_.size()].occluded_quad(q, open);
+    }
+    return blocked;
 }
 
 void ChainShape::primitive_spans(std::size_t i, const Ray& r, SpanList& out) const {

@@ -2,6 +2,7 @@
 // The paper's small primitive: spheres joined by flat-ended cylinders ("hair", "hook",
 // "thistle spike"), the solid being the union of all of them.
 #include <array>
+#include <span>
 #include <vector>
 
 #include "geometry/capped_cylinder.h"
@@ -60,6 +61,15 @@ public:
     bool occluded_primitive(std::size_t i, const Ray& r, double tmin, double tmax) const override {
         return part(i).occluded(r, tmin, tmax);
     }
+
+    // Four parallel rays at once (geometry/ray_quad.h), each lane as the scalar loops answer
+    // it, bit for bit: the lanes in `live` that first_crossing_of_parts over `parts` finds a
+    // crossing for (kept in hits, the lanes' tmax narrowed to them), and the lanes in `live`
+    // that any_part_occludes finds blocked.
+    unsigned first_crossings(std::span<const std::uint32_t> parts, RayQuad& q, unsigned live,
+                             QuadCrossings& hits) const;
+    unsigned blocked_lanes(std::span<const std::uint32_t> parts, const RayQuad& q,
+                           unsigned live) const;
 
 private:
     std::vector<ChainSphere> spheres_;

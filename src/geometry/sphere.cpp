@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "geometry/ray_quad.h"
+
 namespace lat {
 
 Bounds3 SphereShape::bounds() const {
@@ -66,6 +68,65 @@ void SphereShape::spans(const Ray& r, SpanList& out) const {
 
 Vec3 SphereShape::normal(const Ray& r, const Crossing& c) const {
     return (r.at(c.t) - c_) / r_;
+}
+
+namespace {
+
+// solve() for lanes h, h + 1 of q: the lanes where the line meets the sphere, and t0 <= t1.
+quad::V solve_pair(const RayQuad& q, int h, Vec3 c, double r, quad::V& t0, quad::V& t1) {
+    using namespace quad;
+    const double dd = length_squared(q.d);
+    const double rr = r * r, reject = -kTouchTolerance * r * r;
+    const V3 f = origins_minus(q, h, c);
+    const V b = -dot(f, q.d) / splat(dd);
+    const V3 perp{f.x + splat(q.d.x) * b, f.y + splat(q.d.y) * b, f.z + splat(q.d.z) * b};
+    const V disc_raw = splat(rr) - dot(perp, perp);
+    const V met = _mm_cmpnlt_pd(disc_raw, splat(reject));
+    const V hh = _mm_sqrt_pd(max0(disc_raw) / splat(dd));
+    const V cc = (dot(f, f) - splat(rr)) / splat(dd);
+    const V qq = b + copysign(hh, b);
+    const V other = cc / qq;
+    const V swap = _mm_cmpgt_pd(qq, other);
+    const V on_centre = _mm_cmpeq_pd(qq, _mm_setzero_pd());
+    t0 = _mm_andnot_pd(on_centre, pick(swap, other, qq));
+    t1 = _mm_andnot_pd(on_centre, pick(swap, qq, other));
+    return met;
+}
+
+}  // namespace
+
+unsigned SphereShape::intersect_quad(RayQuad& q, unsigned live, QuadCrossings& hits) const {
+    using namespace quad;
+    if (length_squared(q.d) == 0.0) return 0;
+    unsigned found = 0;
+    for (int h = 0; h < 4; h += 2) {
+        if ((live >> h & 3u) == 0) continue;
+        V t0, t1;
+        const V met = solve_pair(q, h, c_, r_, t0, t1);
+        const V tmin = load(q.tmin + h), tmax = load(q.tmax + h);
+        const V t = pick(_mm_cmpgt_pd(t0, tmin), t0, t1);
+        const V in_range = _mm_and_pd(_mm_cmpnle_pd(t, tmin), _mm_cmpnge_pd(t, tmax));
+        const V hit = _mm_and_pd(_mm_and_pd(met, in_range), mask_of(live >> h & 3u));
+        found |= keep(q, hits, h, hit, t, _mm_setzero_pd());
+    }
+    return found;
+}
+
+unsigned SphereShape::occluded_quad(const RayQuad& q, unsigned live) const {
+    using namespace quad;
+    if (length_squared(q.d) == 0.0) return 0;
+    unsigned blocked = 0;
+    for (int h = 0; h < 4; h += 2) {
+        if ((live >> h & 3u) == 0) continue;
+        V t0, t1;
+        const V met = solve_pair(q, h, c_, r_, t0, t1);
+        const V tmin = load(q.tmin + h), tmax = load(q.tmax + h);
+        const V in0 = _mm_and_pd(_mm_cmpgt_pd(t0, tmin), _mm_cmplt_pd(t0, tmax));
+        const V in1 = _mm_and_pd(_mm_cmpgt_pd(t1, tmin), _mm_cmplt_pd(t1, tmax));
+        const V hit = _mm_and_pd(_mm_and_pd(met, _mm_or_pd(in0, in1)), mask_of(live >> h & 3u));
+        blocked |= bits(hit) << h;
+    }
+    return blocked;
 }
 
 }  // namespace lat

@@ -3,6 +3,9 @@
 
 namespace lat {
 
+struct RayQuad;
+struct QuadCrossings;
+
 class SphereShape final : public Shape {
 public:
     SphereShape(Vec3 center, double radius) : c_(center), r_(radius) {}
@@ -20,6 +23,12 @@ public:
 
     // Both crossings t0 <= t1 of the ray's line, if it meets the sphere.
     bool solve(const Ray& r, double& t0, double& t1) const;
+
+    // Four parallel rays at once (geometry/ray_quad.h), each lane as the scalar test answers it:
+    // the lanes in `live` that intersect() finds a crossing for, their crossings kept in hits
+    // and their tmax narrowed to them; and the lanes in `live` that occluded() blocks.
+    unsigned intersect_quad(RayQuad& q, unsigned live, QuadCrossings& hits) const;
+    unsigned occluded_quad(const RayQuad& q, unsigned live) const;
 
 private:
     Vec3 c_;

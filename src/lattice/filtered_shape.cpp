@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "geometry/ray_quad.h"
 #include "geometry/sub_rays.h"
 
 namespace lat {
@@ -309,41 +310,67 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
     const std::size_t n_near =
         part_boxes_ ? part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, near) : 0;
     const std::span parts(near.data(), n_near);
+    // The sub-rays, lane k = i n + j (bit k of Sheet::sub_rays), each clipped to the box.
+    RayQuad q;
+    q.d = r.d;
+    unsigned live = 0;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
+            const int k = i * n + j;
             const double a = ((i + 0.5) / n - 0.5) * width, b = ((j + 0.5) / n - 0.5) * width;
-            const Ray sub{r.o + u * a + v * b, r.d};
+            const Vec3 o = r.o + u * a + v * b;
+            q.ox[k] = o.x, q.oy[k] = o.y, q.oz[k] = o.z;
             double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
-            if (!clip_ray(point_.bounds(), sub, t0, t1)) continue;
-            const auto bit = static_cast<std::uint8_t>(1u << (i * n + j));
-            if (!normal) {
-                t1 = std::min(t1, tmax);
-                if (t0 < t1 && blocked(parts, sub, t0, t1))
-                    s.add_opaque(w, sub.at(0.5 * (t0 + t1)), {}), s.sub_rays |= bit;
-                continue;
-            }
-            Crossing c;
-            if (!crossing(parts, sub, t0, t1, c)) continue;
-            const SurfacePoint sp = primitive_->surface(sub, c);
-            const double ln = length(sp.n);
-            s.add_opaque(w, sp.p, ln > 0 ? sp.n / ln : Vec3{});
-            s.sub_rays |= bit;
+            if (!clip_ray(point_.bounds(), {o, r.d}, t0, t1)) continue;
+            q.tmin[k] = t0, q.tmax[k] = normal ? t1 : std::min(t1, tmax);
+            if (q.tmin[k] < q.tmax[k] || normal) live |= 1u << k;
         }
+    if (!normal) {
+        const unsigned blocked = blocked_sub_rays(parts, q, live);
+        for (int k = 0; k < kSubRays; ++k)
+            if (blocked >> k & 1)
+                s.add_opaque(w, q.ray(k).at(0.5 * (q.tmin[k] + q.tmax[k])), {}),
+                    s.sub_rays |= static_cast<std::uint8_t>(1u << k);
+        return;
+    }
+    QuadCrossings hits;
+    const unsigned found = sub_ray_crossings(parts, q, live, hits);
+    for (int k = 0; k < kSubRays; ++k) {
+        if (!(found >> k & 1)) continue;
+        const SurfacePoint sp = primitive_->surface(q.ray(k), Crossing(hits.t[k], hits.part[k], 0));
+        const double ln = length(sp.n);
+        s.add_opaque(w, sp.p, ln > 0 ? sp.n / ln : Vec3{});
+        s.sub_rays |= static_cast<std::uint8_t>(1u << k);
+    }
 }
 
-// Chains' parts are tested through the chain's own type, inline.
-bool FilteredLatticeShape::crossing(std::span<const std::uint32_t> parts, const Ray& sub, double t0,
-                                    double t1, Crossing& c) const {
-    if (!part_boxes_) return primitive_->intersect(sub, t0, t1, c);
-    return chain_ ? first_crossing_of_parts(*chain_, parts, sub, t0, t1, c)
-                  : first_crossing_of_parts(*primitive_, parts, sub, t0, t1, c);
+// A chain's parts take the sub-rays four at once; other primitives one sub-ray at a time.
+unsigned FilteredLatticeShape::sub_ray_crossings(std::span<const std::uint32_t> parts, RayQuad& q,
+                                                 unsigned live, QuadCrossings& hits) const {
+    if (chain_ && part_boxes_) return chain_->first_crossings(parts, q, live, hits);
+    unsigned found = 0;
+    for (int k = 0; k < kSubRays; ++k) {
+        if (!(live >> k & 1)) continue;
+        Crossing c;
+        const bool met = part_boxes_
+                             ? first_crossing_of_parts(*primitive_, parts, q.ray(k), q.tmin[k], q.tmax[k], c)
+                             : primitive_->intersect(q.ray(k), q.tmin[k], q.tmax[k], c);
+        if (met) hits.t[k] = c.t, hits.part[k] = c.part, found |= 1u << k;
+    }
+    return found;
 }
 
-bool FilteredLatticeShape::blocked(std::span<const std::uint32_t> parts, const Ray& sub, double t0,
-                                   double t1) const {
-    if (!part_boxes_) return primitive_->occluded(sub, t0, t1);
-    return chain_ ? any_part_occludes(*chain_, parts, sub, t0, t1)
-                  : any_part_occludes(*primitive_, parts, sub, t0, t1);
+unsigned FilteredLatticeShape::blocked_sub_rays(std::span<const std::uint32_t> parts,
+                                                const RayQuad& q, unsigned live) const {
+    if (chain_ && part_boxes_) return chain_->blocked_lanes(parts, q, live);
+    unsigned blocked = 0;
+    for (int k = 0; k < kSubRays; ++k) {
+        if (!(live >> k & 1)) continue;
+        const bool b = part_boxes_ ? any_part_occludes(*primitive_, parts, q.ray(k), q.tmin[k], q.tmax[k])
+                                   : primitive_->occluded(q.ray(k), q.tmin[k], q.tmax[k]);
+        if (b) blocked |= 1u << k;
+    }
+    return blocked;
 }
 
 bool FilteredLatticeShape::occluded(const Ray& r, double tmin, double tmax) const {

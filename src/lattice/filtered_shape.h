@@ -25,6 +25,9 @@
 
 namespace lat {
 
+struct RayQuad;
+struct QuadCrossings;
+
 enum class LatticeFilter { kNone, kBox, kSmooth };
 // The option names, "none", "box" and "smooth": the one place they are spelled.
 inline constexpr std::array<std::pair<std::string_view, LatticeFilter>, 3> kLatticeFilterNames{
@@ -214,11 +217,12 @@ private:
     // footprint at the box, primitive units.
     void add_exact(double width, bool normal, const Ray& r, double tmin, double tmax,
                    Sheet& s) const;
-    // A sub-ray's first crossing, and whether it is blocked, over the parts near its ray (all
-    // of the primitive without part boxes).
-    bool crossing(std::span<const std::uint32_t> parts, const Ray& sub, double t0, double t1,
-                  Crossing& c) const;
-    bool blocked(std::span<const std::uint32_t> parts, const Ray& sub, double t0, double t1) const;
+    // The sub-rays' first crossings (the lanes found) and which of them are blocked, over the
+    // parts near their ray (all of the primitive without part boxes).
+    unsigned sub_ray_crossings(std::span<const std::uint32_t> parts, RayQuad& q, unsigned live,
+                               QuadCrossings& hits) const;
+    unsigned blocked_sub_rays(std::span<const std::uint32_t> parts, const RayQuad& q,
+                              unsigned live) const;
 };
 
 }  // namespace lat
