@@ -122,6 +122,36 @@ TEST(PartBoxes, NearPartsKeepEveryPartAParallelRayWithinGrowMeets) {
     EXPECT_LT(kept, 20000 * 20);  // and it does leave parts out
 }
 
+// near_parts tests four boxes at a time: the parts it keeps, in order, are those the one-box
+// test keeps, for every count of parts modulo 4 (lanes past the last part never reported).
+TEST(PartBoxes, NearPartsFourAtATimeAreTheOneBoxTests) {
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (std::size_t parts = 1; parts <= 9; ++parts) {
+        const Boxes prim = random_boxes(rng, static_cast<int>(parts), 0.5, 2.0);
+        const PartBoxes boxes(prim, prim.bounds());
+        std::vector<std::uint32_t> near(parts), one_by_one;
+        std::size_t kept = 0;
+        for (int n = 0; n < 4000; ++n) {
+            const Vec3 p = Vec3{u(rng), u(rng), u(rng)} * Vec3{7, 7, 20};
+            const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+            const Ray r{p - d * 30.0, d};
+            const double g = 0.5 * u(rng), tmin = n % 2 ? 0.0 : 30 * u(rng);
+            const std::size_t count = boxes.near_parts(r, g, tmin, near);
+            const PartBoxes::Ray4 slabs(boxes, r);
+            const PartBoxes::Ray4::Range range = slabs.range(tmin, kInfinity);
+            one_by_one.clear();
+            for (std::uint32_t i = 0; i < parts; ++i)
+                if (slabs.meets_grown(i, range, PartBoxes::Ray4::grow(g))) one_by_one.push_back(i);
+            ASSERT_EQ(std::vector<std::uint32_t>(near.begin(), near.begin() + count), one_by_one)
+                << parts << " parts, ray " << n;
+            kept += count;
+        }
+        EXPECT_GT(kept, 20 * parts);      // parts are met
+        EXPECT_LT(kept, 4000 * parts);    // and left out
+    }
+}
+
 // A union's first crossing over its parts, box-tested first (what filtered lattices blend in),
 // is the primitive's own, bit for bit: the same t, part and stored point, and none where it has
 // none; rays aimed at joints (where a sphere and its cylinders meet) and grazing the hair.

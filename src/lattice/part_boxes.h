@@ -49,6 +49,8 @@ public:
             float lo, hi;  // shifted and widened for the float test
         };
         Range range(double tmin, double tmax) const;
+        // Whether the tests run in float (else in double: a direction component too small).
+        bool in_float() const { return use_float_; }
         // Whether the ray's line meets part i's box at some t in the range.
         bool meets(std::uint32_t i, const Range& r) const {
             return use_float_ ? meets_float(boxes_.f_[i], r) : meets_double(boxes_.exact_[i], r);
@@ -61,6 +63,9 @@ public:
         static Grow grow(double g);
         // Whether the ray's line meets part i's box grown by g at some t in the range.
         bool meets_grown(std::uint32_t i, const Range& r, const Grow& g) const;
+        // The same for parts 4 k to 4 k + 3 at once (bit j: part 4 k + j), the float test
+        // lane for lane; float rays only.
+        unsigned meets_grown4(std::size_t k, const Range& r, const Grow& g) const;
 
     private:
         const PartBoxes& boxes_;
@@ -92,6 +97,12 @@ private:
     };
     std::vector<Bounds3> exact_;  // the parts' bounds padded as in double
     std::vector<Box4> f_;         // padded by kPad x D, rounded outward
+    // f_ by fours, axis by axis (part 4 k + j in lane j of quads_[k]; lanes past the last part
+    // are never reported).
+    struct alignas(16) BoxQuad {
+        float lo[3][4], hi[3][4];
+    };
+    std::vector<BoxQuad> quads_;
     Vec3 center_;
 };
 
