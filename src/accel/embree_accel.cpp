@@ -116,6 +116,8 @@ struct QueryContext {
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;
+    // The object whose directions across the ray were handed on last.
+    std::uint32_t across_obj = ~0u;
     // Objects culled by several parts that this query has already tested: a second part of
     // the same object can add nothing (its answer for a shorter range is no closer). A small
     // ring; an object that falls out of it is merely tested again.
@@ -241,15 +243,21 @@ struct EmbreeAccel::Impl {
         return tol > 0 ? ctx->tmin + tol / length(local.d) : ctx->tmin;
     }
 
-    // The object-space ray, and (geometry/sub_rays.h) the directions across it handed on. Both
-    // are set again only when the object changes: within one query nothing else sets them.
+    // The object-space ray: consecutive callbacks for one object reuse it.
     const Ray& local_ray(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->cached_obj != obj) {
             ctx->cached_obj = obj;
             ctx->cached_local = objects[obj].xf->inverse_ray(ctx->ray);
-            set_across_ray_in_object(across_in_object(*objects[obj].xf, similar[obj]));
         }
         return ctx->cached_local;
+    }
+    // Before an object is tested: the directions across the ray in its space handed on
+    // (geometry/sub_rays.h), only when the object changes (within one query nothing else sets
+    // them), and not for the many objects that culling rejects.
+    void hand_across(QueryContext* ctx, std::uint32_t obj) const {
+        if (ctx->across_obj == obj) return;
+        ctx->across_obj = obj;
+        set_across_ray_in_object(across_in_object(*objects[obj].xf, similar[obj]));
     }
 
     // Whether a direct primitive's object is to be tested: it was not tested already for this
@@ -302,6 +310,7 @@ struct EmbreeAccel::Impl {
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
+        self->hand_across(ctx, t.object);
         assert(ctx->hit);  // rtcIntersect1 runs only for intersect and intersect_layers
         const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
         const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
@@ -330,6 +339,7 @@ struct EmbreeAccel::Impl {
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
+        self->hand_across(ctx, t.object);
         const double tmin = self->occlusion_tmin(ctx, t.object, local);
         const bool hit = K == Kind::kDirect
                              ? shape.occluded(local, tmin, ctx->tmax)
