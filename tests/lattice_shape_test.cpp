@@ -86,3 +86,74 @@ TEST(LatticeInCsg, ShapesAnswerWithTheStoredSurface) {
 
 }  // namespace
 }  // namespace lat
+
+namespace lat {
+namespace {
+
+// The line parallel to `line` (shifted across it) that the shape's test, on the line mapped
+// by xf and back, accepts last: within rounding of the capsule's surface.
+Ray grazing(const LatticeFrame& frame, std::size_t i, const Transform& xf, const Ray& line) {
+    Vec3 e, f;
+    orthonormal_basis(line.d, e, f);
+    const auto kept = [&](double s) {
+        const Ray r{xf.point(line.o + e * s), xf.vector(line.d)};
+        return frame.cull_meets(i, xf.inverse_ray(r));
+    };
+    double in = -6, out = 6;
+    for (double s = -6; s <= 6; s += 0.05)
+        if (kept(s)) {
+            in = s;
+            break;
+        }
+    if (!kept(in)) return line;
+    for (int k = 0; k < 80; ++k) {
+        const double mid = 0.5 * (in + out);
+        (kept(mid) ? in : out) = mid;
+    }
+    return {line.o + e * in, line.d};
+}
+
+// The accelerator rejects rays by a cull part's capsule placed in world space before mapping
+// them into the lattice's space (Shape::cull_capsule): it must accept every line the shape's
+// own test accepts, under rotations, uniform and non-uniform scales and far translations, for
+// lines grazing the capsule within rounding; and it does reject lines.
+TEST(LatticeCulling, WorldCapsulesHoldEveryLineTheShapeAccepts) {
+    const HookLattice lattice;
+    const LatticeFrame frame(lattice.ctx, 0.3);
+    ASSERT_GT(frame.cull_count(), 1u);
+    const Transform xfs[] = {
+        Transform{},
+        Transform::translate({10, -3, 2}) * Transform::rotate({1, 2, 3}, 0.7) *
+            Transform::scale({2.5, 2.5, 2.5}),
+        Transform::rotate({0, 1, 0}, 2.1) * Transform::scale({1, 3, 0.5}),
+        Transform::translate({4e3, 1e3, -2e3}) * Transform::rotate({3, 1, 0}, -1.2)};
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int accepted = 0, rejected = 0;
+    for (const Transform& xf : xfs)
+        for (std::size_t i = 0; i < frame.cull_count(); ++i) {
+            Capsule world;
+            ASSERT_TRUE(frame.cull_capsule(i, xf, world));
+            for (int n = 0; n < 3000; ++n) {
+                // A line through a point at about the reach from the hook's axis (in the
+                // lattice's space), many within rounding of the capsules' surfaces.
+                const Vec3 d = normalize(Vec3{u(rng), u(rng), u(rng)});
+                const Vec3 p{2 + 1.5 * u(rng), 1 + 1.5 * u(rng), 2 + 1.5 * u(rng)};
+                Ray local{p - d * 5, d};
+                if (n % 2 == 0) local = grazing(frame, i, xf, local);
+                const Ray r{xf.point(local.o), xf.vector(local.d)};
+                const bool kept = frame.cull_meets(i, xf.inverse_ray(r));
+                const bool kept_world = world.meets_line(r.o, r.d);
+                if (kept) {
+                    ++accepted;
+                    ASSERT_TRUE(kept_world) << "part " << i << " line " << n;
+                }
+                rejected += kept_world ? 0 : 1;
+            }
+        }
+    EXPECT_GT(accepted, 2000);
+    EXPECT_GT(rejected, 2000);
+}
+
+}  // namespace
+}  // namespace lat

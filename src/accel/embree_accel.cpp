@@ -209,13 +209,25 @@ struct EmbreeAccel::Impl {
     std::vector<bool> similar;  // per object: keeps_directions_across
     // The top-level user geometry of single-part objects: one primitive per cull part
     // (Shape::cull_count).
+    // Read on every callback, so kept small: 36 bytes, the bounds (read only while Embree
+    // builds) apart. Its loads are the callbacks' main cost (cache misses): with the capsule in
+    // double beside the bounds, its test saved grass 4 % of its time; this way, 5 %.
     struct DirectPrim {
         std::uint32_t object;
-        std::uint32_t cull;  // the object's cull part
-        bool shared;         // one of several cull parts of its object
-        Bounds3 bounds;      // world space
+        std::uint32_t cull : 31;  // the object's cull part
+        std::uint32_t shared : 1;  // one of several cull parts of its object
+        // Shape::cull_capsule in world space, rounded to float and grown to hold the double
+        // one; radius < 0: none.
+        float a[3], b[3], radius;
+        bool capsule_meets(const Ray& r) const {
+            if (radius < 0) return true;
+            return Capsule{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}, radius}.meets_line(r.o, r.d);
+        }
     };
+    static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
+                                  const Shape& shape, const Transform& xf);
     std::vector<DirectPrim> direct;
+    std::vector<Bounds3> direct_bounds;  // world space, per direct primitive
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
     std::vector<std::uint32_t> inst_object;  // top-level geomID -> object, for instances
     struct FlatPrim {
@@ -261,11 +273,18 @@ struct EmbreeAccel::Impl {
     }
 
     // Whether a direct primitive's object is to be tested: it was not tested already for this
-    // query, and the line meets the cull part.
+    // query, and the line meets the cull part, first its capsule in world space (most rays
+    // are rejected there, before the object's transform is loaded: grass 5.8 million callbacks,
+    // 3.1 million in the capsules), then in the shape's own space (first_visit).
+    bool may_visit(QueryContext* ctx, unsigned prim) const {
+        const DirectPrim& d = direct[prim];
+        if (!d.shared) return true;
+        return !ctx->tested_already(d.object) && d.capsule_meets(ctx->ray);
+    }
     bool first_visit(QueryContext* ctx, unsigned prim, const Shape& shape, const Ray& local) const {
         const DirectPrim& d = direct[prim];
         if (!d.shared) return true;
-        if (ctx->tested_already(d.object) || !shape.cull_meets(d.cull, local)) return false;
+        if (!shape.cull_meets(d.cull, local)) return false;
         ctx->mark_tested(d.object);
         return true;
     }
@@ -306,6 +325,8 @@ struct EmbreeAccel::Impl {
         const Impl* self = ctx->accel;
         const unsigned inst = args->context->instID[0];
         const Target t = self->template target<K>(args->primID, inst);
+        if constexpr (K == Kind::kDirect)
+            if (!self->may_visit(ctx, args->primID)) return;
         const Shape& shape = *self->objects[t.object].shape;
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
@@ -335,6 +356,8 @@ struct EmbreeAccel::Impl {
         auto* ctx = reinterpret_cast<QueryContext*>(args->context);
         const Impl* self = ctx->accel;
         const Target t = self->template target<K>(args->primID, args->context->instID[0]);
+        if constexpr (K == Kind::kDirect)
+            if (!self->may_visit(ctx, args->primID)) return;
         const Shape& shape = *self->objects[t.object].shape;
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
@@ -359,7 +382,7 @@ struct EmbreeAccel::Impl {
 
     static void bounds_direct(const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
-        *args->bounds_o = to_rtc_bounds(self->direct[args->primID].bounds);
+        *args->bounds_o = to_rtc_bounds(self->direct_bounds[args->primID]);
     }
 
     static void bounds_proto(const RTCBoundsFunctionArguments* args) {
@@ -397,6 +420,27 @@ struct EmbreeAccel::Impl {
 
 static void on_embree_error(void* user, RTCError, const char* str) {
     static_cast<EmbreeAccel::Impl*>(user)->error = str ? str : "unknown Embree error";
+}
+
+// The float capsule holds the double one: each end moves by its rounding, which moves every
+// point of the segment by no more (so the distance of any line to it), and the radius grows by
+// that and rounds up.
+EmbreeAccel::Impl::DirectPrim EmbreeAccel::Impl::direct_prim(std::uint32_t object,
+                                                             std::uint32_t cull, bool shared,
+                                                             const Shape& shape,
+                                                             const Transform& xf) {
+    DirectPrim d{object, cull, shared, {}, {}, -1.0f};
+    Capsule c;
+    if (!shared || !shape.cull_capsule(cull, xf, c)) return d;
+    double moved = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+        d.a[k] = static_cast<float>(c.a[k]), d.b[k] = static_cast<float>(c.b[k]);
+        moved = std::max({moved, std::abs(double(d.a[k]) - c.a[k]), std::abs(double(d.b[k]) - c.b[k])});
+    }
+    const double r = c.r + std::sqrt(3.0) * moved;
+    d.radius = static_cast<float>(r);
+    if (double(d.radius) < r) d.radius = std::nextafter(d.radius, INFINITY);
+    return d;
 }
 
 EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOptions& opt)
@@ -442,11 +486,14 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             if (m.inst_object.size() <= id) m.inst_object.resize(id + 1, 0);
             m.inst_object[id] = i;
         } else if (o.shape->cull_count() == 1) {
-            m.direct.push_back({i, 0, false, wb});
+            m.direct.push_back(Impl::direct_prim(i, 0, false, *o.shape, *o.xf));
+            m.direct_bounds.push_back(wb);
         } else {
             for (std::uint32_t c = 0; c < o.shape->cull_count(); ++c) {
                 const Bounds3 b = o.shape->cull_bounds(c, *o.xf);
-                if (!b.empty()) m.direct.push_back({i, c, true, b});
+                if (b.empty()) continue;
+                m.direct.push_back(Impl::direct_prim(i, c, true, *o.shape, *o.xf));
+                m.direct_bounds.push_back(b);
             }
         }
     }

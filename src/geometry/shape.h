@@ -214,6 +214,10 @@ public:
     // Whether the line of r (shape coordinates) can meet cull part i, for a line that meets its
     // bounds: a cheap test that saves the shape's own.
     virtual bool cull_meets(std::size_t, const Ray&) const { return true; }
+    // A capsule that every line cull_meets(i, .) accepts meets, placed by xf (world space), if
+    // the cull part has one: the accelerator rejects rays by it before mapping them into the
+    // shape's space (most rays meeting a cull part's box miss its capsule).
+    virtual bool cull_capsule(std::size_t, const Transform&, Capsule&) const { return false; }
 
     // CSG trees carry a material tag per leaf; other shapes answer with the fallback.
     virtual std::uint32_t tag(const Crossing&, std::uint32_t fallback) const { return fallback; }

@@ -43,6 +43,9 @@ public:
         return frame_.cull_bounds(i, xf);
     }
     bool cull_meets(std::size_t i, const Ray& r) const override { return frame_.cull_meets(i, r); }
+    bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const override {
+        return frame_.cull_capsule(i, xf, out);
+    }
 
 private:
     std::shared_ptr<const LatticeTable> table_;

@@ -141,6 +141,9 @@ public:
     }
     // With the primitive's crossings, by the reach of the ray's own sub-rays.
     bool cull_meets(std::size_t i, const Ray& r) const override;
+    bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const override {
+        return cull_frame().cull_capsule(i, xf, out);
+    }
     // How far a ray leaving a sheet skips this lattice: a sheet's point is a blend of the
     // tables' pairs' points, within about 2 cells of the surface; with the primitive's
     // crossings, a mean of points on it across the footprint, within its width. The sub-rays'

@@ -27,6 +27,9 @@ public:
         return frame_.cull_bounds(i, xf);
     }
     bool cull_meets(std::size_t i, const Ray& r) const override { return frame_.cull_meets(i, r); }
+    bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const override {
+        return frame_.cull_capsule(i, xf, out);
+    }
     // Rays leaving a point found through this lattice skip crossings within this distance of
     // it: the table's own error, which would otherwise shade the surface by itself (acne).
     double surface_tolerance() const override { return 2.0 * frame_.cell(); }

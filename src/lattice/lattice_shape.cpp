@@ -152,6 +152,20 @@ bool LatticeFrame::cull_meets(std::size_t i, const Ray& r, double narrower) cons
     return false;
 }
 
+// Any affine map takes the capsule's ball into an ellipsoid within max_stretch times its
+// radius, so the placed segment's capsule of that radius holds the placed capsule; it is grown
+// by far more than the rounding of the placement and of either test (a few ulps of the
+// coordinates), so that it never rejects a line the test in the shape's space accepts.
+bool LatticeFrame::cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const {
+    const CullPart& p = cull_[i];
+    if (p.count != 1) return false;
+    const Capsule& c = capsules_[p.first];
+    out.a = xf.point(c.a), out.b = xf.point(c.b);
+    const double scale = max_component(abs(out.a)) + max_component(abs(out.b));
+    out.r = c.r * xf.max_stretch() * (1 + 1e-9) + 1e-9 * scale;
+    return true;
+}
+
 // A point within the reach of a part (primitive units) lies within reach times the largest
 // stretch of xf of the placed part.
 Bounds3 LatticeFrame::placed_parts(const CullPart& p, const Transform& xf) const {

@@ -35,6 +35,8 @@ public:
     // narrower: for a ray known to need less reach, by how much (at most the reach) to narrow
     // the capsules (still around the parts grown by the rest, capsules being convex).
     bool cull_meets(std::size_t i, const Ray& r, double narrower = 0) const;
+    // See Shape::cull_capsule: a cull part of one capsule has it.
+    bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const;
 
     // The ray's line in lattice units, and its snapped entry and exit points.
     struct Snap {
