@@ -14,12 +14,18 @@ namespace {
 
 // Shadow rays leaving a surface seen at a slant are up to kMaxShadowWidening times as wide as
 // the camera's footprint there; wider sub-rays make wider culling boxes (their reach), and those
-// cost more than the shadows gain. Plates 3, 4 and 5, the furry bunny and grass, 1 spp:
-//   1:  36 / 194 / 318 / 728 / 768 ms, 52.77 / 38.16 / 40.08 / 32.71 / 37.44 dB
-//   2:  34 / 201 / 336 / 835 / 975 ms, 52.98 / 38.28 / 40.12 / 32.71 / 37.44 dB (kept)
-//   4:  34 / 223 / 364 / 1078 / 1434 ms, 52.98 / 38.28 / 40.11 / 32.71 / 37.43 dB
-// (1 leaves Plate 3 under exact at 4 spp, 52.81 dB.)
-constexpr double kSubRayWidening = 2;
+// cost more than the shadows gain: the accelerator calls back for every box a ray meets, and
+// the boxes of dense fur overlap. Plates 3, 4 and 5, the furry bunny, grass, and the bunny and
+// Plate 5 at 128^2, 1 spp, 2 threads (2026-11-26, after sub-rays went four at once):
+//   1:     37 / 160 / 232 / 397 / 298 / 115 / 38 ms
+//          52.86 / 38.35 / 40.23 / 32.66 / 37.46 / 29.66 / 36.15 dB
+//   1.25:  43 / 163 / 232 / 416 / 318 / 131 / 40 ms
+//          53.05 / 38.44 / 40.26 / 32.76 / 37.46 / 29.67 / 36.14 dB (kept)
+//   1.5:   40 / 176 / 237 / 434 / 341 / -- / -- ms, 53.13 / 38.46 / 40.27 / 32.85 / 37.45 dB
+//   2:     39 / 169 / 243 / 476 / 386 / 179 / 49 ms
+//          53.15 / 38.47 / 40.27 / 32.92 / 37.45 / 29.68 / 36.16 dB
+// (Exact at 4 spp: Plate 3 52.81 dB, which 1 beats by too little; the bunny 30.97 dB.)
+constexpr double kSubRayWidening = 1.25;
 
 
 // The levels j (sigma^-1 = K 2^j) a primitive's instances need: from the level whose cell
