@@ -321,9 +321,10 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
             const Vec3 o = r.o + u * a + v * b;
             q.ox[k] = o.x, q.oy[k] = o.y, q.oz[k] = o.z;
             double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
-            if (!clip_ray(point_.bounds(), {o, r.d}, t0, t1)) continue;
+            // A lane clipped away gets a range of 0: its tests run, masked off.
+            if (!clip_ray(point_.bounds(), {o, r.d}, t0, t1)) t0 = t1 = 0;
             q.tmin[k] = t0, q.tmax[k] = normal ? t1 : std::min(t1, tmax);
-            if (q.tmin[k] < q.tmax[k] || normal) live |= 1u << k;
+            if (q.tmin[k] < q.tmax[k]) live |= 1u << k;
         }
     if (!normal) {
         const unsigned blocked = blocked_sub_rays(parts, q, live);
