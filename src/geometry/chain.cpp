@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <ranges>
 
 #include "geometry/ray_quad.h"
 
@@ -14,7 +13,10 @@ ChainShape::ChainShape(std::vector<ChainSphere> spheres, std::vector<ChainCylind
     for (const ChainCylinder& c : cylinders_)
         cyl_parts_.emplace_back(spheres_[static_cast<std::size_t>(c.from)].center,
                                 spheres_[static_cast<std::size_t>(c.to)].center, c.radius);
-    for (std::size_t i = 0; i < primitive_count(); ++i) bounds_ = merge(bounds_, part(i).bounds());
+    for (std::size_t i = 0; i < primitive_count(); ++i) {
+        bounds_ = merge(bounds_, part(i).bounds());
+        all_parts_.push_back(static_cast<std::uint32_t>(i));
+    }
 }
 
 const Shape& ChainShape::part(std::size_t i) const {
@@ -43,8 +45,7 @@ void ChainShape::primitive_spheres(std::size_t i, std::vector<BoundingSphere>& o
 
 bool ChainShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
     // From outside, the union's first crossing is the first crossing of any part.
-    return first_crossing_of_parts(*this, std::views::iota(std::size_t{0}, primitive_count()), r,
-                                   tmin, tmax, hit);
+    return first_crossing_of_parts(*this, all_parts_, r, tmin, tmax, hit);
 }
 
 bool ChainShape::occluded(const Ray& r, double tmin, double tmax) const {

@@ -77,6 +77,9 @@ private:
     std::vector<SphereShape> sphere_parts_;
     std::vector<CappedCylinderShape> cyl_parts_;
     Bounds3 bounds_;
+    // 0 to primitive_count() - 1 (std::views::iota does not build with clang 14, the fuzzing
+    // compiler, and g++ 12's library).
+    std::vector<std::uint32_t> all_parts_;
 
     const Shape& part(std::size_t i) const;
 };
