@@ -9,6 +9,7 @@
 #include "csg/csg_shape.h"
 #include "geometry/chain.h"
 #include "geometry/named_shapes.h"
+#include "geometry/sphere.h"
 #include "geometry/triangle_mesh.h"
 #include "hook_primitive.h"
 #include "lattice/encoding.h"
@@ -142,7 +143,8 @@ TEST(FilteredCloseUps, CameraRaysGetTheirSubRaysCrossings) {
 // middle of the box along the ray). Footprints wider than the shape's exact width are narrowed
 // to it. (With the hook, and with a hook of 9 parts, whose sub-rays meet only the parts found
 // near the ray first: the same crossings as the whole primitive's.)
-void expect_sheets_are_their_sub_rays_crossings(const ChainShape& prim, bool shadow) {
+void expect_sheets_are_their_sub_rays_crossings(const Shape& prim, bool shadow,
+                                                 int least_checked) {
     const HookLattice h = hook_lattice(prim);
     const int n = kExactSubRays;
     const Bounds3 box{{0, 0, 0}, Vec3{4, 2, 4}};
@@ -181,15 +183,33 @@ void expect_sheets_are_their_sub_rays_crossings(const ChainShape& prim, bool sha
         }
     }
     set_ray_footprint({});
-    EXPECT_GT(checked, shadow ? 700 : 1500);
+    EXPECT_GT(checked, least_checked);
+}
+
+// Two tori, one bitten by a ball: a CSG tree cheap enough to answer by its crossings, whose
+// normals depend on the leaf a crossing is on and on whether it is a subtracted solid's.
+const CsgShape& bitten_tori() {
+    static const CsgShape tree = [] {
+        CsgShape t;
+        const PlacedShape a = make_torus({1.4, 1, 2}, {1, 0.3, 0.5}, 0.9, 0.3);
+        const PlacedShape b = make_torus({2.6, 1, 2.2}, {0.2, 1, 0.4}, 0.8, 0.25);
+        const int ta = t.add_leaf({a.shape, a.placement, 1});
+        const int ball = t.add_leaf({std::make_shared<SphereShape>(Vec3{2.2, 1, 2.1}, 0.45), {}, 2});
+        const int tb = t.add_leaf({b.shape, b.placement, 3});
+        t.set_root(t.add_node(CsgOp::kUnion, {t.add_node(CsgOp::kDifference, {ta, ball}), tb}));
+        return t;
+    }();
+    return tree;
 }
 
 TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
     ASSERT_LT(hook().primitive_count(), 8u);
     ASSERT_GE(long_hook().primitive_count(), 8u);
+    ASSERT_LE(bitten_tori().intersect_cost(), kMaxExactCost);
     for (const bool shadow : {false, true}) {
-        expect_sheets_are_their_sub_rays_crossings(hook(), shadow);
-        expect_sheets_are_their_sub_rays_crossings(long_hook(), shadow);
+        expect_sheets_are_their_sub_rays_crossings(hook(), shadow, shadow ? 700 : 1500);
+        expect_sheets_are_their_sub_rays_crossings(long_hook(), shadow, shadow ? 700 : 1500);
+        expect_sheets_are_their_sub_rays_crossings(bitten_tori(), shadow, shadow ? 300 : 600);
     }
 }
 

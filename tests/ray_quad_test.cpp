@@ -61,8 +61,8 @@ void expect_lanes_are_scalar(const S& shape, const RayQuad& q0) {
             const bool met = live_k && shape.intersect(q0.ray(k), q0.tmin[k], q0.tmax[k], c);
             ASSERT_EQ(bool(found >> k & 1), met) << "lane " << k << " live " << live;
             if (met) {
-                EXPECT_TRUE(same_bits(hits.t[k], c.t)) << hits.t[k] << " " << c.t;
-                EXPECT_EQ(hits.part[k], c.part);
+                EXPECT_TRUE(same_bits(hits.c[k].t, c.t)) << hits.c[k].t << " " << c.t;
+                EXPECT_EQ(hits.c[k].part, c.part);
                 EXPECT_TRUE(same_bits(q.tmax[k], c.t));  // the range narrowed to the crossing
             } else {
                 EXPECT_TRUE(same_bits(q.tmax[k], q0.tmax[k]));
@@ -125,8 +125,9 @@ TEST(RayQuad, ChainLanesAreTheScalarLoopsOverParts) {
                                                                    q0.tmin[k], q0.tmax[k], c);
                 ASSERT_EQ(bool(found >> k & 1), met);
                 if (met) {
-                    EXPECT_TRUE(same_bits(hits.t[k], c.t));
-                    EXPECT_EQ(hits.part[k], c.part);
+                    EXPECT_TRUE(same_bits(hits.c[k].t, c.t));
+                    EXPECT_EQ(hits.c[k].part, c.part);
+                    EXPECT_TRUE(same_bits(q.tmax[k], c.t));  // narrowed, as the scalar loop does
                 }
                 const bool occ =
                     live_k && any_part_occludes(hook, parts, q0.ray(k), q0.tmin[k], q0.tmax[k]);

@@ -62,7 +62,7 @@ unsigned ChainShape::first_crossings(std::span<const std::uint32_t> parts, RayQu
                                ? sphere_parts_[i].intersect_quad(q, live, hits)
                                : cyl_parts_[i - sphere_parts_.size()].intersect_quad(q, live, hits);
         for (int k = 0; k < 4; ++k)
-            if (m >> k & 1) hits.part[k] = i << 2 | hits.part[k];
+            if (m >> k & 1) hits.c[k].part = i << 2 | hits.c[k].part;
         found |= m;
     }
     return found;

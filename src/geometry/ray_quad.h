@@ -1,7 +1,7 @@
 #pragma once
 // Four parallel rays tested against one part at once: a ray's 2 x 2 sub-rays (sub_rays.h)
 // share their direction, so what a part's test derives from the direction alone is derived
-// once, and the rest runs two rays to an SSE register. Each lane's arithmetic is the scalar
+// once, and the rest runs two rays to an SSE register (SSE4.1: x86-64-v2). Each lane's arithmetic is the scalar
 // test's, operation for operation (SSE2 rounds as scalar doubles do, and the build contracts
 // nothing into FMA), so a lane's answer is the scalar test's bit for bit (ray_quad_test).
 #include <immintrin.h>
@@ -20,11 +20,11 @@ struct RayQuad {
     Ray ray(int k) const { return {{ox[k], oy[k], oz[k]}, d}; }
 };
 
-// The closest crossings found so far of the lanes of a RayQuad: a lane's t is valid where its
-// bit is set in the mask the tests return.
+// The closest crossings found so far of the lanes of a RayQuad: a lane's is valid where its
+// bit is set in the mask the tests return. Whole crossings: a shape tested one lane at a time
+// (a CSG tree) hands on its leaf, which its surface needs.
 struct QuadCrossings {
-    double t[4];
-    std::uint32_t part[4];
+    Crossing c[4];
 };
 
 namespace quad {
@@ -67,8 +67,8 @@ inline unsigned keep(RayQuad& q, QuadCrossings& hits, int h, V found, V t, V par
     _mm_store_pd(ps, part);
     for (int k = 0; k < 2; ++k)
         if (m >> k & 1) {
-            hits.t[h + k] = q.tmax[h + k] = ts[k];
-            hits.part[h + k] = static_cast<std::uint32_t>(ps[k]);
+            q.tmax[h + k] = ts[k];
+            hits.c[h + k] = Crossing(ts[k], static_cast<std::uint32_t>(ps[k]), 0);
         }
     return m << h;
 }

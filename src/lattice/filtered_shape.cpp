@@ -311,6 +311,7 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
         part_boxes_ ? part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, near) : 0;
     const std::span parts(near.data(), n_near);
     // The sub-rays, lane k = i n + j (bit k of Sheet::sub_rays), each clipped to the box.
+    static_assert(n * n == 4, "a RayQuad holds a ray's sub-rays");
     RayQuad q;
     q.d = r.d;
     unsigned live = 0;
@@ -338,7 +339,7 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
     const unsigned found = sub_ray_crossings(parts, q, live, hits);
     for (int k = 0; k < kSubRays; ++k) {
         if (!(found >> k & 1)) continue;
-        const SurfacePoint sp = primitive_->surface(q.ray(k), Crossing(hits.t[k], hits.part[k], 0));
+        const SurfacePoint sp = primitive_->surface(q.ray(k), hits.c[k]);
         const double ln = length(sp.n);
         s.add_opaque(w, sp.p, ln > 0 ? sp.n / ln : Vec3{});
         s.sub_rays |= static_cast<std::uint8_t>(1u << k);
@@ -356,7 +357,7 @@ unsigned FilteredLatticeShape::sub_ray_crossings(std::span<const std::uint32_t> 
         const bool met = part_boxes_
                              ? first_crossing_of_parts(*primitive_, parts, q.ray(k), q.tmin[k], q.tmax[k], c)
                              : primitive_->intersect(q.ray(k), q.tmin[k], q.tmax[k], c);
-        if (met) hits.t[k] = c.t, hits.part[k] = c.part, found |= 1u << k;
+        if (met) hits.c[k] = c, found |= 1u << k;
     }
     return found;
 }
