@@ -114,19 +114,24 @@ Ray grazing(const LatticeFrame& frame, std::size_t i, const Transform& xf, const
 }
 
 // The accelerator rejects rays by a cull part's capsule placed in world space before mapping
-// them into the lattice's space (Shape::cull_capsule): it must accept every line the shape's
-// own test accepts, under rotations, uniform and non-uniform scales and far translations, for
-// lines grazing the capsule within rounding; and it does reject lines.
+// them into the lattice's space (Shape::cull_capsule), kept in float (FloatCapsule): both must
+// accept every line the shape's own test accepts, under rotations, uniform and non-uniform
+// scales, a shear (condition number near 400) and far translations, for lines found within
+// rounding of the capsules' surfaces, with origins near, 10^9 and 10^13 away; and they do reject
+// lines.
 TEST(LatticeCulling, WorldCapsulesHoldEveryLineTheShapeAccepts) {
     const HookLattice lattice;
     const LatticeFrame frame(lattice.ctx, 0.3);
     ASSERT_GT(frame.cull_count(), 1u);
+    Affine shear;
+    shear.m = Mat3{{Vec3{1, 20, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}}};
     const Transform xfs[] = {
         Transform{},
         Transform::translate({10, -3, 2}) * Transform::rotate({1, 2, 3}, 0.7) *
             Transform::scale({2.5, 2.5, 2.5}),
         Transform::rotate({0, 1, 0}, 2.1) * Transform::scale({1, 3, 0.5}),
-        Transform::translate({4e3, 1e3, -2e3}) * Transform::rotate({3, 1, 0}, -1.2)};
+        Transform::translate({4e3, 1e3, -2e3}) * Transform::rotate({3, 1, 0}, -1.2),
+        Transform::translate({-1e6, 3e5, 0}) * *Transform::from_affine(shear)};
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> u(-1, 1);
     int accepted = 0, rejected = 0;
@@ -134,25 +139,31 @@ TEST(LatticeCulling, WorldCapsulesHoldEveryLineTheShapeAccepts) {
         for (std::size_t i = 0; i < frame.cull_count(); ++i) {
             Capsule world;
             ASSERT_TRUE(frame.cull_capsule(i, xf, world));
+            const FloatCapsule kept_in_float = FloatCapsule::holding(world);
             for (int n = 0; n < 3000; ++n) {
                 // A line through a point at about the reach from the hook's axis (in the
                 // lattice's space), many within rounding of the capsules' surfaces.
                 const Vec3 d = normalize(Vec3{u(rng), u(rng), u(rng)});
                 const Vec3 p{2 + 1.5 * u(rng), 1 + 1.5 * u(rng), 2 + 1.5 * u(rng)};
-                Ray local{p - d * 5, d};
+                const double far = n % 6 == 0 ? 1e13 : n % 3 == 0 ? 1e9 : 5.0;
+                Ray local{p - d * far, d};
                 if (n % 2 == 0) local = grazing(frame, i, xf, local);
                 const Ray r{xf.point(local.o), xf.vector(local.d)};
                 const bool kept = frame.cull_meets(i, xf.inverse_ray(r));
                 const bool kept_world = world.meets_line(r.o, r.d);
                 if (kept) {
                     ++accepted;
-                    ASSERT_TRUE(kept_world) << "part " << i << " line " << n;
+                    // The capsule in double, without FloatCapsule's allowance for far origins.
+                    if (n % 3 != 0) {
+                        ASSERT_TRUE(kept_world) << "part " << i << " line " << n;
+                    }
+                    ASSERT_TRUE(kept_in_float.meets_line(r.o, r.d)) << "part " << i << " line " << n;
                 }
-                rejected += kept_world ? 0 : 1;
+                rejected += kept_in_float.meets_line(r.o, r.d) ? 0 : 1;
             }
         }
-    EXPECT_GT(accepted, 2000);
-    EXPECT_GT(rejected, 2000);
+    EXPECT_GT(accepted, 3000);
+    EXPECT_GT(rejected, 3000);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -98,6 +99,55 @@ TEST(RayQuad, CylinderLanesAreTheScalarTests) {
         if (n % 6 == 3) d = {0, 1, 0};      // along a world axis
         const Vec3 target = lerp(a, b, double(n % 7) / 6.0);
         expect_lanes_are_scalar(cyl, random_quad(rng, target, d, 3 * radius, radius));
+    }
+}
+
+// The branches random rays never take: directions with components exactly 0 (an end cap's
+// slab or the side's quadratic absent), no direction at all, a ray starting on a sphere where
+// it is tangent (both roots 0), ranges ending exactly at a crossing, and NaN ranges.
+TEST(RayQuad, EdgeCasesAreTheScalarTests) {
+    const CappedCylinderShape along_z({1, 1, 0}, {1, 1, 2}, 0.5);
+    const SphereShape ball({0, 0, 0}, 1);
+    const auto quad = [](Vec3 o, Vec3 step, Vec3 d) {
+        RayQuad q;
+        q.d = d;
+        for (int k = 0; k < 4; ++k) {
+            q.ox[k] = o.x + step.x * k, q.oy[k] = o.y + step.y * k, q.oz[k] = o.z + step.z * k;
+            q.tmin[k] = k == 3 ? -kInfinity : 0, q.tmax[k] = kInfinity;
+        }
+        return q;
+    };
+    // Across the axis (da = 0), along it (A = 0), none.
+    for (const Vec3 d : {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}, Vec3{0, 0, -2}, Vec3{}}) {
+        expect_lanes_are_scalar(along_z, quad({-1, 0.6, 1}, {0, 0.25, 0.3}, d));
+        expect_lanes_are_scalar(along_z, quad({1.2, 0.9, -1}, {0.1, 0.1, 1.0}, d));
+        expect_lanes_are_scalar(ball, quad({-2, -0.5, 0}, {0, 0.5, 0}, d));
+    }
+    // Starting where tangent: the closest point is the origin, on the surface.
+    expect_lanes_are_scalar(ball, quad({0, 1, 0}, {0, 0, 0}, {1, 0, 0}));
+    expect_lanes_are_scalar(along_z, quad({1.5, 1, 1}, {0, 0, 0.2}, {0, 1, 0}));
+    // Ranges that end or start exactly at the scalar test's crossings, and NaN ones.
+    for (const Vec3 d : {Vec3{1, 0.1, 0.05}, Vec3{0, 0, 1}}) {
+        RayQuad q = quad({-3, 0.2, -3 * d.z}, {0, 0.1, 0}, d);
+        for (int k = 0; k < 4; ++k) {
+            double t0, t1;
+            if (!ball.solve(q.ray(k), t0, t1)) continue;
+            if (k == 0) q.tmax[k] = t0;
+            if (k == 1) q.tmin[k] = t0;
+            if (k == 2) q.tmin[k] = t0, q.tmax[k] = t1;
+            if (k == 3) q.tmin[k] = std::nan("");
+        }
+        expect_lanes_are_scalar(ball, q);
+        Crossing in, out;
+        RayQuad c = quad({-2, 1.2, -1}, {0, -0.1, 0.2}, d);
+        for (int k = 0; k < 4; ++k) {
+            if (!along_z.solve(c.ray(k), in, out)) continue;
+            if (k == 0) c.tmax[k] = in.t;
+            if (k == 1) c.tmin[k] = in.t;
+            if (k == 2) c.tmin[k] = in.t, c.tmax[k] = out.t;
+            if (k == 3) c.tmax[k] = std::nan("");
+        }
+        expect_lanes_are_scalar(along_z, c);
     }
 }
 

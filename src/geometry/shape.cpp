@@ -13,6 +13,22 @@ Bounds3 Capsule::placed_bounds(const Transform& xf) const {
     return {min(pa, pb) - e, max(pa, pb) + e};
 }
 
+// Moving the ends by at most `moved` moves every point of the segment by no more (each is a
+// convex combination of them), so the distance from any line to it by no more.
+FloatCapsule FloatCapsule::holding(const Capsule& c) {
+    FloatCapsule f;
+    double moved = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+        f.a[k] = static_cast<float>(c.a[k]), f.b[k] = static_cast<float>(c.b[k]);
+        moved = std::max({moved, std::abs(double(f.a[k]) - c.a[k]), std::abs(double(f.b[k]) - c.b[k])});
+    }
+    const double r = c.r + std::sqrt(3.0) * moved;
+    f.r = static_cast<float>(r);
+    if (double(f.r) < r) f.r = std::nextafter(f.r, INFINITY);
+    if (!std::isfinite(moved) || !std::isfinite(f.r)) f.r = -1;  // beyond float: none
+    return f;
+}
+
 bool first_crossing(const SpanList& spans, double tmin, double tmax, Crossing& hit) {
     for (const Span& s : spans) {
         if (s.in.t >= tmax) return false;

@@ -61,6 +61,22 @@ struct Capsule {
     Bounds3 placed_bounds(const Transform& xf) const;
 };
 
+// A capsule in float (28 bytes: the accelerator keeps one a cull part) that holds a given one:
+// its ends are rounded, and its radius grown by their rounding and rounded up. A line's test
+// allows, besides, for the rounding of a far origin (1e-9 of its distance from the capsule),
+// so that it accepts every line that the held capsule's test accepts on the same line mapped
+// into another space, with its own rounding (LatticeFrame::cull_capsule).
+struct FloatCapsule {
+    float a[3] = {}, b[3] = {}, r = -1;  // r < 0: none, and every line meets it
+
+    static FloatCapsule holding(const Capsule& c);
+    bool meets_line(Vec3 o, Vec3 d) const {
+        if (r < 0) return true;
+        const Capsule c{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}, r};
+        return c.meets_line(o, d, c.r + 1e-9 * max_component(abs(o - c.a)));
+    }
+};
+
 // A hit's place on its surface and the outward unit normal there.
 struct SurfacePoint {
     Vec3 p, n;
@@ -216,7 +232,7 @@ public:
     virtual bool cull_meets(std::size_t, const Ray&) const { return true; }
     // A capsule that every line cull_meets(i, .) accepts meets, placed by xf (world space), if
     // the cull part has one: the accelerator rejects rays by it before mapping them into the
-    // shape's space (most rays meeting a cull part's box miss its capsule).
+    // shape's space (about half the rays meeting a cull part's box miss its capsule).
     virtual bool cull_capsule(std::size_t, const Transform&, Capsule&) const { return false; }
 
     // CSG trees carry a material tag per leaf; other shapes answer with the fallback.

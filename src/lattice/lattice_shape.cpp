@@ -153,15 +153,18 @@ bool LatticeFrame::cull_meets(std::size_t i, const Ray& r, double narrower) cons
 }
 
 // Any affine map takes the capsule's ball into an ellipsoid within max_stretch times its
-// radius, so the placed segment's capsule of that radius holds the placed capsule; it is grown
-// by far more than the rounding of the placement and of either test (a few ulps of the
-// coordinates), so that it never rejects a line the test in the shape's space accepts.
+// radius, so the placed segment's capsule of that radius holds the placed capsule. It is grown
+// by far more than the rounding of the placement (a few ulps of the placed coordinates and of
+// the translation, which can cancel) and of either test on the near side; the far side, a
+// far origin's rounding, is FloatCapsule's. So it never rejects a line that the test in the
+// shape's space accepts (tests/lattice_shape_test.cpp).
 bool LatticeFrame::cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const {
     const CullPart& p = cull_[i];
     if (p.count != 1) return false;
     const Capsule& c = capsules_[p.first];
     out.a = xf.point(c.a), out.b = xf.point(c.b);
-    const double scale = max_component(abs(out.a)) + max_component(abs(out.b));
+    const double scale = max_component(abs(out.a)) + max_component(abs(out.b)) +
+                         max_component(abs(xf.point({0, 0, 0})));
     out.r = c.r * xf.max_stretch() * (1 + 1e-9) + 1e-9 * scale;
     return true;
 }

@@ -24,7 +24,8 @@ namespace {
 //   1.5:   40 / 176 / 237 / 434 / 341 / -- / -- ms, 53.13 / 38.46 / 40.27 / 32.85 / 37.45 dB
 //   2:     39 / 169 / 243 / 476 / 386 / 179 / 49 ms
 //          53.15 / 38.47 / 40.27 / 32.92 / 37.45 / 29.68 / 36.16 dB
-// (Exact at 4 spp: Plate 3 52.81 dB, which 1 beats by too little; the bunny 30.97 dB.)
+// (Medians of 3; Plate 3's times vary by a few ms from run to run. Exact at 4 spp: Plate 3
+// 52.81 dB, which 1 beats by too little; the bunny 30.97 dB.)
 constexpr double kSubRayWidening = 1.25;
 
 
