@@ -122,7 +122,7 @@ struct QuadSpan {
 // solve() for lanes h, h + 1 of q: the lanes where the line meets the cylinder, and their
 // span. What depends on the direction alone, shared by the lanes, is tested once.
 quad::V solve_pair(const RayQuad& q, int h, Vec3 a, Vec3 axis, double len, double radius,
-                          QuadSpan& span) {
+                    QuadSpan& span) {
     using namespace quad;
     const V3 w = origins_minus(q, h, a);
     const V wa = dot(w, axis);
@@ -144,28 +144,33 @@ quad::V solve_pair(const RayQuad& q, int h, Vec3 a, Vec3 axis, double len, doubl
 
     // Infinite cylinder.
     V c0 = splat(-kInfinity), c1 = splat(kInfinity);
-    const double A = length_squared(dp), rr = radius * radius;
-    if (A > 0.0) {
-        const V b = -dot(wp, dp) / splat(A);
-        const V3 p{wp.x + splat(dp.x) * b, wp.y + splat(dp.y) * b, wp.z + splat(dp.z) * b};
-        const V disc = splat(rr) - dot(p, p);
-        met = _mm_and_pd(met, _mm_cmpnlt_pd(disc, splat(-kTouchTolerance * radius * radius)));
-        const V hh = _mm_sqrt_pd(max0(disc) / splat(A));
-        const V c = (dot(wp, wp) - splat(rr)) / splat(A);
-        const V qq = b + copysign(hh, b);
-        const V other = c / qq;
-        const V swap = _mm_cmpgt_pd(qq, other);
-        const V on_axis = _mm_cmpeq_pd(qq, _mm_setzero_pd());
-        c0 = _mm_andnot_pd(on_axis, pick(swap, other, qq));
-        c1 = _mm_andnot_pd(on_axis, pick(swap, qq, other));
+    if (const double A = length_squared(dp); A > 0.0) {
+        met = _mm_and_pd(met, line_roots(wp, dp, A, radius, c0, c1));
     } else {
-        met = _mm_andnot_pd(_mm_cmpgt_pd(dot(wp, wp), splat(rr)), met);
+        met = _mm_andnot_pd(_mm_cmpgt_pd(dot(wp, wp), splat(radius * radius)), met);
     }
 
     const V side_in = _mm_cmpgt_pd(c0, s0), side_out = _mm_cmplt_pd(c1, s1);
     span.tin = pick(side_in, c0, s0), span.pin = _mm_andnot_pd(side_in, s0part);
     span.tout = pick(side_out, c1, s1), span.pout = _mm_andnot_pd(side_out, s1part);
     return _mm_and_pd(met, _mm_cmple_pd(span.tin, span.tout));
+}
+
+// The lanes (of h, h + 1) in `live` whose entry (in_ok) or else exit (out_ok) lies in their
+// range: the crossing intersect() answers with, if any.
+struct QuadCrossing {
+    QuadSpan span;
+    quad::V in_ok, out_ok;
+};
+QuadCrossing crossing_pair(const RayQuad& q, int h, unsigned live, Vec3 a, Vec3 axis,
+                           double len, double radius) {
+    using namespace quad;
+    QuadCrossing x;
+    const V met = _mm_and_pd(solve_pair(q, h, a, axis, len, radius, x.span), mask_of(live >> h & 3u));
+    const V tmin = load(q.tmin + h), tmax = load(q.tmax + h);
+    x.in_ok = _mm_and_pd(met, _mm_and_pd(_mm_cmpgt_pd(x.span.tin, tmin), _mm_cmplt_pd(x.span.tin, tmax)));
+    x.out_ok = _mm_and_pd(met, _mm_and_pd(_mm_cmpgt_pd(x.span.tout, tmin), _mm_cmplt_pd(x.span.tout, tmax)));
+    return x;
 }
 
 }  // namespace
@@ -175,28 +180,20 @@ unsigned CappedCylinderShape::intersect_quad(RayQuad& q, unsigned live, QuadCros
     unsigned found = 0;
     for (int h = 0; h < 4; h += 2) {
         if ((live >> h & 3u) == 0) continue;
-        QuadSpan sp;
-        const V met = _mm_and_pd(solve_pair(q, h, a_, axis_, len_, r_, sp), mask_of(live >> h & 3u));
-        const V tmin = load(q.tmin + h), tmax = load(q.tmax + h);
-        const V in_ok = _mm_and_pd(_mm_cmpgt_pd(sp.tin, tmin), _mm_cmplt_pd(sp.tin, tmax));
-        const V out_ok = _mm_and_pd(_mm_cmpgt_pd(sp.tout, tmin), _mm_cmplt_pd(sp.tout, tmax));
-        const V t = pick(in_ok, sp.tin, sp.tout), part = pick(in_ok, sp.pin, sp.pout);
-        found |= keep(q, hits, h, _mm_and_pd(met, _mm_or_pd(in_ok, out_ok)), t, part);
+        const QuadCrossing x = crossing_pair(q, h, live, a_, axis_, len_, r_);
+        const V t = pick(x.in_ok, x.span.tin, x.span.tout);
+        const V part = pick(x.in_ok, x.span.pin, x.span.pout);
+        found |= keep(q, hits, h, _mm_or_pd(x.in_ok, x.out_ok), t, part);
     }
     return found;
 }
 
 unsigned CappedCylinderShape::occluded_quad(const RayQuad& q, unsigned live) const {
-    using namespace quad;
     unsigned blocked = 0;
     for (int h = 0; h < 4; h += 2) {
         if ((live >> h & 3u) == 0) continue;
-        QuadSpan sp;
-        const V met = _mm_and_pd(solve_pair(q, h, a_, axis_, len_, r_, sp), mask_of(live >> h & 3u));
-        const V tmin = load(q.tmin + h), tmax = load(q.tmax + h);
-        const V in_ok = _mm_and_pd(_mm_cmpgt_pd(sp.tin, tmin), _mm_cmplt_pd(sp.tin, tmax));
-        const V out_ok = _mm_and_pd(_mm_cmpgt_pd(sp.tout, tmin), _mm_cmplt_pd(sp.tout, tmax));
-        blocked |= bits(_mm_and_pd(met, _mm_or_pd(in_ok, out_ok))) << h;
+        const QuadCrossing x = crossing_pair(q, h, live, a_, axis_, len_, r_);
+        blocked |= quad::bits(_mm_or_pd(x.in_ok, x.out_ok)) << h;
     }
     return blocked;
 }

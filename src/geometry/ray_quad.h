@@ -57,6 +57,26 @@ inline V3 origins_minus(const RayQuad& q, int h, Vec3 p) {
     return {load(q.ox + h) - splat(p.x), load(q.oy + h) - splat(p.y), load(q.oz + h) - splat(p.z)};
 }
 
+// The roots t0 <= t1 of |w + t d|^2 = r^2 for lanes of w (d shared, dd = |d|^2 > 0), and the
+// lanes where the line comes within r of the point (the touch tolerance allowed): what the
+// scalar sphere's and cylinder's solve() compute, in their stable closest-point form.
+inline V line_roots(const V3& w, Vec3 d, double dd, double r, V& t0, V& t1) {
+    const double rr = r * r;
+    const V b = -dot(w, d) / splat(dd);
+    const V3 p{w.x + splat(d.x) * b, w.y + splat(d.y) * b, w.z + splat(d.z) * b};
+    const V disc = splat(rr) - dot(p, p);
+    const V met = _mm_cmpnlt_pd(disc, splat(-kTouchTolerance * r * r));
+    const V hh = _mm_sqrt_pd(max0(disc) / splat(dd));
+    const V c = (dot(w, w) - splat(rr)) / splat(dd);
+    const V q = b + copysign(hh, b);
+    const V other = c / q;
+    const V swap = _mm_cmpgt_pd(q, other);
+    const V zero = _mm_cmpeq_pd(q, _mm_setzero_pd());  // both roots 0
+    t0 = _mm_andnot_pd(zero, pick(swap, other, q));
+    t1 = _mm_andnot_pd(zero, pick(swap, q, other));
+    return met;
+}
+
 // Keeps in `hits` the lanes (of h, h + 1) where `found` is set, at t with this part number, and
 // narrows their tmax to t, as the scalar loop over parts does (first_crossing_of_parts).
 inline unsigned keep(RayQuad& q, QuadCrossings& hits, int h, V found, V t, V part) {

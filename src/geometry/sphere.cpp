@@ -74,23 +74,7 @@ namespace {
 
 // solve() for lanes h, h + 1 of q: the lanes where the line meets the sphere, and t0 <= t1.
 quad::V solve_pair(const RayQuad& q, int h, Vec3 c, double r, quad::V& t0, quad::V& t1) {
-    using namespace quad;
-    const double dd = length_squared(q.d);
-    const double rr = r * r, reject = -kTouchTolerance * r * r;
-    const V3 f = origins_minus(q, h, c);
-    const V b = -dot(f, q.d) / splat(dd);
-    const V3 perp{f.x + splat(q.d.x) * b, f.y + splat(q.d.y) * b, f.z + splat(q.d.z) * b};
-    const V disc_raw = splat(rr) - dot(perp, perp);
-    const V met = _mm_cmpnlt_pd(disc_raw, splat(reject));
-    const V hh = _mm_sqrt_pd(max0(disc_raw) / splat(dd));
-    const V cc = (dot(f, f) - splat(rr)) / splat(dd);
-    const V qq = b + copysign(hh, b);
-    const V other = cc / qq;
-    const V swap = _mm_cmpgt_pd(qq, other);
-    const V on_centre = _mm_cmpeq_pd(qq, _mm_setzero_pd());
-    t0 = _mm_andnot_pd(on_centre, pick(swap, other, qq));
-    t1 = _mm_andnot_pd(on_centre, pick(swap, qq, other));
-    return met;
+    return quad::line_roots(quad::origins_minus(q, h, c), q.d, length_squared(q.d), r, t0, t1);
 }
 
 }  // namespace
