@@ -27,10 +27,11 @@ public:
 
     const std::vector<ChainSphere>& spheres() const { return spheres_; }
     const std::vector<ChainCylinder>& cylinders() const { return cylinders_; }
+    // Its parts' indices, 0 to primitive_count() - 1, in the order intersect() tests them.
+    std::span<const std::uint32_t> all_parts() const { return all_parts_; }
 
     Bounds3 bounds() const override { return bounds_; }
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
-    bool intersects_parts_in_order() const override { return true; }
     bool occluded(const Ray& r, double tmin, double tmax) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;

@@ -163,9 +163,6 @@ public:
     // every lookup, only where that is cheap.
     virtual bool cheap_normal(const Crossing&) const { return true; }
 
-    // Whether intersect() is first_crossing_of_parts over all the primitives in order: then
-    // any superset of the parts a ray can meet, in order, gives the same crossing, bit for bit.
-    virtual bool intersects_parts_in_order() const { return false; }
     // About how many simple tests (a sphere's or a cylinder's) one intersect() makes: what a
     // lattice weighs before tracing its primitive exactly where its tables could answer
     // (FilteredLatticeShape). By default its primitives, tested one by one.

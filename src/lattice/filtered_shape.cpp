@@ -99,13 +99,14 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
                            BoundaryGrid(l.ctx.cells)});
     }
     bounds_ = exact_ ? expand(point_.bounds(), sub_ray_reach_) : point_.bounds();
-    // Boxes pay for their set-up on a hair of 19 parts, not on a thistle spike of 3 (Plate 2
-    // rendered 9 % slower when every sub-ray tested the boxes).
-    if (exact_ && primitive_->intersects_parts_in_order() &&
-        primitive_->primitive_count() >= kMinBoxedParts &&
-        primitive_->primitive_count() <= kMaxNearParts)
-        part_boxes_ = std::make_unique<const PartBoxes>(*primitive_, point_.bounds());
-    chain_ = dynamic_cast<const ChainShape*>(primitive_);
+    // A chain's crossing is the first of its parts' in order (ChainShape::intersect), so any
+    // superset of the parts a sub-ray can meet, in order, gives it bit for bit. Boxes pay for
+    // their set-up on a hair of 19 parts, not on a thistle spike of 3 (Plate 2 rendered 9 %
+    // slower when every sub-ray tested the boxes).
+    chain_ = exact_ ? dynamic_cast<const ChainShape*>(primitive_) : nullptr;
+    if (chain_ && chain_->primitive_count() >= kMinBoxedParts &&
+        chain_->primitive_count() <= kMaxNearParts)
+        part_boxes_ = std::make_unique<const PartBoxes>(*chain_, point_.bounds());
 }
 
 void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bool smooth,
@@ -307,9 +308,8 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
     // faster than with every part intersected by every sub-ray; images identical. (Boxes grown
     // by (n - 1) / n of the width, as first written, kept more parts: 2 % slower.)
     std::array<std::uint32_t, kMaxNearParts> near;
-    const std::size_t n_near =
-        part_boxes_ ? part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, near) : 0;
-    const std::span parts(near.data(), n_near);
+    std::span<const std::uint32_t> parts = chain_ ? chain_->all_parts() : std::span<const std::uint32_t>{};
+    if (part_boxes_) parts = {near.data(), part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, near)};
     // The sub-rays, lane k = i n + j (bit k of Sheet::sub_rays), each clipped to the box.
     static_assert(n * n == 4, "a RayQuad holds a ray's sub-rays");
     RayQuad q;
@@ -349,29 +349,20 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
 // A chain's parts take the sub-rays four at once; other primitives one sub-ray at a time.
 unsigned FilteredLatticeShape::sub_ray_crossings(std::span<const std::uint32_t> parts, RayQuad& q,
                                                  unsigned live, QuadCrossings& hits) const {
-    if (chain_ && part_boxes_) return chain_->first_crossings(parts, q, live, hits);
+    if (chain_) return chain_->first_crossings(parts, q, live, hits);
     unsigned found = 0;
-    for (int k = 0; k < kSubRays; ++k) {
-        if (!(live >> k & 1)) continue;
-        Crossing c;
-        const bool met = part_boxes_
-                             ? first_crossing_of_parts(*primitive_, parts, q.ray(k), q.tmin[k], q.tmax[k], c)
-                             : primitive_->intersect(q.ray(k), q.tmin[k], q.tmax[k], c);
-        if (met) hits.c[k] = c, found |= 1u << k;
-    }
+    for (int k = 0; k < kSubRays; ++k)
+        if (live >> k & 1 && primitive_->intersect(q.ray(k), q.tmin[k], q.tmax[k], hits.c[k]))
+            found |= 1u << k;
     return found;
 }
 
 unsigned FilteredLatticeShape::blocked_sub_rays(std::span<const std::uint32_t> parts,
                                                 const RayQuad& q, unsigned live) const {
-    if (chain_ && part_boxes_) return chain_->blocked_lanes(parts, q, live);
+    if (chain_) return chain_->blocked_lanes(parts, q, live);
     unsigned blocked = 0;
-    for (int k = 0; k < kSubRays; ++k) {
-        if (!(live >> k & 1)) continue;
-        const bool b = part_boxes_ ? any_part_occludes(*primitive_, parts, q.ray(k), q.tmin[k], q.tmax[k])
-                                   : primitive_->occluded(q.ray(k), q.tmin[k], q.tmax[k]);
-        if (b) blocked |= 1u << k;
-    }
+    for (int k = 0; k < kSubRays; ++k)
+        if (live >> k & 1 && primitive_->occluded(q.ray(k), q.tmin[k], q.tmax[k])) blocked |= 1u << k;
     return blocked;
 }
 

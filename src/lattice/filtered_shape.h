@@ -106,7 +106,7 @@ double farthest_sub_ray(double width);
 inline constexpr double kMaxExactCost = 64;
 // Whether a filtered lattice with levels of detail answers its rays from the primitive itself.
 bool answered_by_primitive(const Shape& primitive);
-// Unions of at most this many parts find the parts near a ray first (PartBoxes::near_parts).
+// Chains of at most this many parts find the parts near a ray first (PartBoxes::near_parts).
 inline constexpr std::size_t kMaxNearParts = 64;
 
 // One level: a coverage table and its lattice.
@@ -202,7 +202,7 @@ private:
     double exact_width_;    // the widest footprint its sub-rays span
     double sub_ray_reach_;  // how far from a ray its sub-rays lie, at most (culling's reach)
     Bounds3 bounds_;
-    // A union's parts' boxes: a sub-ray is intersected with the parts whose box it meets only.
+    // A chain's parts' boxes: a sub-ray is intersected with the parts whose box it meets only.
     std::unique_ptr<const PartBoxes> part_boxes_;
     const ChainShape* chain_ = nullptr;  // primitive_, when it is a chain
     HitTableShape point_;  // the finest level, point-sampled
