@@ -81,8 +81,8 @@ public:
         s_->primitive_spheres(i, out);
     }
     std::size_t cull_count() const override { return s_->cull_count(); }
-    lat::Bounds3 cull_bounds(std::size_t i, const lat::Transform& xf) const override {
-        return s_->cull_bounds(i, xf);
+    lat::Bounds3 cull_bounds(std::size_t i, const lat::Transform& xf, double widest) const override {
+        return s_->cull_bounds(i, xf, widest);
     }
     bool cull_meets(std::size_t i, const lat::Ray& r) const override {
         return s_->cull_meets(i, r);

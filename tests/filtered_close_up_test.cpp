@@ -10,6 +10,7 @@
 #include "geometry/chain.h"
 #include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
+#include "geometry/sub_rays.h"
 #include "geometry/triangle_mesh.h"
 #include "hook_primitive.h"
 #include "lattice/encoding.h"
@@ -231,7 +232,7 @@ TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
         double t0 = 0, t1 = kInfinity;
         if (!clip_ray(s.bounds(), r, t0, t1)) return false;
         for (std::size_t i = 0; i < s.cull_count(); ++i)
-            if (t0 = 0, t1 = kInfinity; clip_ray(s.cull_bounds(i, Transform{}), r, t0, t1)) return true;
+            if (t0 = 0, t1 = kInfinity; clip_ray(s.cull_bounds(i, Transform{}, kInfinity), r, t0, t1)) return true;
         return false;
     };
     int hits = 0, culled = 0, outside = 0;
@@ -254,6 +255,59 @@ TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
     EXPECT_GT(hits, 3000);
     EXPECT_GT(culled, 3000);
     EXPECT_GT(outside, 20);  // rays whose lines miss the lattice box, answered by sub-rays
+}
+
+// An instance whose rays span at most `widest` (AccelObject::widest_footprint) is culled by
+// its own narrower boxes and capsules, placed in world space: every ray (of any footprint,
+// wider ones narrowed to it) whose sheet has a crossing meets one of them, under a rotation
+// and scale too; and narrower instances cull more rays.
+TEST(FilteredCloseUps, EachInstanceIsCulledByItsOwnWidestFootprint) {
+    const HookLattice h = hook_lattice(long_hook());
+    const FilteredLatticeShape& s = *h.exact;
+    const Transform turned = Transform::translate({3, -2, 5}) * Transform::rotate({1, 2, 3}, 0.7) *
+                             Transform::scale({1.5, 1.5, 1.5});
+    int last_culled = -1;
+    for (const double widest : {kInfinity, 0.7 * kExactWidth, 0.3 * kExactWidth, 0.05}) {
+        AcrossRay in_object;  // no directions across: each sub-ray along the object's own axes
+        in_object.widest = widest;
+        int hits = 0, culled = 0;
+        for (const Transform& xf : {Transform{}, turned}) {
+            std::vector<Bounds3> boxes;
+            std::vector<FloatCapsule> capsules;
+            for (std::size_t i = 0; i < s.cull_count(); ++i) {
+                boxes.push_back(s.cull_bounds(i, xf, widest));
+                Capsule c;
+                capsules.push_back(s.cull_capsule(i, xf, widest, c) ? FloatCapsule::holding(c)
+                                                                    : FloatCapsule{});
+            }
+            const auto kept = [&](const Ray& world) {
+                for (std::size_t i = 0; i < boxes.size(); ++i)
+                    if (double t0 = -kInfinity, t1 = kInfinity;
+                        clip_ray(boxes[i], world, t0, t1) && capsules[i].meets_line(world.o, world.d))
+                        return true;
+                return false;
+            };
+            for (const double footprint : {0.0, 0.05, 0.5, 2.0, kExactWidth, 3 * kExactWidth}) {
+                set_ray_footprint({footprint, 0, false});
+                for (const Ray& local : rays(2000)) {
+                    const Ray world{xf.point(local.o), xf.vector(local.d)};
+                    set_across_ray_in_object(in_object);
+                    Crossing c;
+                    const bool hit = s.intersect(xf.inverse_ray(world), 0.0, kInfinity, c);
+                    hits += hit;
+                    if (hit) {
+                        EXPECT_TRUE(kept(world)) << "widest " << widest << ", footprint " << footprint;
+                    }
+                    culled += !kept(world);
+                }
+            }
+        }
+        EXPECT_GT(hits, 1000) << "widest " << widest;
+        EXPECT_GT(culled, last_culled) << "widest " << widest;
+        last_culled = culled;
+    }
+    set_ray_footprint({});
+    set_across_ray_in_object({});
 }
 
 // A ray leaving a sheet skips its own lattice for the sheet's distance from the surface: with

@@ -131,7 +131,7 @@ TEST_F(LatticeRender, CullingByThePrimitiveChangesNoPixel) {
                 const std::size_t parts = culled[i]->cull_count();
                 double volume = 0;
                 for (std::size_t c = 0; c < parts; ++c) {
-                    const Bounds3 b = culled[i]->cull_bounds(c, Transform{});
+                    const Bounds3 b = culled[i]->cull_bounds(c, Transform{}, kInfinity);
                     volume += b.extent().x * b.extent().y * b.extent().z;
                 }
                 const Vec3 box = culled[i]->bounds().extent();
@@ -193,7 +193,7 @@ TEST_F(LatticeRender, TurnedInstancesAreCulledByTheirPlacedParts) {
         auto volume = [](const Bounds3& b) { return b.extent().x * b.extent().y * b.extent().z; };
         double culled_volume = 0;
         for (std::size_t c = 0; c < culled->cull_count(); ++c)
-            culled_volume += volume(culled->cull_bounds(c, xf));
+            culled_volume += volume(culled->cull_bounds(c, xf, kInfinity));
         // Two halves of the lattice box, each bounded in world space (as before the placed
         // parts were used), gave 0.47 (hash14) and 0.25 (candidates) of the turned box's bounds.
         const double limit = encoding == "candidates" ? 0.2 : 0.4;

@@ -38,7 +38,7 @@ public:
     std::size_t cull_count() const override { return parts_; }
     // Boxes reaching farther and farther back along the ray, so that a traversal meets other
     // objects between the parts of one (more than the ring of tested objects holds).
-    Bounds3 cull_bounds(std::size_t i, const Transform& xf) const override {
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf, double) const override {
         return xf.bounds(Bounds3{{-1, -1, z_ - 6.0 * double(i) - 0.01}, {1, 1, z_ + 0.01}});
     }
 

@@ -45,18 +45,19 @@ bool keeps_directions_across(const Transform& xf) {
 
 // The directions across the ray being traced, in an object's space (unset where its map does
 // not keep them, `similar`).
-AcrossRay across_in_object(const Transform& xf, bool similar) {
+AcrossRay across_in_object(const AccelObject& o, bool similar) {
     AcrossRay a = across_ray();
-    if (!a.set || xf.is_identity()) return a;
+    a.widest = o.widest_footprint;
+    if (!a.set || o.xf->is_identity()) return a;
     a.set = similar;
-    if (similar) a.u = xf.inverse_vector(a.u), a.v = xf.inverse_vector(a.v);
+    if (similar) a.u = o.xf->inverse_vector(a.u), a.v = o.xf->inverse_vector(a.v);
     return a;
 }
 
 // The object-space ray for objects tested outside Embree, with the directions across it.
-Ray object_ray(const Transform& xf, bool similar, const Ray& r) {
-    set_across_ray_in_object(across_in_object(xf, similar));
-    return xf.is_identity() ? r : xf.inverse_ray(r);
+Ray object_ray(const AccelObject& o, bool similar, const Ray& r) {
+    set_across_ray_in_object(across_in_object(o, similar));
+    return o.xf->is_identity() ? r : o.xf->inverse_ray(r);
 }
 
 // Partial crossings in ray order, ties by object: the same for any traversal order.
@@ -220,7 +221,7 @@ struct EmbreeAccel::Impl {
     };
     static_assert(sizeof(DirectPrim) == 36);
     static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
-                                  const Shape& shape, const Transform& xf);
+                                  const AccelObject& o);
     std::vector<DirectPrim> direct;
     std::vector<Bounds3> direct_bounds;  // world space, per direct primitive
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
@@ -264,7 +265,7 @@ struct EmbreeAccel::Impl {
     void hand_across(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->across_obj == obj) return;
         ctx->across_obj = obj;
-        set_across_ray_in_object(across_in_object(*objects[obj].xf, similar[obj]));
+        set_across_ray_in_object(across_in_object(objects[obj], similar[obj]));
     }
 
     // Whether a direct primitive's object is to be tested: it was not tested already for this
@@ -419,10 +420,10 @@ static void on_embree_error(void* user, RTCError, const char* str) {
 
 EmbreeAccel::Impl::DirectPrim EmbreeAccel::Impl::direct_prim(std::uint32_t object,
                                                              std::uint32_t cull, bool shared,
-                                                             const Shape& shape,
-                                                             const Transform& xf) {
+                                                             const AccelObject& o) {
     DirectPrim d{object, cull, shared, {}};
-    if (Capsule c; shared && shape.cull_capsule(cull, xf, c)) d.capsule = FloatCapsule::holding(c);
+    if (Capsule c; shared && o.shape->cull_capsule(cull, *o.xf, o.widest_footprint, c))
+        d.capsule = FloatCapsule::holding(c);
     return d;
 }
 
@@ -469,13 +470,13 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             if (m.inst_object.size() <= id) m.inst_object.resize(id + 1, 0);
             m.inst_object[id] = i;
         } else if (o.shape->cull_count() == 1) {
-            m.direct.push_back(Impl::direct_prim(i, 0, false, *o.shape, *o.xf));
+            m.direct.push_back(Impl::direct_prim(i, 0, false, o));
             m.direct_bounds.push_back(wb);
         } else {
             for (std::uint32_t c = 0; c < o.shape->cull_count(); ++c) {
-                const Bounds3 b = o.shape->cull_bounds(c, *o.xf);
+                const Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);
                 if (b.empty()) continue;
-                m.direct.push_back(Impl::direct_prim(i, c, true, *o.shape, *o.xf));
+                m.direct.push_back(Impl::direct_prim(i, c, true, o));
                 m.direct_bounds.push_back(b);
             }
         }
@@ -505,7 +506,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
-        const Ray local = object_ray(*o.xf, m.similar[i], r);
+        const Ray local = object_ray(o, m.similar[i], r);
         Crossing c;
         if (o.shape->intersect(local, tmin, ctx.found ? hit.t : tmax, c)) {
             ctx.found = true;
@@ -531,7 +532,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;
         const AccelObject& o = m.objects[i];
-        const Ray local = object_ray(*o.xf, m.similar[i], r);
+        const Ray local = object_ray(o, m.similar[i], r);
         Crossing c;
         const double t1 = ctx.found ? std::min(hit.t, ctx.tmax) : ctx.tmax;
         if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), t1, c)) continue;
@@ -558,7 +559,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     ctx.self = self;
     for (const std::uint32_t i : m.unbounded) {
         const AccelObject& o = m.objects[i];
-        const Ray local = object_ray(*o.xf, m.similar[i], r);
+        const Ray local = object_ray(o, m.similar[i], r);
         if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) return true;
     }
 

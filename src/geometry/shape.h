@@ -220,8 +220,11 @@ public:
     // gets a crossing from this shape only if its line meets one of them, and a shadow ray is
     // occluded only if it does. By default one part, the bounds.
     virtual std::size_t cull_count() const { return 1; }
-    // The bounds of cull part i placed by xf.
-    virtual Bounds3 cull_bounds(std::size_t, const Transform& xf) const {
+    // The bounds of cull part i placed by xf. widest: the widest footprint (shape units) of the
+    // rays this placement is traced with (AccelObject::widest_footprint; infinity: any). A shape
+    // whose reach grows with the footprint (a filtered lattice's sub-rays) culls narrower for
+    // narrower ones; its queries then take the same bound from across_ray_in_object().
+    virtual Bounds3 cull_bounds(std::size_t, const Transform& xf, double /*widest*/) const {
         return placed_bounds(xf);
     }
     // Whether the line of r (shape coordinates) can meet cull part i, for a line that meets its
@@ -230,7 +233,10 @@ public:
     // A capsule that every line cull_meets(i, .) accepts meets, placed by xf (world space), if
     // the cull part has one: the accelerator rejects rays by it before mapping them into the
     // shape's space (about half the rays meeting a cull part's box miss its capsule).
-    virtual bool cull_capsule(std::size_t, const Transform&, Capsule&) const { return false; }
+    // widest as for cull_bounds.
+    virtual bool cull_capsule(std::size_t, const Transform&, double /*widest*/, Capsule&) const {
+        return false;
+    }
 
     // CSG trees carry a material tag per leaf; other shapes answer with the fallback.
     virtual std::uint32_t tag(const Crossing&, std::uint32_t fallback) const { return fallback; }

@@ -22,6 +22,9 @@ inline constexpr int kSubRays = 4;  // a 2 x 2 grid
 struct AcrossRay {
     Vec3 u, v;
     bool set = false;
+    // The object's copy only: the widest footprint (object units) its sub-rays may span, its
+    // placement's (AccelObject::widest_footprint), by which its culling was narrowed.
+    double widest = kInfinity;
 };
 const AcrossRay& across_ray();
 // Sets the directions across a ray (unit direction) for a scope: the previous ones after it,

@@ -39,11 +39,11 @@ public:
         return primitive_->tag(c, fallback);
     }
     std::size_t cull_count() const override { return frame_.cull_count(); }
-    Bounds3 cull_bounds(std::size_t i, const Transform& xf) const override {
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf, double) const override {
         return frame_.cull_bounds(i, xf);
     }
     bool cull_meets(std::size_t i, const Ray& r) const override { return frame_.cull_meets(i, r); }
-    bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const override {
+    bool cull_capsule(std::size_t i, const Transform& xf, double, Capsule& out) const override {
         return frame_.cull_capsule(i, xf, out);
     }
 

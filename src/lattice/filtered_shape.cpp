@@ -200,7 +200,9 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
     Sheet s;
     double finer = 0;  // how many levels finer than the finest table the footprint is
     if (exact_) {
-        add_exact(std::min(width, exact_width_), normal, r, tmin, tmax, s);
+        // The instance's own bound, by which its culling was narrowed (cull_bounds).
+        const double widest = std::min(exact_width_, across_ray_in_object().widest);
+        add_exact(std::min(width, widest), normal, r, tmin, tmax, s);
     } else {
         // Rays without a footprint read the finest table.
         const double top = double(levels_.size() - 1);
@@ -252,12 +254,10 @@ double FilteredLatticeShape::footprint_width(const Ray& r) const {
 }
 
 bool FilteredLatticeShape::cull_meets(std::size_t i, const Ray& r) const {
-    if (!exact_) return cull_frame().cull_meets(i, r);
-    // The capsules less the part of the reach this ray's sub-rays do not span (0 when it is
-    // narrowed to the exact width; written so that rounding never makes it negative).
-    const double width = footprint_width(r);
-    const double unspanned = width >= exact_width_ ? 0.0 : sub_ray_reach_ - farthest_sub_ray(width);
-    return cull_frame().cull_meets(i, r, unspanned);
+    // The capsules less the part of the reach this ray's sub-rays do not span. (The instance's
+    // own bound is not handed on yet when its cull parts are tested: its capsules and boxes
+    // were narrowed by it already, cull_bounds.)
+    return cull_frame().cull_meets(i, r, unspanned_reach(footprint_width(r)));
 }
 
 void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, double tmin,

@@ -138,13 +138,15 @@ public:
     bool inside(Vec3 p) const override { return point_.inside(p); }
     // Culled by the frame of level cull_level_ (see the constructor).
     std::size_t cull_count() const override { return cull_frame().cull_count(); }
-    Bounds3 cull_bounds(std::size_t i, const Transform& xf) const override {
-        return cull_frame().cull_bounds(i, xf);
+    // An instance whose rays span at most `widest` has its capsules and boxes narrowed by the
+    // reach its sub-rays cannot use (unspanned_reach).
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf, double widest) const override {
+        return cull_frame().cull_bounds(i, xf, unspanned_reach(widest));
     }
     // With the primitive's crossings, by the reach of the ray's own sub-rays.
     bool cull_meets(std::size_t i, const Ray& r) const override;
-    bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const override {
-        return cull_frame().cull_capsule(i, xf, out);
+    bool cull_capsule(std::size_t i, const Transform& xf, double widest, Capsule& out) const override {
+        return cull_frame().cull_capsule(i, xf, out, unspanned_reach(widest));
     }
     // How far a ray leaving a sheet skips this lattice: a sheet's point is a blend of the
     // tables' pairs' points, within about 2 cells of the surface; with the primitive's
@@ -210,6 +212,12 @@ private:
     const LatticeFrame& cull_frame() const { return levels_[cull_level_].frame; }
     // The ray's footprint's width at the box (primitive units; 0 without one).
     double footprint_width(const Ray& r) const;
+    // How much of sub_ray_reach_ the sub-rays of footprints at most `width` wide leave unused:
+    // 0 at exact_width_ and above, and for lattices answered by their tables (written so that
+    // rounding never makes it negative).
+    double unspanned_reach(double width) const {
+        return exact_ && width < exact_width_ ? sub_ray_reach_ - farthest_sub_ray(width) : 0.0;
+    }
     // intersect, with or without the sheet's normal.
     bool sheet(const Ray& r, double tmin, double tmax, bool normal, Crossing& hit) const;
     void blend(const Level& l, const Ray& r, double weight, bool smooth, Blend& b) const;

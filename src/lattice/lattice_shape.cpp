@@ -24,6 +24,7 @@ LatticeFrame::LatticeFrame(const TableContext& ctx, double reach, double beyond_
       box_{{0, 0, 0},
            Vec3{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])} * ctx.cell} {
     make_cull_parts(ctx.primitive, reach, expand(box_, beyond_box));
+    if (std::isfinite(reach) && beyond_box >= reach) max_narrower_ = reach;
 }
 
 // Every answer's ray point lies within the reach of the primitive (make_lattice_shape), so
@@ -158,35 +159,43 @@ bool LatticeFrame::cull_meets(std::size_t i, const Ray& r, double narrower) cons
 // the translation, which can cancel) and of either test on the near side; the far side, a
 // far origin's rounding, is FloatCapsule's. So it never rejects a line that the test in the
 // shape's space accepts (tests/lattice_shape_test.cpp).
-bool LatticeFrame::cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const {
+bool LatticeFrame::cull_capsule(std::size_t i, const Transform& xf, Capsule& out,
+                                double narrower) const {
+    assert(narrower >= 0 && narrower <= max_narrower_);
     const CullPart& p = cull_[i];
     if (p.count != 1) return false;
     const Capsule& c = capsules_[p.first];
     out.a = xf.point(c.a), out.b = xf.point(c.b);
     const double scale = max_component(abs(out.a)) + max_component(abs(out.b)) +
                          max_component(abs(xf.point({0, 0, 0})));
-    out.r = c.r * xf.max_stretch() * (1 + 1e-9) + 1e-9 * scale;
+    out.r = (c.r - narrower) * xf.max_stretch() * (1 + 1e-9) + 1e-9 * scale;
     return true;
 }
 
 // A point within the reach of a part (primitive units) lies within reach times the largest
 // stretch of xf of the placed part.
-Bounds3 LatticeFrame::placed_parts(const CullPart& p, const Transform& xf) const {
-    const double grow = reach_ * xf.max_stretch();
+Bounds3 LatticeFrame::placed_parts(const CullPart& p, const Transform& xf, double narrower) const {
+    const double grow = (reach_ - narrower) * xf.max_stretch();
     Bounds3 placed;
     for (std::uint32_t k = p.part_first; k < p.part_first + p.part_count; ++k)
         placed = merge(placed, expand(primitive_->primitive_bounds(parts_[k], xf), grow));
     return placed;
 }
 
-Bounds3 LatticeFrame::cull_bounds(std::size_t i, const Transform& xf) const {
+// Narrowed, a box around parts grown by the reach (and clipped to the region, the box grown by
+// as much: make_lattice_shape, FilteredLatticeShape) shrinks by as much on every side: an
+// axis-aligned box shrinks the same whether clipped before or after.
+Bounds3 LatticeFrame::cull_bounds(std::size_t i, const Transform& xf, double narrower) const {
+    assert(narrower >= 0 && narrower <= max_narrower_);
     const CullPart& p = cull_[i];
-    Bounds3 bounds = xf.bounds(p.box);
-    if (p.part_count > 0) bounds = lat::intersect(bounds, placed_parts(p, xf));
+    Bounds3 bounds = xf.bounds(narrower > 0 ? expand(p.box, -narrower) : p.box);
+    if (p.part_count > 0) bounds = lat::intersect(bounds, placed_parts(p, xf, narrower));
     if (p.count == 0) return bounds;
     Bounds3 placed;
-    for (std::uint32_t k = p.first; k < p.first + p.count; ++k)
-        placed = merge(placed, capsules_[k].placed_bounds(xf));
+    for (std::uint32_t k = p.first; k < p.first + p.count; ++k) {
+        const Capsule& c = capsules_[k];
+        placed = merge(placed, Capsule{c.a, c.b, c.r - narrower}.placed_bounds(xf));
+    }
     return lat::intersect(bounds, placed);
 }
 

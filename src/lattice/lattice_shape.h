@@ -30,13 +30,13 @@ public:
     double cell() const { return cell_; }
 
     // See Shape::cull_count, cull_bounds and cull_meets.
+    // narrower: for rays known to need less reach, by how much (at most the reach) to narrow
+    // the capsules and boxes (still around the parts grown by the rest, capsules being convex).
     std::size_t cull_count() const { return cull_.size(); }
-    Bounds3 cull_bounds(std::size_t i, const Transform& xf) const;
-    // narrower: for a ray known to need less reach, by how much (at most the reach) to narrow
-    // the capsules (still around the parts grown by the rest, capsules being convex).
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf, double narrower = 0) const;
     bool cull_meets(std::size_t i, const Ray& r, double narrower = 0) const;
     // See Shape::cull_capsule: a cull part of one capsule has it.
-    bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out) const;
+    bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out, double narrower = 0) const;
 
     // The ray's line in lattice units, and its snapped entry and exit points.
     struct Snap {
@@ -83,6 +83,10 @@ private:
     std::vector<std::uint32_t> parts_;
     const Shape* primitive_ = nullptr;
     double reach_ = 0;
+    // How much culling can be narrowed by: the reach, where the parts are clipped to the box
+    // grown by at least as much (a filtered lattice's sub-rays), else 0: clipped to the box
+    // itself, a narrowed box would lose the rays near its faces.
+    double max_narrower_ = 0;
     // Placed bounds are computed per part and instance when the scene is built: only for
     // primitives of at most this many parts.
     static constexpr std::size_t kMaxPlacedParts = 256;
@@ -93,7 +97,7 @@ private:
         double key = 0;
         std::uint32_t part = 0;
     };
-    Bounds3 placed_parts(const CullPart& p, const Transform& xf) const;
+    Bounds3 placed_parts(const CullPart& p, const Transform& xf, double narrower) const;
     void make_cull_parts(const Shape* primitive, double reach, const Bounds3& region);
     static void drop_covered(std::vector<Piece>& pieces);
     void group(const std::vector<Piece>& pieces, bool capsules, const Bounds3& region);

@@ -1,12 +1,15 @@
 #include "render/render_scene.h"
 
+#include <cassert>
+
 #include "csg/csg_shape.h"
 
 namespace lat {
 
 RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape,
-                         const AccelOptions& accel)
+                         const AccelOptions& accel, std::span<const double> widest_footprints)
     : scene_(scene) {
+    assert(widest_footprints.empty() || widest_footprints.size() == scene.objects.size());
     shapes_.reserve(scene.objects.size());
     for (const SceneObject& o : scene.objects) {
         std::shared_ptr<const Shape> s = o.shape;
@@ -19,7 +22,8 @@ RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_sha
         shapes_.push_back(std::move(s));
     }
     for (std::size_t i = 0; i < scene.objects.size(); ++i)
-        accel_objects_.push_back({shapes_[i].get(), &scene.objects[i].xf});
+        accel_objects_.push_back({shapes_[i].get(), &scene.objects[i].xf,
+                                  widest_footprints.empty() ? kInfinity : widest_footprints[i]});
     accel_ = std::make_unique<EmbreeAccel>(accel_objects_, accel);
 }
 

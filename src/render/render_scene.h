@@ -3,6 +3,7 @@
 // closest-hit query (Intersect) and the cheaper any-hit query for shadow rays (Occluded).
 #include <functional>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "accel/embree_accel.h"
@@ -30,8 +31,10 @@ public:
     // `instance_shape`, when given, supplies the shape traced for instances of primitive i
     // (e.g. its lattice); by default instances are traced exactly as their sphere/cylinder union.
     using InstanceShapeFn = std::function<std::shared_ptr<const Shape>(int primitive)>;
+    // widest_footprints: per object, or empty (infinity), its AccelObject::widest_footprint.
     explicit RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape = {},
-                         const AccelOptions& accel = {});
+                         const AccelOptions& accel = {},
+                         std::span<const double> widest_footprints = {});
 
     bool intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const;
     // Through partial hits (render/layers.h): the closest opaque hit, if any, and every partial

@@ -53,10 +53,19 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     const bool lod = filtering.lod && filtering.spread > 0;
     std::pair<int, int> range{0, 0};
     double exact_width = 0;
-    if (lod && base.primitive && answered_by_primitive(*base.primitive))
+    if (lod && base.primitive && answered_by_primitive(*base.primitive)) {
         exact_width = kSubRayWidening * footprint_range(scene, prim, base, filtering.spread).second;
-    else if (lod)
+        // Each instance's own sub-rays, and so its culling, span at most as much of its own
+        // widest footprint (AccelObject::widest_footprint). The farthest instance's is 1.4
+        // times the nearest's on Plates 4 and 5, 1.9 times on the furry bunny, 3.7 on grass.
+        for (std::size_t i = 0; i < scene.objects.size(); ++i)
+            if (scene.objects[i].primitive == prim)
+                out.widest_footprints[i] =
+                    kSubRayWidening *
+                    instance_footprints(scene, scene.objects[i], base, filtering.spread).second;
+    } else if (lod) {
         range = lod_range(scene, prim, base, filtering.spread);
+    }
     // Levels beyond the largest refinement or the pair budget are left out: the finest level
     // within both then serves the rays that want finer. Level 0
     // (the lattice asked for) is built whatever its size.
@@ -92,23 +101,28 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
 
 }  // namespace
 
-std::pair<double, double> footprint_range(const Scene& scene, int prim, const TableContext& base,
-                                          double spread) {
-    const Vec3 eye = scene.camera.eye;
+std::pair<double, double> instance_footprints(const Scene& scene, const SceneObject& o,
+                                              const TableContext& base, double spread) {
     const Bounds3 box{{0, 0, 0}, Vec3{double(base.cells[0]), double(base.cells[1]),
                                       double(base.cells[2])} * base.cell};
+    const Bounds3 wb = o.xf.bounds(box);
+    const double r = 0.5 * length(wb.extent());
+    const double d = length(wb.center() - scene.camera.eye);
+    // Object units per world unit along a ray (rigid or uniformly scaled instances).
+    const double scale = 1 / std::cbrt(length(o.xf.vector({1, 0, 0})) *
+                                       length(o.xf.vector({0, 1, 0})) *
+                                       length(o.xf.vector({0, 0, 1})));
+    return {std::max(d - r, 1e-9) * spread * scale, (d + r) * spread * scale};
+}
+
+std::pair<double, double> footprint_range(const Scene& scene, int prim, const TableContext& base,
+                                          double spread) {
     double lo = kInfinity, hi = -kInfinity;
     for (const SceneObject& o : scene.objects) {
         if (o.primitive != prim) continue;
-        const Bounds3 wb = o.xf.bounds(box);
-        const double r = 0.5 * length(wb.extent());
-        const double d = length(wb.center() - eye);
-        // Object units per world unit along a ray (rigid or uniformly scaled instances).
-        const double scale = 1 / std::cbrt(length(o.xf.vector({1, 0, 0})) *
-                                           length(o.xf.vector({0, 1, 0})) *
-                                           length(o.xf.vector({0, 0, 1})));
-        lo = std::min(lo, std::max(d - r, 1e-9) * spread * scale);
-        hi = std::max(hi, (d + r) * spread * scale);
+        const auto [near, far] = instance_footprints(scene, o, base, spread);
+        lo = std::min(lo, near);
+        hi = std::max(hi, far);
     }
     return {lo, hi};
 }
@@ -117,6 +131,7 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const 
                              bool progress, const LatticeFiltering& filtering) {
     SceneLattices out;
     out.shapes.resize(scene.primitives.size());
+    out.widest_footprints.assign(scene.objects.size(), kInfinity);
     // Instances, at the top level or as CSG leaves.
     std::vector<bool> used(scene.primitives.size(), false);
     for (const SceneObject& o : scene.objects) {

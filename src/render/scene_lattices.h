@@ -13,6 +13,9 @@ namespace lat {
 
 struct SceneLattices {
     std::vector<std::shared_ptr<const Shape>> shapes;  // per primitive; null if unused
+    // Per object: the widest footprint (object units) its rays are traced with, for instances
+    // of primitives answered by sub-rays (AccelObject::widest_footprint); else infinity.
+    std::vector<double> widest_footprints;
     std::uint64_t table_bytes = 0;
     std::uint64_t table_entries = 0;
     int built = 0;
@@ -45,6 +48,9 @@ inline constexpr int kMaxLodLevels = 3;
 // of its own (only in CSG).
 std::pair<double, double> footprint_range(const Scene& scene, int prim, const TableContext& base,
                                           double spread);
+// The same for one instance.
+std::pair<double, double> instance_footprints(const Scene& scene, const SceneObject& o,
+                                              const TableContext& base, double spread);
 
 // With filtering, spec's encoding must store coverage (Encoding::coverage; else InputError).
 SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const TableSpec& spec,
