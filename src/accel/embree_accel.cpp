@@ -43,20 +43,9 @@ bool keeps_directions_across(const Transform& xf) {
            std::abs(dot(c[1], c[2])) <= tol;
 }
 
-// The directions across the ray being traced, in an object's space (unset where its map does
-// not keep them, `similar`).
-AcrossRay across_in_object(const AccelObject& o, bool similar) {
-    AcrossRay a = across_ray();
-    a.widest = o.widest_footprint;
-    if (!a.set || o.xf->is_identity()) return a;
-    a.set = similar;
-    if (similar) a.u = o.xf->inverse_vector(a.u), a.v = o.xf->inverse_vector(a.v);
-    return a;
-}
-
 // The object-space ray for objects tested outside Embree, with the directions across it.
 Ray object_ray(const AccelObject& o, bool similar, const Ray& r) {
-    set_across_ray_in_object(across_in_object(o, similar));
+    set_across_ray_in_object(*o.xf, similar, o.widest_footprint);
     return o.xf->is_identity() ? r : o.xf->inverse_ray(r);
 }
 
@@ -265,7 +254,7 @@ struct EmbreeAccel::Impl {
     void hand_across(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->across_obj == obj) return;
         ctx->across_obj = obj;
-        set_across_ray_in_object(across_in_object(objects[obj], similar[obj]));
+        set_across_ray_in_object(*objects[obj].xf, similar[obj], objects[obj].widest_footprint);
     }
 
     // Whether a direct primitive's object is to be tested: it was not tested already for this

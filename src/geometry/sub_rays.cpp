@@ -21,6 +21,14 @@ ScopedAcrossRay::~ScopedAcrossRay() {
 const AcrossRay& across_ray() { return t_world; }
 const AcrossRay& across_ray_in_object() { return t_object; }
 void set_across_ray_in_object(const AcrossRay& in_object) { t_object = in_object; }
+void set_across_ray_in_object(const Transform& xf, bool similar, double widest) {
+    AcrossRay& a = t_object;
+    a.widest = widest;
+    a.set = t_world.set && (similar || xf.is_identity());
+    if (!a.set) return;
+    a.u = xf.is_identity() ? t_world.u : xf.inverse_vector(t_world.u);
+    a.v = xf.is_identity() ? t_world.v : xf.inverse_vector(t_world.v);
+}
 
 double LayerComposite::add(double coverage, std::uint8_t sub_rays) {
     const double before = left();

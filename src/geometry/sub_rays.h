@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "geometry/shape.h"
+#include "math/transform.h"
 
 namespace lat {
 
@@ -44,6 +45,10 @@ private:
 // the object's inverse linear map, when set and when the map keeps them across the ray and as
 // long as it, a similarity, within 1e-3; else unset, and the object uses its own directions).
 void set_across_ray_in_object(const AcrossRay& in_object);
+// The same from the world's copy, written in place (a copy built on the stack and handed over
+// stalled store forwarding: 4 % of a candidates lattice's time). xf: object -> world;
+// similar: whether it keeps the directions across (see above); widest: AcrossRay::widest.
+void set_across_ray_in_object(const Transform& xf, bool similar, double widest);
 const AcrossRay& across_ray_in_object();
 
 // Partial crossings of one ray composed: what is left of it after each, front to back (camera
