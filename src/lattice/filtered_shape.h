@@ -82,6 +82,8 @@ double lod_blend(double f, double band);
 //       to lattice (sub_rays.h) 47.18 / 53.15 / 38.47 / 40.27 / 32.92 / 37.45 / 36.16 / -- dB
 //       four at once, thinner   114 / 43 / 163 / 232 / 416 / 318 / 40 / 25 ms
 //       culling (a later day)   47.16 / 53.05 / 38.44 / 40.26 / 32.76 / 37.46 / 36.14 / 33.76 dB
+//       each instance's own     118 / 40 / 161 / 236 / 393 / 281 / 39 / 22 ms
+//       reach (the next day)    47.16 / 53.05 / 38.40 / 40.23 / 32.76 / 37.43 / 36.13 / 33.66 dB
 //     tables, with half the     238 / 39 / 439 / 934 / 1720 / 2103 / 480 / 106 ms
 //     sub-rays' weight blended  45.98 / 51.64 / 39.35 / 40.33 / 33.01 / 38.45 / 35.95 / 34.09 dB
 //     in (camera rays) and one
