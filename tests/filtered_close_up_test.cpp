@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "accel/embree_accel.h"
 #include "csg/csg_shape.h"
 #include "geometry/chain.h"
 #include "geometry/named_shapes.h"
@@ -257,19 +258,40 @@ TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
     EXPECT_GT(outside, 20);  // rays whose lines miss the lattice box, answered by sub-rays
 }
 
+// Rays lying in the planes across each axis through a point: where a cull box split in halves
+// (LatticeFrame::split_in_halves) is cut.
+std::vector<Ray> rays_in_mid_planes(Vec3 centre, int per_plane) {
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<Ray> out;
+    for (std::size_t axis = 0; axis < 3; ++axis)
+        for (int i = 0; i < per_plane; ++i) {
+            Vec3 p = centre + Vec3{u(rng), u(rng), u(rng)} * 2.5, d{u(rng), u(rng), u(rng)};
+            p[axis] = centre[axis];
+            d[axis] = 0;
+            if (length(d) < 1e-3) continue;
+            d = d / length(d);
+            out.push_back({p - d * 8.0, d});
+        }
+    return out;
+}
+
 // An instance whose rays span at most `widest` (AccelObject::widest_footprint) is culled by
 // its own narrower boxes and capsules, placed in world space: every ray (of any footprint,
-// wider ones narrowed to it) whose sheet has a crossing meets one of them, under a rotation
-// and scale too; and narrower instances cull more rays.
-TEST(FilteredCloseUps, EachInstanceIsCulledByItsOwnWidestFootprint) {
-    const HookLattice h = hook_lattice(long_hook());
+// wider ones narrowed to it) whose sheet has a crossing meets one of them and passes cull_meets,
+// under a rotation and scale too, including rays in the planes where a box split in halves is
+// cut; and narrower instances cull more rays. For a chain (capsules), a ball and a CSG tree
+// (boxes, split in halves).
+void expect_instances_culled_by_their_own_bound(const Shape& primitive) {
+    const HookLattice h = hook_lattice(primitive);
     const FilteredLatticeShape& s = *h.exact;
     const Transform turned = Transform::translate({3, -2, 5}) * Transform::rotate({1, 2, 3}, 0.7) *
                              Transform::scale({1.5, 1.5, 1.5});
+    std::vector<Ray> local_rays = rays(1500);
+    for (const Vec3 centre : {Vec3{2, 1, 2}, primitive.bounds().center()})
+        for (const Ray& r : rays_in_mid_planes(centre, 150)) local_rays.push_back(r);
     int last_culled = -1;
     for (const double widest : {kInfinity, 0.7 * kExactWidth, 0.3 * kExactWidth, 0.05}) {
-        AcrossRay in_object;  // no directions across: each sub-ray along the object's own axes
-        in_object.widest = widest;
         int hits = 0, culled = 0;
         for (const Transform& xf : {Transform{}, turned}) {
             std::vector<Bounds3> boxes;
@@ -280,34 +302,90 @@ TEST(FilteredCloseUps, EachInstanceIsCulledByItsOwnWidestFootprint) {
                 capsules.push_back(s.cull_capsule(i, xf, widest, c) ? FloatCapsule::holding(c)
                                                                     : FloatCapsule{});
             }
-            const auto kept = [&](const Ray& world) {
+            const auto kept = [&](const Ray& world, const Ray& local) {
                 for (std::size_t i = 0; i < boxes.size(); ++i)
                     if (double t0 = -kInfinity, t1 = kInfinity;
-                        clip_ray(boxes[i], world, t0, t1) && capsules[i].meets_line(world.o, world.d))
+                        clip_ray(boxes[i], world, t0, t1) &&
+                        capsules[i].meets_line(world.o, world.d) && s.cull_meets(i, local))
                         return true;
                 return false;
             };
             for (const double footprint : {0.0, 0.05, 0.5, 2.0, kExactWidth, 3 * kExactWidth}) {
                 set_ray_footprint({footprint, 0, false});
-                for (const Ray& local : rays(2000)) {
-                    const Ray world{xf.point(local.o), xf.vector(local.d)};
-                    set_across_ray_in_object(in_object);
+                for (const Ray& r : local_rays) {
+                    const Ray world{xf.point(r.o), xf.vector(r.d)};
+                    const Ray local = xf.inverse_ray(world);
+                    // Outside a traversal: no directions across, the instance's bound.
+                    set_across_ray_in_object(Transform{}, true, widest);
                     Crossing c;
-                    const bool hit = s.intersect(xf.inverse_ray(world), 0.0, kInfinity, c);
+                    const bool hit = s.intersect(local, 0.0, kInfinity, c);
                     hits += hit;
                     if (hit) {
-                        EXPECT_TRUE(kept(world)) << "widest " << widest << ", footprint " << footprint;
+                        EXPECT_TRUE(kept(world, local)) << "widest " << widest << ", footprint " << footprint;
                     }
-                    culled += !kept(world);
+                    culled += !kept(world, local);
                 }
             }
         }
-        EXPECT_GT(hits, 1000) << "widest " << widest;
+        EXPECT_GT(hits, 500) << "widest " << widest;
         EXPECT_GT(culled, last_culled) << "widest " << widest;
         last_culled = culled;
     }
     set_ray_footprint({});
-    set_across_ray_in_object({});
+    clear_across_ray_in_object();
+}
+
+TEST(FilteredCloseUps, EachInstanceIsCulledByItsOwnWidestFootprint) {
+    const SphereShape ball({2, 1, 2}, 0.8);
+    expect_instances_culled_by_their_own_bound(long_hook());
+    expect_instances_culled_by_their_own_bound(ball);
+    expect_instances_culled_by_their_own_bound(bitten_tori());
+}
+
+// The accelerator hands each instance its own bound (AccelObject::widest_footprint): it
+// answers as the shape does when given each instance's bound, for footprints narrower and wider
+// than it, the two instances' bounds apart.
+TEST(FilteredCloseUps, TheAcceleratorHandsEachInstanceItsBound) {
+    const HookLattice h = hook_lattice(long_hook());
+    const FilteredLatticeShape& s = *h.exact;
+    const Transform near = Transform::translate({3, -2, 5}) * Transform::rotate({1, 2, 3}, 0.7);
+    const Transform far = Transform::translate({3, 20, 5});
+    const double near_widest = 0.3 * kExactWidth;
+    const std::vector<AccelObject> objects{{&s, &near, near_widest}, {&s, &far, kInfinity}};
+    const EmbreeAccel accel(objects);
+    // The closest crossing of either instance, each tested with its own bound.
+    const auto expected = [&](const Ray& world, double near_bound, AccelHit& out) {
+        bool found = false;
+        for (std::uint32_t i = 0; i < 2; ++i) {
+            const Transform& xf = *objects[i].xf;
+            set_across_ray_in_object(xf, true, i == 0 ? near_bound : kInfinity);
+            Crossing c;
+            if (s.intersect(xf.inverse_ray(world), 0.0, found ? out.t : kInfinity, c))
+                found = true, out = {c.t, i, c};
+        }
+        return found;
+    };
+    int near_hits = 0, differ_unbounded = 0;
+    for (const double footprint : {0.05, 2.0, 3 * kExactWidth}) {
+        set_ray_footprint({footprint, 0, false});
+        for (const Ray& r : rays(1500)) {
+            const Ray world{near.point(r.o), near.vector(r.d)};
+            AccelHit a, e, wide;
+            const bool found = accel.intersect(world, 0.0, kInfinity, a);
+            ASSERT_EQ(found, expected(world, near_widest, e)) << "footprint " << footprint;
+            if (!found) continue;
+            EXPECT_EQ(a.object, e.object);
+            EXPECT_EQ(a.t, e.t);
+            EXPECT_EQ(a.crossing.coverage, e.crossing.coverage);
+            if (a.object != 0) continue;
+            ++near_hits;
+            differ_unbounded += !expected(world, kInfinity, wide) || wide.t != e.t;
+        }
+    }
+    set_ray_footprint({});
+    clear_across_ray_in_object();
+    EXPECT_GT(near_hits, 1000);
+    EXPECT_GT(differ_unbounded, 100);  // the bound matters for these rays
 }
 
 // A ray leaving a sheet skips its own lattice for the sheet's distance from the surface: with

@@ -62,6 +62,10 @@ struct QueryContext {
         : accel(&m), ray(r), tmin(t0), tmax(t1), hit(h) {
         rtcInitIntersectContext(&rtc);
     }
+    // The objects' copy of the directions across the ray ends with the query (sub_rays.h).
+    ~QueryContext() { clear_across_ray_in_object(); }
+    QueryContext(const QueryContext&) = delete;
+    QueryContext& operator=(const QueryContext&) = delete;
 
     RTCIntersectContext rtc;
     const EmbreeAccel::Impl* accel;
@@ -459,8 +463,10 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             if (m.inst_object.size() <= id) m.inst_object.resize(id + 1, 0);
             m.inst_object[id] = i;
         } else if (o.shape->cull_count() == 1) {
+            const Bounds3 b = lat::intersect(wb, o.shape->cull_bounds(0, *o.xf, o.widest_footprint));
+            if (b.empty()) continue;
             m.direct.push_back(Impl::direct_prim(i, 0, false, o));
-            m.direct_bounds.push_back(wb);
+            m.direct_bounds.push_back(b);
         } else {
             for (std::uint32_t c = 0; c < o.shape->cull_count(); ++c) {
                 const Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);

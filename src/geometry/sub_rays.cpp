@@ -20,7 +20,7 @@ ScopedAcrossRay::~ScopedAcrossRay() {
 }
 const AcrossRay& across_ray() { return t_world; }
 const AcrossRay& across_ray_in_object() { return t_object; }
-void set_across_ray_in_object(const AcrossRay& in_object) { t_object = in_object; }
+void clear_across_ray_in_object() { t_object = {}; }
 void set_across_ray_in_object(const Transform& xf, bool similar, double widest) {
     AcrossRay& a = t_object;
     a.widest = widest;

@@ -23,8 +23,9 @@ inline constexpr int kSubRays = 4;  // a 2 x 2 grid
 struct AcrossRay {
     Vec3 u, v;
     bool set = false;
-    // The object's copy only: the widest footprint (object units) its sub-rays may span, its
-    // placement's (AccelObject::widest_footprint), by which its culling was narrowed.
+    // The object's copy only (what the accelerator hands an object about the ray): the widest
+    // footprint (object units) its sub-rays may span, its placement's
+    // (AccelObject::widest_footprint), by which its culling was narrowed.
     double widest = kInfinity;
 };
 const AcrossRay& across_ray();
@@ -41,14 +42,15 @@ public:
 private:
     AcrossRay previous_;
 };
-// The accelerator: before testing an object, its own copy (the world one's directions through
-// the object's inverse linear map, when set and when the map keeps them across the ray and as
-// long as it, a similarity, within 1e-3; else unset, and the object uses its own directions).
-void set_across_ray_in_object(const AcrossRay& in_object);
-// The same from the world's copy, written in place (a copy built on the stack and handed over
-// stalled store forwarding: 4 % of a candidates lattice's time). xf: object -> world;
-// similar: whether it keeps the directions across (see above); widest: AcrossRay::widest.
+// The accelerator: before testing an object, its own copy: the world one's directions through
+// the object's inverse linear map (xf: object -> world), when set and when the map keeps them
+// across the ray and as long as it (`similar`: a similarity, within 1e-3; else unset, and the
+// object uses its own directions), and the object's widest footprint (AcrossRay::widest).
+// Written in place: a copy built on the caller's stack and handed over stalled store
+// forwarding (4 % of a candidates lattice's samples).
 void set_across_ray_in_object(const Transform& xf, bool similar, double widest);
+// After a query: no object copy, so that a shape tested directly never sees the last object's.
+void clear_across_ray_in_object();
 const AcrossRay& across_ray_in_object();
 
 // Partial crossings of one ray composed: what is left of it after each, front to back (camera

@@ -86,8 +86,8 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // (docs/filtering.md, "Culling").
     // A primitive answered by its own crossings reads no table (but point_): its one level's
     // frame culls, with the parts grown by the farthest sub-ray's distance from the ray (a
-    // bound; each ray by its own, cull_meets), and a ray whose line passes that close outside
-    // the box can have sub-rays that enter it.
+    // bound; each instance by its own, cull_bounds, and each ray by its own, cull_meets), and
+    // a ray whose line passes that close outside the box can have sub-rays that enter it.
     assert(!exact_ || levels.size() == 1);
     cull_level_ = std::min<std::size_t>(1, levels.size() - 1);
     for (std::size_t i = 0; i < levels.size(); ++i) {
@@ -254,9 +254,10 @@ double FilteredLatticeShape::footprint_width(const Ray& r) const {
 }
 
 bool FilteredLatticeShape::cull_meets(std::size_t i, const Ray& r) const {
-    // The capsules less the part of the reach this ray's sub-rays do not span. (The instance's
-    // own bound is not handed on yet when its cull parts are tested: its capsules and boxes
-    // were narrowed by it already, cull_bounds.)
+    // The capsules less the part of the reach this ray's own footprint leaves unused. (The
+    // instance's bound is not handed on yet when its cull parts are tested, so a ray wider than
+    // it is tested by more reach than it will use: the accelerator's boxes and world capsules
+    // were narrowed by the instance's bound already, cull_bounds and cull_capsule.)
     return cull_frame().cull_meets(i, r, unspanned_reach(footprint_width(r)));
 }
 
@@ -287,7 +288,7 @@ void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, d
 // wants only the share of its sub-rays blocked before tmax (the light), not where: any part's
 // crossing ends a sub-ray's tests, and the sheet lies halfway along the blocked ones' chords.
 // The footprint's width is taken across the ray as along it (instances scaled uniformly, as
-// footprint_range assumes).
+// instance_footprints assumes).
 void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, double tmin,
                                      double tmax, Sheet& s) const {
     constexpr int n = kExactSubRays;

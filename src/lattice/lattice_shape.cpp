@@ -141,7 +141,7 @@ void LatticeFrame::split_in_halves() {
     Bounds3 low = whole, high = whole;
     low.hi[axis] = high.lo[axis] = whole.lo[axis] + 0.5 * ext[axis];
     const std::uint32_t first = cull_.front().part_first, count = cull_.front().part_count;
-    cull_ = {{low, 0, 0, first, count}, {high, 0, 0, first, count}};
+    cull_ = {{low, 0, 0, first, count, whole}, {high, 0, 0, first, count, whole}};
 }
 
 bool LatticeFrame::cull_meets(std::size_t i, const Ray& r, double narrower) const {
@@ -184,11 +184,15 @@ Bounds3 LatticeFrame::placed_parts(const CullPart& p, const Transform& xf, doubl
 
 // Narrowed, a box around parts grown by the reach (and clipped to the region, the box grown by
 // as much: make_lattice_shape, FilteredLatticeShape) shrinks by as much on every side: an
-// axis-aligned box shrinks the same whether clipped before or after.
+// axis-aligned box shrinks the same whether clipped before or after. A half's cut face was not
+// grown: the whole box shrinks, and the half is what of it lies on its side.
 Bounds3 LatticeFrame::cull_bounds(std::size_t i, const Transform& xf, double narrower) const {
     assert(narrower >= 0 && narrower <= max_narrower_);
     const CullPart& p = cull_[i];
-    Bounds3 bounds = xf.bounds(narrower > 0 ? expand(p.box, -narrower) : p.box);
+    const Bounds3 narrowed =
+        narrower > 0 ? lat::intersect(expand(p.whole.empty() ? p.box : p.whole, -narrower), p.box)
+                     : p.box;
+    Bounds3 bounds = xf.bounds(narrowed);
     if (p.part_count > 0) bounds = lat::intersect(bounds, placed_parts(p, xf, narrower));
     if (p.count == 0) return bounds;
     Bounds3 placed;

@@ -77,6 +77,9 @@ private:
         // bounds are also those of the placed parts grown by the reach (tight for turned
         // instances, where the box around the turned box is loose). None: the box alone.
         std::uint32_t part_first = 0, part_count = 0;
+        // A half of a box split_in_halves cut: the whole box, the one grown by the reach on
+        // every side (narrowing shrinks it, not the cut face). Empty: the box itself.
+        Bounds3 whole = {};
     };
     std::vector<CullPart> cull_;
     std::vector<Capsule> capsules_;
