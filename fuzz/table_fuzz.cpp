@@ -65,7 +65,7 @@ void exercise(const std::string& path) {
                 __builtin_trap();
             }
         }
-    if (lat::BoundaryGrid::pair_count(h.cells) <= 2e4)
+    if (lat::BoundaryGrid::pair_count(h.cells) <= 2e4L)
         (void)lat::certify_table(*t.table, h.context(prim.shape.get()), false);
 }
 

@@ -148,10 +148,11 @@ RTCBounds to_rtc_bounds(const Bounds3& b) {
 // extreme transform or polynomial); it must never reach rtcIntersect1 or rtcOccluded1.
 bool embree_can_trace(const Ray& r, double tmin, double tmax) {
     constexpr double kLarge = 1.8e18;  // just below Embree's FLT_LARGE
-    // Comparisons with NaN are false, so NaN fails too; `&` keeps it one branch per ray.
-    return (std::abs(r.o.x) < kLarge) & (std::abs(r.o.y) < kLarge) & (std::abs(r.o.z) < kLarge) &
-           (std::abs(r.d.x) < kLarge) & (std::abs(r.d.y) < kLarge) & (std::abs(r.d.z) < kLarge) &
-           (std::abs(tmin) < kLarge) & !std::isnan(tmax);
+    // Comparisons with NaN are false, so NaN fails too; `&` on 0s and 1s keeps it one branch
+    // per ray.
+    const auto small = [&](double v) { return static_cast<unsigned>(std::abs(v) < kLarge); };
+    return (small(r.o.x) & small(r.o.y) & small(r.o.z) & small(r.d.x) & small(r.d.y) &
+            small(r.d.z) & small(tmin) & static_cast<unsigned>(!std::isnan(tmax))) != 0;
 }
 
 // Embree drops primitives whose float bounds are not finite or exceed FLT_LARGE; objects that

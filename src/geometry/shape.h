@@ -72,7 +72,9 @@ struct FloatCapsule {
     static FloatCapsule holding(const Capsule& c);
     bool meets_line(Vec3 o, Vec3 d) const {
         if (r < 0) return true;
-        const Capsule c{{a[0], a[1], a[2]}, {b[0], b[1], b[2]}, r};
+        const auto wide = [](float f) { return static_cast<double>(f); };
+        const Capsule c{{wide(a[0]), wide(a[1]), wide(a[2])}, {wide(b[0]), wide(b[1]), wide(b[2])},
+                        wide(r)};
         return c.meets_line(o, d, c.r + 1e-9 * max_component(abs(o - c.a)));
     }
 };

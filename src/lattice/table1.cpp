@@ -77,7 +77,7 @@ std::string table1_cell_error(const std::array<int, 3>& box, int sigma_inv) {
         if (b < 1 || b > kMaxTable1Box) return "the box must be 1 to 4096 units along each axis";
     if (std::string e = sigma_inv_error(sigma_inv); !e.empty()) return e;
     const std::array<int, 3> cells{box[0] * sigma_inv, box[1] * sigma_inv, box[2] * sigma_inv};
-    if (BoundaryGrid::pair_count(cells) > kMaxTable1Pairs)
+    if (BoundaryGrid::pair_count(cells) > static_cast<long double>(kMaxTable1Pairs))
         return "the lattice has too many point pairs to count here (more than " +
                paper_notation(kMaxTable1Pairs) + ")";
     return {};

@@ -53,7 +53,7 @@ void RenderScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) 
     hit.object = h.object;
     hit.part = h.crossing.part;
     hit.material = shape.tag(h.crossing, o.material);
-    hit.alpha = h.crossing.coverage;
+    hit.alpha = static_cast<double>(h.crossing.coverage);
     hit.sub_rays = h.crossing.sub_rays;
     const SurfacePoint s = shape.surface(o.xf.is_identity() ? r : o.xf.inverse_ray(r), h.crossing);
     // Only a mean of normals (prefiltered lattices) is meant to be shorter than 1.

@@ -78,7 +78,8 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     };
     const auto allowed = [&](int j) {
         return (static_cast<long long>(spec.sigma_inv) << j) <= kMaxSigmaInv &&
-               BoundaryGrid::pair_count(level_plan(j).context.cells) <= filtering.max_pairs;
+               BoundaryGrid::pair_count(level_plan(j).context.cells) <=
+                   static_cast<long double>(filtering.max_pairs);
     };
     int finest = 0;
     while (finest < range.second && allowed(finest + 1)) ++finest;

@@ -83,7 +83,7 @@ std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
     entries.reserve(hits.size());
     for (const auto& chunk : hits.chunks)
         for (const RawHit& h : chunk)
-            entries.push_back({h.a * n + h.b, {quantise_t(h.t), h.nu, h.nv, 0, 0, 0, 0}});
+            entries.push_back({h.a * n + h.b, {quantise_t(static_cast<double>(h.t)), h.nu, h.nv, 0, 0, 0, 0}});
     const auto by_pair = [](const Entry& x, const Entry& y) { return x.pair < y.pair; };
     std::sort(entries.begin(), entries.end(), by_pair);
     const std::size_t centers = entries.size();
@@ -100,7 +100,7 @@ std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
             entries.push_back({pair, {kNoHit, 0, 0, 0, 0, 0, 0}});
             e = &entries.back();
         }
-        e->f[CoverageTable::kMeanT] = quantise_t(c.t);
+        e->f[CoverageTable::kMeanT] = quantise_t(static_cast<double>(c.t));
         e->f[CoverageTable::kMeanNu] = c.nu, e->f[CoverageTable::kMeanNv] = c.nv;
         e->f[CoverageTable::kAlpha] = static_cast<std::uint16_t>(std::lround(double(c.alpha) * kAlphaScale));
     }

@@ -146,7 +146,8 @@ private:
             if (part_t_bits > 30) return false;
             const double top = double((1ull << part_t_bits) - 1);
             const double worst = max_over(raw_, [&](const RawHit& h) {
-                return angle_deg(normal_at(h, h.t), normal_at(h, quantise(h.t, part_t_bits) / top));
+                const auto t = static_cast<double>(h.t);
+                return angle_deg(normal_at(h, t), normal_at(h, quantise(t, part_t_bits) / top));
             });
             if (worst + kRawNormalSlack <= opt_.max_normal_error_deg) return true;
         }
@@ -244,7 +245,7 @@ private:
             for (const RawHit& h : chunk) {
                 const std::uint64_t k = rank.rank(pair_of(h));
                 const int dir = h.a < h.b ? 0 : 1;
-                write_field(k, dir, quantise(h.t, l_.t_bits), normal_field(h));
+                write_field(k, dir, quantise(static_cast<double>(h.t), l_.t_bits), normal_field(h));
                 present[k] |= static_cast<std::uint8_t>(1 << dir);
             }
         // The rare lone direction (a tangency decided differently each way): copy it over.

@@ -160,7 +160,7 @@ void value_widths(const Fit& fit, const std::vector<Exception>& ex, unsigned& ex
             for (std::size_t k = r.begin(); k != r.end(); ++k) {
                 const RawHit& h = *fit.by_a[hits[k]];
                 for (unsigned bits = 1; bits <= 32; ++bits)
-                    if (!fit.point_ok(decode_value_t(encode_value_t(h.t, bits), bits), h))
+                    if (!fit.point_ok(decode_value_t(encode_value_t(static_cast<double>(h.t), bits), bits), h))
                         m &= ~(std::uint64_t{1} << bits);
             }
             return m;
@@ -236,7 +236,7 @@ ByteBuffer write_payload(const Fit& fit, const Trial& tr, const std::vector<Exce
             continue;
         }
         const RawHit& r = *fit.by_a[e.hit];
-        const std::uint64_t t = encode_value_t(r.t, h.ex_t);
+        const std::uint64_t t = encode_value_t(static_cast<double>(r.t), h.ex_t);
         const Oct o = oct_encode_precise(fit.normal(r), static_cast<int>(h.ex_n));
         const std::uint64_t n = o.u | (std::uint64_t{o.v} << h.ex_n);
         if (e.kind == kHit)
