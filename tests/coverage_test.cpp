@@ -232,7 +232,8 @@ CullLoss cull_loss(const TwoLevels& t, LatticeFilter filter, bool inside, double
         const std::size_t n = shape.cull_count();
         for (std::size_t i = 0; i < n; ++i) {
             double t0 = 0, t1 = kInfinity;
-            if (clip_ray(shape.cull_bounds(i, Transform{}, kInfinity), r, t0, t1) && (n == 1 || shape.cull_meets(i, r)))
+            if (clip_ray(shape.cull_bounds(i, Transform{}, kInfinity), r, t0, t1) &&
+                (n == 1 || shape.cull_meets(i, r)))
                 return true;
         }
         return false;

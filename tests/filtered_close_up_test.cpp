@@ -233,7 +233,8 @@ TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
         double t0 = 0, t1 = kInfinity;
         if (!clip_ray(s.bounds(), r, t0, t1)) return false;
         for (std::size_t i = 0; i < s.cull_count(); ++i)
-            if (t0 = 0, t1 = kInfinity; clip_ray(s.cull_bounds(i, Transform{}, kInfinity), r, t0, t1)) return true;
+            if (t0 = 0, t1 = kInfinity; clip_ray(s.cull_bounds(i, Transform{}, kInfinity), r, t0, t1))
+                return true;
         return false;
     };
     int hits = 0, culled = 0, outside = 0;
@@ -321,7 +322,8 @@ void expect_instances_culled_by_their_own_bound(const Shape& primitive) {
                     const bool hit = s.intersect(local, 0.0, kInfinity, c);
                     hits += hit;
                     if (hit) {
-                        EXPECT_TRUE(kept(world, local)) << "widest " << widest << ", footprint " << footprint;
+                        EXPECT_TRUE(kept(world, local))
+                            << "widest " << widest << ", footprint " << footprint;
                     }
                     culled += !kept(world, local);
                 }

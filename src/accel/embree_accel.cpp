@@ -464,7 +464,8 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             if (m.inst_object.size() <= id) m.inst_object.resize(id + 1, 0);
             m.inst_object[id] = i;
         } else if (o.shape->cull_count() == 1) {
-            const Bounds3 b = lat::intersect(wb, o.shape->cull_bounds(0, *o.xf, o.widest_footprint));
+            const Bounds3 b =
+                lat::intersect(wb, o.shape->cull_bounds(0, *o.xf, o.widest_footprint));
             if (b.empty()) continue;
             m.direct.push_back(Impl::direct_prim(i, 0, false, o));
             m.direct_bounds.push_back(b);

@@ -166,10 +166,14 @@ QuadCrossing crossing_pair(const RayQuad& q, int h, unsigned live, Vec3 a, Vec3 
                            double len, double radius) {
     using namespace quad;
     QuadCrossing x;
-    const V met = _mm_and_pd(solve_pair(q, h, a, axis, len, radius, x.span), mask_of(live >> h & 3u));
+    const V met =
+        _mm_and_pd(solve_pair(q, h, a, axis, len, radius, x.span), mask_of(live >> h & 3u));
     const V tmin = load(q.tmin + h), tmax = load(q.tmax + h);
-    x.in_ok = _mm_and_pd(met, _mm_and_pd(_mm_cmpgt_pd(x.span.tin, tmin), _mm_cmplt_pd(x.span.tin, tmax)));
-    x.out_ok = _mm_and_pd(met, _mm_and_pd(_mm_cmpgt_pd(x.span.tout, tmin), _mm_cmplt_pd(x.span.tout, tmax)));
+    const auto within = [&](V t) {
+        return _mm_and_pd(_mm_cmpgt_pd(t, tmin), _mm_cmplt_pd(t, tmax));
+    };
+    x.in_ok = _mm_and_pd(met, within(x.span.tin));
+    x.out_ok = _mm_and_pd(met, within(x.span.tout));
     return x;
 }
 

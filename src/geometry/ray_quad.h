@@ -1,9 +1,10 @@
 #pragma once
 // Four parallel rays tested against one part at once: a ray's 2 x 2 sub-rays (sub_rays.h)
 // share their direction, so what a part's test derives from the direction alone is derived
-// once, and the rest runs two rays to an SSE register (SSE4.1: x86-64-v2). Each lane's arithmetic is the scalar
-// test's, operation for operation (SSE2 rounds as scalar doubles do, and the build contracts
-// nothing into FMA), so a lane's answer is the scalar test's bit for bit (ray_quad_test).
+// once, and the rest runs two rays to an SSE register (SSE4.1: x86-64-v2). Each lane's
+// arithmetic is the scalar test's, operation for operation (SSE2 rounds as scalar doubles do,
+// and the build contracts nothing into FMA), so a lane's answer is the scalar test's bit for
+// bit (ray_quad_test).
 #include <immintrin.h>
 
 #include <cstdint>

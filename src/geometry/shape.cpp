@@ -20,7 +20,8 @@ FloatCapsule FloatCapsule::holding(const Capsule& c) {
     double moved = 0;
     for (std::size_t k = 0; k < 3; ++k) {
         f.a[k] = static_cast<float>(c.a[k]), f.b[k] = static_cast<float>(c.b[k]);
-        moved = std::max({moved, std::abs(double(f.a[k]) - c.a[k]), std::abs(double(f.b[k]) - c.b[k])});
+        moved = std::max({moved, std::abs(double(f.a[k]) - c.a[k]),
+                          std::abs(double(f.b[k]) - c.b[k])});
     }
     const double r = c.r + std::sqrt(3.0) * moved;
     f.r = static_cast<float>(r);

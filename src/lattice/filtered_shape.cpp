@@ -309,8 +309,11 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
     // faster than with every part intersected by every sub-ray; images identical. (Boxes grown
     // by (n - 1) / n of the width, as first written, kept more parts: 2 % slower.)
     std::array<std::uint32_t, kMaxNearParts> near;
-    std::span<const std::uint32_t> parts = chain_ ? chain_->all_parts() : std::span<const std::uint32_t>{};
-    if (part_boxes_) parts = {near.data(), part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, near)};
+    std::span<const std::uint32_t> parts;
+    if (part_boxes_)
+        parts = {near.data(), part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, near)};
+    else if (chain_)
+        parts = chain_->all_parts();
     // The sub-rays, lane k = i n + j (bit k of Sheet::sub_rays), each clipped to the box.
     static_assert(n * n == 4, "a RayQuad holds a ray's sub-rays");
     RayQuad q;
@@ -363,7 +366,8 @@ unsigned FilteredLatticeShape::blocked_sub_rays(std::span<const std::uint32_t> p
     if (chain_) return chain_->blocked_lanes(parts, q, live);
     unsigned blocked = 0;
     for (int k = 0; k < kSubRays; ++k)
-        if (live >> k & 1 && primitive_->occluded(q.ray(k), q.tmin[k], q.tmax[k])) blocked |= 1u << k;
+        if (live >> k & 1 && primitive_->occluded(q.ray(k), q.tmin[k], q.tmax[k]))
+            blocked |= 1u << k;
     return blocked;
 }
 

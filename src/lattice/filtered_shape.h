@@ -148,7 +148,8 @@ public:
     }
     // With the primitive's crossings, by the reach of the ray's own sub-rays.
     bool cull_meets(std::size_t i, const Ray& r) const override;
-    bool cull_capsule(std::size_t i, const Transform& xf, double widest, Capsule& out) const override {
+    bool cull_capsule(std::size_t i, const Transform& xf, double widest,
+                      Capsule& out) const override {
         return cull_frame().cull_capsule(i, xf, out, unspanned_reach(widest));
     }
     // How far a ray leaving a sheet skips this lattice: a sheet's point is a blend of the

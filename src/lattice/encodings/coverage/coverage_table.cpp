@@ -82,8 +82,10 @@ std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
     std::vector<Entry> entries;
     entries.reserve(hits.size());
     for (const auto& chunk : hits.chunks)
-        for (const RawHit& h : chunk)
-            entries.push_back({h.a * n + h.b, {quantise_t(static_cast<double>(h.t)), h.nu, h.nv, 0, 0, 0, 0}});
+        for (const RawHit& h : chunk) {
+            const std::uint16_t t = quantise_t(static_cast<double>(h.t));
+            entries.push_back({h.a * n + h.b, {t, h.nu, h.nv, 0, 0, 0, 0}});
+        }
     const auto by_pair = [](const Entry& x, const Entry& y) { return x.pair < y.pair; };
     std::sort(entries.begin(), entries.end(), by_pair);
     const std::size_t centers = entries.size();

@@ -159,8 +159,9 @@ void value_widths(const Fit& fit, const std::vector<Exception>& ex, unsigned& ex
         [&](const auto& r, std::uint64_t m) {
             for (std::size_t k = r.begin(); k != r.end(); ++k) {
                 const RawHit& h = *fit.by_a[hits[k]];
+                const auto t = static_cast<double>(h.t);
                 for (unsigned bits = 1; bits <= 32; ++bits)
-                    if (!fit.point_ok(decode_value_t(encode_value_t(static_cast<double>(h.t), bits), bits), h))
+                    if (!fit.point_ok(decode_value_t(encode_value_t(t, bits), bits), h))
                         m &= ~(std::uint64_t{1} << bits);
             }
             return m;
