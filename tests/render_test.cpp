@@ -72,6 +72,36 @@ TEST(Render, LitSphereMatchesTheShadingRule) {
     EXPECT_EQ(checked, 64 * 48 * 3);
 }
 
+// A light that adds nothing at a hit (N.L and R.V both at most 0) casts no shadow ray there;
+// every other light at every hit casts one. Counted by the reference rule, as above.
+TEST(Render, LightsThatAddNothingCastNoShadowRay) {
+    const Scene s = load_scene_text(kSphereScene, "sphere.json");
+    const RenderOutput out = render_image(RenderScene(s), {});
+    const Camera& c = s.camera;
+    const Vec3 w = normalize(c.look_at - c.eye), u = normalize(cross(w, c.up)), v = cross(u, w);
+    const double h = std::tan(c.fov_y_deg * M_PI / 360), a = double(c.width) / c.height;
+    const Vec3 center{0.2, 0.1, 0.05};
+    std::uint64_t pairs = 0, adding = 0;
+    for (int j = 0; j < c.height; ++j)
+        for (int i = 0; i < c.width; ++i) {
+            const Vec3 d = normalize(w + (2 * (i + 0.5) / c.width - 1) * a * h * u +
+                                     (1 - 2 * (j + 0.5) / c.height) * h * v);
+            const Vec3 oc = c.eye - center;
+            const double b = dot(oc, d), disc = b * b - (dot(oc, oc) - 1.1 * 1.1);
+            if (disc < 0) continue;
+            const Vec3 p = c.eye + d * (-b - std::sqrt(disc)), n = normalize(p - center);
+            for (const PointLight& l : s.lights) {
+                const Vec3 L = normalize(l.position - p);
+                const double nl = dot(n, L);
+                ++pairs;
+                adding += nl > 0 || dot(2 * nl * n - L, -d) > 0;
+            }
+        }
+    ASSERT_LT(adding, pairs);  // the scene has surfaces turned from a light
+    // A hit within rounding of a terminator may count either way.
+    EXPECT_NEAR(double(out.stats.shadow_rays), double(adding), 2.0);
+}
+
 Scene small_plate(const char* name, int size) {
     Scene s = load_scene(test::source_path(std::string("examples/") + name));
     s.camera.width = s.camera.height = size;

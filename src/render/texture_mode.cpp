@@ -202,10 +202,20 @@ RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const R
         auto visible = [&](const Ray& r, double tmin, double tmax, double) {
             return rs.occluded(r, tmin, tmax, hit.object) ? 0.0 : 1.0;
         };
-        for_each_light(rs, hit.p, counters, visible, [&](const PointLight& light, Vec3 l, double) {
-            bare += phong_term(m, m.color, n, l, v, light.intensity);
-            furred += phong_term(fur, t.colour, nf, l, v, light.intensity);
-        });
+        // Both surfaces' terms: a light that adds to neither casts no shadow ray.
+        struct Terms {
+            Vec3 bare, furred;
+            bool operator==(const Terms&) const = default;
+        };
+        const auto terms = [&](const PointLight& light, Vec3 l) {
+            return Terms{phong_term(m, m.color, n, l, v, light.intensity),
+                         phong_term(fur, t.colour, nf, l, v, light.intensity)};
+        };
+        const auto lit = [&](const PointLight&, const Terms& added, double) {
+            bare += added.bare;
+            furred += added.furred;
+        };
+        for_each_light(rs, hit.p, counters, terms, visible, lit);
         return (1 - t.coverage) * bare + t.coverage * furred;
     };
     return render_image(rs, o);
