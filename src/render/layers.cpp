@@ -37,14 +37,13 @@ Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, d
 
 double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tmax,
                      std::uint32_t self) {
-    thread_local std::vector<SurfaceHit> partial;
+    thread_local std::vector<AccelHit> partial;
     // Sub-rays along the same world directions in every lattice (geometry/sub_rays.h).
     const ScopedAcrossRay across(normalize(r.d));
-    SurfaceHit opaque;
-    if (rs.intersect_layers(r, tmin, tmax, self, opaque, partial, {.blocked_below = kMinTransmittance}))
+    if (rs.partial_crossings(r, tmin, tmax, self, partial, {.blocked_below = kMinTransmittance}))
         return 0;
     LayerComposite through;
-    for (const SurfaceHit& h : partial) through.add(h.alpha, h.sub_rays);
+    for (const AccelHit& h : partial) through.add(h.crossing);
     const double trans = through.left();
     return trans <= kMinTransmittance ? 0 : trans;
 }

@@ -43,6 +43,14 @@ public:
     bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                           SurfaceHit& hit, std::vector<SurfaceHit>& partial,
                           const LayerStop& stop = {}) const;
+    // As intersect_layers, for a ray that wants only what its crossings cover (a shadow ray's
+    // transmittance): whether an opaque crossing was met, and the partial crossings before it,
+    // not made into surface hits (their points and normals are not wanted).
+    bool partial_crossings(const Ray& r, double tmin, double tmax, std::uint32_t self,
+                           std::vector<AccelHit>& partial, const LayerStop& stop) const {
+        AccelHit opaque;
+        return accel_->intersect_layers(r, tmin, tmax, self, opaque, partial, stop);
+    }
     // `self`: the object whose surface the ray leaves (see EmbreeAccel::occluded).
     bool occluded(const Ray& r, double tmin, double tmax,
                   std::uint32_t self = EmbreeAccel::kNoObject) const {
