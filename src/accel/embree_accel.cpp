@@ -179,6 +179,15 @@ void trace_closest(RTCScene scene, Context& ctx, const Ray& r, double tmin, doub
     rtcIntersect1(scene, &ctx.rtc, &rh);
 }
 
+// Embree's any-hit traversal (children unsorted, cheaper per node); a callback ends it by
+// setting the ray's tfar to -infinity.
+template <class Context>
+void trace_any(RTCScene scene, Context& ctx, const Ray& r, double tmin, double tmax) {
+    alignas(16) RTCRay ray;
+    set_rtc_ray(ray, r, tmin, tmax);
+    rtcOccluded1(scene, &ctx.rtc, &ray);
+}
+
 void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax) {
     ray.org_x = static_cast<float>(r.o.x);
     ray.org_y = static_cast<float>(r.o.y);
@@ -340,6 +349,23 @@ struct EmbreeAccel::Impl {
         if (ctx->stop.blocked_below > 0) rh->ray.tfar = -INFINITY;
     }
 
+    // A shadow ray's transmittance (intersect_layers with LayerStop::blocked_below), traced by
+    // the any-hit traversal since its crossings compose in any order: whether this object
+    // blocks it, opaque or with the partial crossings met so far letting too little through.
+    template <Kind K>
+    bool blocks_transmittance(QueryContext* ctx, Target t, const Shape& shape, const Ray& local,
+                              double tmin) const {
+        Crossing c;
+        const bool hit = K == Kind::kDirect
+                             ? shape.intersect(local, tmin, ctx->tmax, c)
+                             : shape.intersect_primitive(t.part, local, tmin, ctx->tmax, c);
+        if (!hit) return false;
+        float tfar = INFINITY;  // add_partial narrows it for camera rays only
+        if (c.coverage < 1.0f && !ctx->add_partial({c.t, t.object, c}, tfar)) return false;
+        *ctx->hit = {c.t, t.object, c};
+        return true;
+    }
+
     template <Kind K>
     static void occluded_cb(const RTCOccludedFunctionNArguments* args) {
         if (!args->valid[0]) return;
@@ -354,7 +380,9 @@ struct EmbreeAccel::Impl {
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
         self->hand_across(ctx, t.object);
         const double tmin = self->occlusion_tmin(ctx, t.object, local);
-        const bool hit = K == Kind::kDirect
+        const bool hit = ctx->partial
+                             ? self->blocks_transmittance<K>(ctx, t, shape, local, tmin)
+                         : K == Kind::kDirect
                              ? shape.occluded(local, tmin, ctx->tmax)
                              : shape.occluded_primitive(t.part, local, tmin, ctx->tmax);
         if (hit) {
@@ -524,7 +552,10 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     ctx.self = self;
     ctx.partial = &partial;
     ctx.stop = stop;
-    if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax);
+    if (traceable && stop.blocked_below > 0)
+        trace_any(m.scene, ctx, r, tmin, tmax);
+    else if (traceable)
+        trace_closest(m.scene, ctx, r, tmin, tmax);
     const bool blocked = ctx.found && stop.blocked_below > 0;
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;
@@ -560,10 +591,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
         if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) return true;
     }
 
-    if (!traceable) return false;
-    alignas(16) RTCRay ray;
-    set_rtc_ray(ray, r, tmin, tmax);
-    rtcOccluded1(m.scene, &ctx.rtc, &ray);
+    if (traceable) trace_any(m.scene, ctx, r, tmin, tmax);
     return ctx.found;
 }
 
