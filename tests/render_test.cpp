@@ -24,22 +24,37 @@ const char* kSphereScene = R"({
   "materials": {"m": {"color": [0.8, 0.5, 0.3], "ka": 0.2, "kd": 0.7, "ks": 0.5, "shininess": 15}},
   "objects": [{"type": "sphere", "center": [0.2, 0.1, 0.05], "radius": 1.1, "material": "m"}]})";
 
+// Pixel (i, j)'s camera ray and where it first meets the scene's one sphere, computed
+// directly (the camera's rule, docs/scene-format.md).
+struct SphereHit {
+    Vec3 d, p, n;  // the unit ray direction, the hit point, the unit normal
+    bool hit = false;
+};
+SphereHit sphere_hit(const Scene& s, int i, int j) {
+    const Camera& c = s.camera;
+    const Vec3 w = normalize(c.look_at - c.eye), u = normalize(cross(w, c.up)), v = cross(u, w);
+    const double h = std::tan(c.fov_y_deg * M_PI / 360), a = double(c.width) / c.height;
+    SphereHit out;
+    out.d = normalize(w + (2 * (i + 0.5) / c.width - 1) * a * h * u +
+                      (1 - 2 * (j + 0.5) / c.height) * h * v);
+    const Vec3 center{0.2, 0.1, 0.05};
+    const double r = 1.1;
+    const Vec3 oc = c.eye - center;
+    const double b = dot(oc, out.d), disc = b * b - (dot(oc, oc) - r * r);
+    if (disc < 0) return out;
+    out.p = c.eye + out.d * (-b - std::sqrt(disc));
+    out.n = normalize(out.p - center);
+    out.hit = true;
+    return out;
+}
+
 // The reference rule evaluated directly for one sphere (no other object can shadow it; the
 // sphere shadows itself exactly where N.L < 0, which the rule then zeroes anyway except for
 // the specular term).
 Vec3 expected_pixel(const Scene& s, int i, int j) {
-    const Camera& c = s.camera;
-    const Vec3 w = normalize(c.look_at - c.eye), u = normalize(cross(w, c.up)), v = cross(u, w);
-    const double h = std::tan(c.fov_y_deg * M_PI / 360), a = double(c.width) / c.height;
-    const Vec3 d = normalize(w + (2 * (i + 0.5) / c.width - 1) * a * h * u +
-                             (1 - 2 * (j + 0.5) / c.height) * h * v);
-    const Vec3 center{0.2, 0.1, 0.05};
-    const double r = 1.1;
-    const Vec3 oc = c.eye - center;
-    const double b = dot(oc, d), disc = b * b - (dot(oc, oc) - r * r);
-    if (disc < 0) return s.background;
-    const double t = -b - std::sqrt(disc);
-    const Vec3 p = c.eye + d * t, n = normalize(p - center), vv = -d;
+    const SphereHit sh = sphere_hit(s, i, j);
+    if (!sh.hit) return s.background;
+    const Vec3 p = sh.p, n = sh.n, vv = -sh.d;
     const Material& m = s.materials[0];
     Vec3 col = m.ka * m.color * s.ambient;
     for (const PointLight& l : s.lights) {
@@ -77,24 +92,16 @@ TEST(Render, LitSphereMatchesTheShadingRule) {
 TEST(Render, LightsThatAddNothingCastNoShadowRay) {
     const Scene s = load_scene_text(kSphereScene, "sphere.json");
     const RenderOutput out = render_image(RenderScene(s), {});
-    const Camera& c = s.camera;
-    const Vec3 w = normalize(c.look_at - c.eye), u = normalize(cross(w, c.up)), v = cross(u, w);
-    const double h = std::tan(c.fov_y_deg * M_PI / 360), a = double(c.width) / c.height;
-    const Vec3 center{0.2, 0.1, 0.05};
     std::uint64_t pairs = 0, adding = 0;
-    for (int j = 0; j < c.height; ++j)
-        for (int i = 0; i < c.width; ++i) {
-            const Vec3 d = normalize(w + (2 * (i + 0.5) / c.width - 1) * a * h * u +
-                                     (1 - 2 * (j + 0.5) / c.height) * h * v);
-            const Vec3 oc = c.eye - center;
-            const double b = dot(oc, d), disc = b * b - (dot(oc, oc) - 1.1 * 1.1);
-            if (disc < 0) continue;
-            const Vec3 p = c.eye + d * (-b - std::sqrt(disc)), n = normalize(p - center);
+    for (int j = 0; j < s.camera.height; ++j)
+        for (int i = 0; i < s.camera.width; ++i) {
+            const SphereHit sh = sphere_hit(s, i, j);
+            if (!sh.hit) continue;
             for (const PointLight& l : s.lights) {
-                const Vec3 L = normalize(l.position - p);
-                const double nl = dot(n, L);
+                const Vec3 L = normalize(l.position - sh.p);
+                const double nl = dot(sh.n, L);
                 ++pairs;
-                adding += nl > 0 || dot(2 * nl * n - L, -d) > 0;
+                adding += nl > 0 || dot(2 * nl * sh.n - L, -sh.d) > 0;
             }
         }
     ASSERT_LT(adding, pairs);  // the scene has surfaces turned from a light

@@ -332,6 +332,7 @@ struct EmbreeAccel::Impl {
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
         self->hand_across(ctx, t.object);
         assert(ctx->hit);  // rtcIntersect1 runs only for intersect and intersect_layers
+        assert(ctx->stop.blocked_below == 0);  // shadow rays: occluded_cb, blocks_transmittance
         const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
         const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
         Crossing c;
@@ -340,13 +341,11 @@ struct EmbreeAccel::Impl {
                              : shape.intersect_primitive(t.part, local, tmin, tmax, c);
         if (!hit) return;
         auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
-        // Partial crossings are kept, and the ray goes on (unless that blocks a shadow ray).
+        // Partial crossings are kept, and the ray goes on.
         if (ctx->partial && c.coverage < 1.0f && !ctx->add_partial({c.t, t.object, c}, rh->ray.tfar))
             return;
         self->record(ctx, rh, t.object, c, args->geomID, args->primID,
                      K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
-        // A blocked shadow ray needs no closer crossing: the traversal ends.
-        if (ctx->stop.blocked_below > 0) rh->ray.tfar = -INFINITY;
     }
 
     // A shadow ray's transmittance (intersect_layers with LayerStop::blocked_below), traced by
