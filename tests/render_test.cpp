@@ -104,9 +104,9 @@ TEST(Render, LightsThatAddNothingCastNoShadowRay) {
                 adding += nl > 0 || dot(2 * nl * sh.n - L, -sh.d) > 0;
             }
         }
-    ASSERT_LT(adding, pairs);  // the scene has surfaces turned from a light
-    // A hit within rounding of a terminator may count either way.
-    EXPECT_NEAR(double(out.stats.shadow_rays), double(adding), 2.0);
+    ASSERT_GT(pairs - adding, 100u);  // the scene has surfaces turned from a light
+    // Exact: at every hit max(N.L, R.V) is at least 3.9e-4 from 0, far beyond rounding.
+    EXPECT_EQ(out.stats.shadow_rays, adding);
 }
 
 Scene small_plate(const char* name, int size) {

@@ -57,7 +57,8 @@ bool in_ray_order(const AccelHit& a, const AccelHit& b) {
 // Per-query state. Embree hands our callbacks the RTCIntersectContext; ours extends it with
 // the double-precision ray and the best hit so far (the documented way to pass query data).
 struct QueryContext {
-    // h: where the closest hit goes; null for occlusion, which needs none.
+    // h: where the closest hit goes (for a shadow ray's transmittance, what blocked it); null
+    // for plain occlusion, which needs none.
     QueryContext(const EmbreeAccel::Impl& m, const Ray& r, double t0, double t1, AccelHit* h)
         : accel(&m), ray(r), tmin(t0), tmax(t1), hit(h) {
         rtcInitIntersectContext(&rtc);
@@ -80,21 +81,31 @@ struct QueryContext {
     std::vector<AccelHit>* partial = nullptr;
     LayerStop stop;
     LayerComposite transmitted;
-    // A partial crossing met; whether it blocks a shadow ray. For camera rays the crossings are
-    // kept in ray order and cut where compositing will stop (LayerStop), and tmax and the
-    // traversal's tfar come down to the last one kept.
-    bool add_partial(const AccelHit& h, float& tfar) {
-        // An object answers a ray with one sheet; met again (it fell out of the ring of tested
-        // objects), it is not counted twice.
+    // An object answers a ray with one sheet; met again (it fell out of the ring of tested
+    // objects), it is not counted twice.
+    bool met_already(std::uint32_t object) const {
         for (const AccelHit& p : *partial)
-            if (p.object == h.object) return false;
-        if (stop.blocked_below > 0) {
-            partial->push_back(h);
-            transmitted.add(h.crossing);
-            return transmitted.left() < stop.blocked_below;
-        }
+            if (p.object == object) return true;
+        return false;
+    }
+    // A shadow ray's partial crossing; whether the ray is now blocked. The stop has a margin
+    // (1e-9 relative) that the product of what the crossings let through, taken in any order,
+    // cannot close: transmittance() then finds at most blocked_below in ray order too.
+    bool add_shadow_partial(const AccelHit& h) {
+        assert(stop.shadow());
+        if (met_already(h.object)) return false;
+        partial->push_back(h);
+        transmitted.add(h.crossing);
+        return transmitted.left() < stop.blocked_below * (1 - 1e-9);
+    }
+    // A camera ray's partial crossing: the crossings are kept in ray order and cut where
+    // compositing will stop (LayerStop), and tmax and the traversal's tfar come down to the
+    // last one kept.
+    void add_camera_partial(const AccelHit& h, float& tfar) {
+        assert(!stop.shadow());
+        if (met_already(h.object)) return;
         partial->insert(std::upper_bound(partial->begin(), partial->end(), h, in_ray_order), h);
-        if (stop.max_layers <= 0) return false;
+        if (stop.max_layers <= 0) return;
         LayerComposite seen;
         for (std::size_t i = 0; i < partial->size(); ++i) {
             seen.add((*partial)[i].crossing);
@@ -105,7 +116,6 @@ struct QueryContext {
                 break;
             }
         }
-        return false;
     }
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
@@ -290,7 +300,7 @@ struct EmbreeAccel::Impl {
 
     void record(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Crossing& c,
                 unsigned geom, unsigned prim, unsigned inst) const {
-        assert(ctx->hit);  // closest-hit queries only (occlusion queries have none)
+        assert(ctx->hit);  // closest-hit queries only (plain occlusion queries have none)
         ctx->found = true;
         *ctx->hit = {c.t, obj, c};
         rh->ray.tfar = float_above(c.t);
@@ -332,7 +342,7 @@ struct EmbreeAccel::Impl {
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
         self->hand_across(ctx, t.object);
         assert(ctx->hit);  // rtcIntersect1 runs only for intersect and intersect_layers
-        assert(ctx->stop.blocked_below == 0);  // shadow rays: occluded_cb, blocks_transmittance
+        assert(!ctx->stop.shadow());  // shadow rays: occluded_cb, blocks_transmittance
         const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
         const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
         Crossing c;
@@ -342,25 +352,28 @@ struct EmbreeAccel::Impl {
         if (!hit) return;
         auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
         // Partial crossings are kept, and the ray goes on.
-        if (ctx->partial && c.coverage < 1.0f && !ctx->add_partial({c.t, t.object, c}, rh->ray.tfar))
+        if (ctx->partial && c.coverage < 1.0f) {
+            ctx->add_camera_partial({c.t, t.object, c}, rh->ray.tfar);
             return;
+        }
         self->record(ctx, rh, t.object, c, args->geomID, args->primID,
                      K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
     }
 
     // A shadow ray's transmittance (intersect_layers with LayerStop::blocked_below), traced by
     // the any-hit traversal since its crossings compose in any order: whether this object
-    // blocks it, opaque or with the partial crossings met so far letting too little through.
+    // blocks it, opaque or with the partial crossings met so far letting too little through
+    // (then written to the query's hit, as intersect_layers reads it).
     template <Kind K>
     bool blocks_transmittance(QueryContext* ctx, Target t, const Shape& shape, const Ray& local,
                               double tmin) const {
+        assert(ctx->hit && ctx->partial && ctx->stop.shadow());
         Crossing c;
         const bool hit = K == Kind::kDirect
                              ? shape.intersect(local, tmin, ctx->tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, ctx->tmax, c);
         if (!hit) return false;
-        float tfar = INFINITY;  // add_partial narrows it for camera rays only
-        if (c.coverage < 1.0f && !ctx->add_partial({c.t, t.object, c}, tfar)) return false;
+        if (c.coverage < 1.0f && !ctx->add_shadow_partial({c.t, t.object, c})) return false;
         *ctx->hit = {c.t, t.object, c};
         return true;
     }
@@ -379,11 +392,13 @@ struct EmbreeAccel::Impl {
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
         self->hand_across(ctx, t.object);
         const double tmin = self->occlusion_tmin(ctx, t.object, local);
-        const bool hit = ctx->partial
-                             ? self->blocks_transmittance<K>(ctx, t, shape, local, tmin)
-                         : K == Kind::kDirect
-                             ? shape.occluded(local, tmin, ctx->tmax)
-                             : shape.occluded_primitive(t.part, local, tmin, ctx->tmax);
+        bool hit;
+        if (ctx->stop.shadow())
+            hit = self->blocks_transmittance<K>(ctx, t, shape, local, tmin);
+        else if constexpr (K == Kind::kDirect)
+            hit = shape.occluded(local, tmin, ctx->tmax);
+        else
+            hit = shape.occluded_primitive(t.part, local, tmin, ctx->tmax);
         if (hit) {
             ctx->found = true;
             reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
@@ -551,11 +566,11 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     ctx.self = self;
     ctx.partial = &partial;
     ctx.stop = stop;
-    if (traceable && stop.blocked_below > 0)
+    if (traceable && stop.shadow())
         trace_any(m.scene, ctx, r, tmin, tmax);
     else if (traceable)
         trace_closest(m.scene, ctx, r, tmin, tmax);
-    const bool blocked = ctx.found && stop.blocked_below > 0;
+    const bool blocked = ctx.found && stop.shadow();
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;
         const AccelObject& o = m.objects[i];

@@ -46,6 +46,7 @@ struct LayerStop {
     // one is met, the ray is blocked and the traversal ends at once (`hit` is then no
     // closest crossing; only "blocked" is meant). 0: not a shadow ray.
     double blocked_below = 0;
+    bool shadow() const { return blocked_below > 0; }
     // Camera rays, composited front to back: the partial crossings up to the max_layers-th
     // without sub-rays (LayerComposite::draws), or to where what they leave falls to min_left
     // or below,

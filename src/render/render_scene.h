@@ -43,9 +43,10 @@ public:
     bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                           SurfaceHit& hit, std::vector<SurfaceHit>& partial,
                           const LayerStop& stop = {}) const;
-    // As intersect_layers, for a ray that wants only what its crossings cover (a shadow ray's
-    // transmittance): whether an opaque crossing was met, and the partial crossings before it,
-    // not made into surface hits (their points and normals are not wanted).
+    // As intersect_layers, for a shadow ray's transmittance, which wants only what its
+    // crossings cover: whether the ray is blocked (an opaque crossing, or partial ones that let
+    // less than stop.blocked_below through), else its partial crossings, not made into surface
+    // hits (their points and normals are not wanted).
     bool partial_crossings(const Ray& r, double tmin, double tmax, std::uint32_t self,
                            std::vector<AccelHit>& partial, const LayerStop& stop) const {
         AccelHit opaque;

@@ -68,11 +68,14 @@ double shadow_epsilon(Vec3 p);
 // The lights that reach p, each with its shadow ray cast (when the scene has shadows):
 // term(light, unit direction to it) is the light's contribution unshadowed, a value that
 // compares equal to its default (zero) when the light adds nothing; visible(shadow ray, tmin,
-// tmax, distance) gives the share of the light that arrives, and lit(light, term, share) is
-// called when that is above 0. A light whose term is zero casts no shadow ray: shadowed or
-// not, it adds nothing (a surface turned from it, N.L and R.V both at most 0; 6 to 9 % of the
-// shadow rays of the ball scenes and grass), and the image is the same. The one home of the
-// light loop: shade() and the texture mode's baked surfaces both go through it.
+// tmax, distance) gives the share of the light that arrives, and lit(term, share) is called
+// when that is above 0. A light whose term is zero casts no shadow ray: shadowed or not, it
+// adds nothing, and the image is the same. With a unit normal that is a surface turned from
+// the light, N.L and R.V both at most 0 (6 to 9 % of the shadow rays of the ball scenes and
+// grass); a prefiltered lattice's mean normal spreads its diffuse term past the terminator,
+// so its layers rarely skip one. The one home of the ray-traced light loop: shade(), layered
+// shading and the texture mode's baked surfaces go through it (particle mode, which reads
+// shadow maps per light, has its own).
 template <class Term, class Visible, class Lit>
 void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Term&& term,
                     Visible&& visible, Lit&& lit) {
@@ -91,7 +94,7 @@ void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Term
             seen = visible(Ray{p, l}, eps, dist * (1 - 1e-12), dist);
             if (seen <= 0) continue;
         }
-        lit(light, unshadowed, seen);
+        lit(unshadowed, seen);
     }
 }
 
@@ -111,7 +114,7 @@ Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, Sh
     const auto term = [&](const PointLight& light, Vec3 l) {
         return phong_term(m, m.color, n, l, v, light.intensity, hit.normal_length);
     };
-    const auto lit = [&](const PointLight&, Vec3 added, double seen) {
+    const auto lit = [&](Vec3 added, double seen) {
         c += seen == 1 ? added : added * seen;
     };
     for_each_light(rs, hit.p, counters, term, visible, lit);

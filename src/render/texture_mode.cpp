@@ -211,7 +211,7 @@ RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const R
             return Terms{phong_term(m, m.color, n, l, v, light.intensity),
                          phong_term(fur, t.colour, nf, l, v, light.intensity)};
         };
-        const auto lit = [&](const PointLight&, const Terms& added, double) {
+        const auto lit = [&](const Terms& added, double) {
             bare += added.bare;
             furred += added.furred;
         };
