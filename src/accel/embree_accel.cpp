@@ -221,6 +221,10 @@ struct EmbreeAccel::Impl {
     RTCScene scene = nullptr;
     std::vector<AccelObject> objects;
     std::vector<bool> similar;  // per object: keeps_directions_across
+    // Per object: placed as direct primitives (one Embree primitive per cull part, whose
+    // callbacks test the whole shape), so that a shadow ray leaving it can test it after the
+    // traversal instead (transmit_through_self).
+    std::vector<bool> direct_object;
     // The top-level user geometry of single-part objects: one primitive per cull part
     // (Shape::cull_count).
     // Read on every callback, so kept small: 36 bytes, the bounds (read only while Embree
@@ -378,6 +382,21 @@ struct EmbreeAccel::Impl {
         return true;
     }
 
+    // A shadow ray's transmittance through the object it leaves, tested after the traversal
+    // rather than in it: the other objects met block most such rays first (then it is never
+    // tested), and otherwise its crossing composes with theirs as in any order. (Grass: 41 %
+    // of the shadow rays' sheet tests were of their own object, 1.2 % of them blocking.)
+    bool self_tested_last(const QueryContext* ctx, std::uint32_t object) const {
+        return ctx->stop.shadow() && object == ctx->self && direct_object[object];
+    }
+    void transmit_through_self(QueryContext& ctx) const {
+        assert(!ctx.found && self_tested_last(&ctx, ctx.self));
+        const AccelObject& o = objects[ctx.self];
+        const Ray local = object_ray(o, similar[ctx.self], ctx.ray);
+        const double tmin = occlusion_tmin(&ctx, ctx.self, local);
+        ctx.found = blocks_transmittance<Kind::kDirect>(&ctx, {ctx.self, 0}, *o.shape, local, tmin);
+    }
+
     template <Kind K>
     static void occluded_cb(const RTCOccludedFunctionNArguments* args) {
         if (!args->valid[0]) return;
@@ -385,7 +404,7 @@ struct EmbreeAccel::Impl {
         const Impl* self = ctx->accel;
         const Target t = self->template target<K>(args->primID, args->context->instID[0]);
         if constexpr (K == Kind::kDirect)
-            if (!self->may_visit(ctx, args->primID)) return;
+            if (self->self_tested_last(ctx, t.object) || !self->may_visit(ctx, args->primID)) return;
         const Shape& shape = *self->objects[t.object].shape;
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
@@ -468,6 +487,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
     Impl& m = *impl_;
     m.objects.assign(objects.begin(), objects.end());
     for (const AccelObject& o : m.objects) m.similar.push_back(keeps_directions_across(*o.xf));
+    m.direct_object.assign(m.objects.size(), false);
     m.device = rtcNewDevice(nullptr);
     if (!m.device) throw std::runtime_error("Embree: cannot create a device");
     rtcSetDeviceErrorFunction(m.device, on_embree_error, &m);
@@ -510,12 +530,14 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
                 lat::intersect(wb, o.shape->cull_bounds(0, *o.xf, o.widest_footprint));
             if (b.empty()) continue;
             m.direct.push_back(Impl::direct_prim(i, 0, false, o));
+            m.direct_object[i] = true;
             m.direct_bounds.push_back(b);
         } else {
             for (std::uint32_t c = 0; c < o.shape->cull_count(); ++c) {
                 const Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);
                 if (b.empty()) continue;
                 m.direct.push_back(Impl::direct_prim(i, c, true, o));
+                m.direct_object[i] = true;
                 m.direct_bounds.push_back(b);
             }
         }
@@ -566,9 +588,11 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     ctx.self = self;
     ctx.partial = &partial;
     ctx.stop = stop;
-    if (traceable && stop.shadow())
+    if (traceable && stop.shadow()) {
         trace_any(m.scene, ctx, r, tmin, tmax);
-    else if (traceable)
+        if (!ctx.found && self < m.objects.size() && m.self_tested_last(&ctx, self))
+            m.transmit_through_self(ctx);
+    } else if (traceable)
         trace_closest(m.scene, ctx, r, tmin, tmax);
     const bool blocked = ctx.found && stop.shadow();
     for (const std::uint32_t i : m.unbounded) {
