@@ -84,9 +84,9 @@ double lod_blend(double f, double band);
 //       culling (a later day)   47.16 / 53.05 / 38.44 / 40.26 / 32.76 / 37.46 / 36.14 / 33.76 dB
 //       each instance's own     118 / 40 / 161 / 236 / 393 / 281 / 39 / 22 ms
 //       reach (the next day)    47.16 / 53.05 / 38.40 / 40.23 / 32.76 / 37.43 / 36.13 / 33.66 dB
-//       shadow rays: any-hit,   123 / 45 / 159 / 246 / 401 / 327 / 42 / 22 ms, same images;
-//       no surface hits (a      exact 4 spp in those runs 179 / 113 / 268 / 329 / 405 / 264 /
-//       slower machine)         26 / 20 ms (render/layers.h, docs/filtering.md)
+//       shadow rays: any-hit,   111 / 39 / 150 / 219 / 355 / 287 / 37 / 21 ms, same images;
+//       own object last, no     exact 4 spp in those runs 162 / 102 / 255 / 302 / 357 / 238 /
+//       surface hits (later)    23 / 20 ms (docs/filtering.md, "Shadow rays: what they ...")
 //     tables, with half the     238 / 39 / 439 / 934 / 1720 / 2103 / 480 / 106 ms
 //     sub-rays' weight blended  45.98 / 51.64 / 39.35 / 40.33 / 33.01 / 38.45 / 35.95 / 34.09 dB
 //     in (camera rays) and one
