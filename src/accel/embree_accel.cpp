@@ -223,7 +223,8 @@ struct EmbreeAccel::Impl {
     std::vector<bool> similar;  // per object: keeps_directions_across
     // Per object: placed as direct primitives (one Embree primitive per cull part, whose
     // callbacks test the whole shape), so that a shadow ray leaving it can test it after the
-    // traversal instead (transmit_through_self).
+    // traversal instead (test_self_last). Culling is conservative, so the test unculled
+    // answers as the callbacks' would.
     std::vector<bool> direct_object;
     // The top-level user geometry of single-part objects: one primitive per cull part
     // (Shape::cull_count).
@@ -394,9 +395,11 @@ struct EmbreeAccel::Impl {
         const AccelObject& o = objects[ctx.self];
         const Ray local = object_ray(o, similar[ctx.self], ctx.ray);
         const double tmin = occlusion_tmin(&ctx, ctx.self, local);
-        ctx.found = ctx.stop.shadow() ? blocks_transmittance<Kind::kDirect>(&ctx, {ctx.self, 0},
-                                                                             *o.shape, local, tmin)
-                                      : o.shape->occluded(local, tmin, ctx.tmax);
+        const Target t{ctx.self, 0};
+        if (ctx.stop.shadow())
+            ctx.found = blocks_transmittance<Kind::kDirect>(&ctx, t, *o.shape, local, tmin);
+        else
+            ctx.found = o.shape->occluded(local, tmin, ctx.tmax);
     }
 
     template <Kind K>
