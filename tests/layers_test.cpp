@@ -125,6 +125,34 @@ TEST(Layers, ShadowRaysSumTransmittanceAndStopWhenBlocked) {
                                               {.blocked_below = expected * 1.01}));
 }
 
+// A shadow ray tests the object it leaves (`self`) after the traversal, if nothing else
+// blocked it: the crossings it finds are the same whichever object it leaves (these sheets
+// have no surface tolerance, and lie ahead of the ray's start), and an opaque sheet blocks a
+// ray leaving it, in a transmittance and in plain occlusion alike.
+TEST(Layers, AShadowRayTestsTheObjectItLeavesAfterTheOthers) {
+    const Stack clear(6), blocked(6, 4);
+    const LayerStop shadow{.blocked_below = 1e-6};
+    AccelHit hit;
+    std::vector<AccelHit> none, mine;
+    ASSERT_FALSE(clear.accel->intersect_layers(kUp, 0, kInfinity, EmbreeAccel::kNoObject, hit,
+                                               none, shadow));
+    ASSERT_EQ(none.size(), 6u);
+    for (std::uint32_t self = 0; self < 6; ++self) {
+        EXPECT_FALSE(clear.accel->intersect_layers(kUp, 0, kInfinity, self, hit, mine, shadow));
+        ASSERT_EQ(mine.size(), none.size()) << self;
+        for (std::size_t i = 0; i < mine.size(); ++i) {
+            EXPECT_EQ(mine[i].object, none[i].object) << self;
+            EXPECT_EQ(mine[i].t, none[i].t) << self;
+        }
+    }
+    // The opaque sheet: the closest opaque crossing of a camera ray.
+    ASSERT_TRUE(blocked.accel->intersect_layers(kUp, 0, kInfinity, EmbreeAccel::kNoObject, hit, none));
+    const std::uint32_t opaque = hit.object;
+    EXPECT_TRUE(blocked.accel->intersect_layers(kUp, 0, kInfinity, opaque, hit, mine, shadow));
+    EXPECT_EQ(hit.object, opaque);  // the others let enough through: it blocks
+    EXPECT_TRUE(blocked.accel->occluded(kUp, 3.5, 4.5, opaque));  // only it lies in range
+}
+
 // The specular light phong_term reflects over the sphere of view directions, for a normal of
 // this length (light along the normal, so that the lobe is centred on it).
 double specular_integral(double normal_length) {
