@@ -21,7 +21,8 @@ namespace {
 // is; culled by `parts` boxes, so that a traversal meets each object several times.
 class Sheet final : public Shape {
 public:
-    Sheet(double z, float alpha, std::size_t parts) : z_(z), alpha_(alpha), parts_(parts) {}
+    Sheet(double z, float alpha, std::size_t parts, double tolerance = 0)
+        : z_(z), alpha_(alpha), parts_(parts), tolerance_(tolerance) {}
     Bounds3 bounds() const override { return {{-1, -1, z_ - 0.01}, {1, 1, z_ + 0.01}}; }
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override {
         if (r.d.z == 0) return false;
@@ -35,6 +36,7 @@ public:
     void spans(const Ray&, SpanList&) const override {}
     Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
     bool inside(Vec3) const override { return false; }
+    double surface_tolerance() const override { return tolerance_; }
     std::size_t cull_count() const override { return parts_; }
     // Boxes reaching farther and farther back along the ray, so that a traversal meets other
     // objects between the parts of one (more than the ring of tested objects holds).
@@ -46,17 +48,19 @@ private:
     double z_;
     float alpha_;
     std::size_t parts_;
+    double tolerance_;
 };
 
 struct Stack {
     std::vector<std::unique_ptr<Sheet>> sheets;
     std::vector<float> alpha;  // by height, z = 1, 2, ...
+    std::vector<int> height;   // by object
     Transform xf;
     std::unique_ptr<EmbreeAccel> accel;
 
     // n sheets, made in a shuffled order so that object order is not ray order; the one at
     // height `opaque` (if any) covers fully.
-    explicit Stack(int n, int opaque = -1) {
+    explicit Stack(int n, int opaque = -1, double tolerance = 0) {
         std::mt19937 rng(7);
         std::uniform_real_distribution<float> u(0.2f, 0.6f);
         std::vector<int> order(static_cast<std::size_t>(n));
@@ -67,7 +71,8 @@ struct Stack {
         for (const int z : order) {
             const float a = z == opaque ? 1.0f : u(rng);
             alpha[static_cast<std::size_t>(z)] = a;
-            sheets.push_back(std::make_unique<Sheet>(z, a, 3));
+            height.push_back(z);
+            sheets.push_back(std::make_unique<Sheet>(z, a, 3, tolerance));
             objects.push_back({sheets.back().get(), &xf});
         }
         accel = std::make_unique<EmbreeAccel>(objects);
@@ -151,6 +156,30 @@ TEST(Layers, AShadowRayTestsTheObjectItLeavesAfterTheOthers) {
     EXPECT_TRUE(blocked.accel->intersect_layers(kUp, 0, kInfinity, opaque, hit, mine, shadow));
     EXPECT_EQ(hit.object, opaque);  // the others let enough through: it blocks
     EXPECT_TRUE(blocked.accel->occluded(kUp, 3.5, 4.5, opaque));  // only it lies in range
+}
+
+// A ray leaving an object skips that object's crossings within its surface tolerance, and no
+// other's: the object is the one the caller numbers `self` (the accelerator numbers objects in
+// its own order, here not the order given).
+TEST(Layers, ARayLeavingAnObjectSkipsItsOwnCrossingsWithinItsTolerance) {
+    const Stack s(8, -1, 1e-3);
+    const LayerStop shadow{.blocked_below = 1e-6};
+    AccelHit hit;
+    std::vector<AccelHit> partial;
+    for (std::uint32_t self = 0; self < 8; ++self) {
+        const double z = s.height[self];
+        const Ray up{{0.1, 0.2, z - 1e-4}, {0, 0, 1}};  // just below its own sheet
+        s.accel->intersect_layers(up, 0, kInfinity, self, hit, partial, shadow);
+        ASSERT_EQ(partial.size(), 8 - static_cast<std::size_t>(z)) << self;  // those above only
+        for (const AccelHit& h : partial) EXPECT_NE(h.object, self);
+        s.accel->intersect_layers(up, 0, kInfinity, self, hit, partial);  // a camera ray's too
+        EXPECT_EQ(partial.size(), 8 - static_cast<std::size_t>(z)) << self;
+        // Plain occlusion: nothing within its own tolerance, the one just beyond it the other's.
+        const std::uint32_t other = (self + 1) % 8;
+        const Ray below_other{{0.1, 0.2, s.height[other] - 1e-4}, {0, 0, 1}};
+        EXPECT_FALSE(s.accel->occluded(up, 0, 5e-4, self)) << self;
+        EXPECT_TRUE(s.accel->occluded(below_other, 0, 5e-4, self)) << self;
+    }
 }
 
 // The specular light phong_term reflects over the sphere of view directions, for a normal of

@@ -43,10 +43,36 @@ bool keeps_directions_across(const Transform& xf) {
            std::abs(dot(c[1], c[2])) <= tol;
 }
 
+// An object as the callbacks read it. The accelerator numbers its objects in the order of a
+// space-filling curve through their boxes, and keeps what a callback loads in this record:
+// the objects a ray meets are near each other, and their records then share cache lines
+// (scattered objects come in random order, and a callback stalled on loading the object's
+// shape and inverse map from the scene's records).
+struct Placed {
+    const Shape* shape;
+    const Transform* xf;  // object -> world
+    Affine inverse;       // xf's inverse map
+    double widest_footprint;
+    std::uint32_t original;  // its index among the objects given to the constructor
+    bool identity;           // xf is the identity
+    bool similar;            // keeps_directions_across(xf)
+    // Placed as direct primitives (one Embree primitive per cull part, whose callbacks test
+    // the whole shape), so that a shadow ray leaving it can test it after the traversal
+    // instead (test_self_last). Culling is conservative, so the test unculled answers as the
+    // callbacks' would.
+    bool direct = false;
+
+    Ray local_ray(const Ray& r) const { return {inverse.point(r.o), inverse.vector(r.d)}; }
+    // Before the object is tested: the directions across the ray in its space handed on.
+    void hand_across() const {
+        set_across_ray_in_object(inverse, identity, similar, widest_footprint);
+    }
+};
+
 // The object-space ray for objects tested outside Embree, with the directions across it.
-Ray object_ray(const AccelObject& o, bool similar, const Ray& r) {
-    set_across_ray_in_object(*o.xf, similar, o.widest_footprint);
-    return o.xf->is_identity() ? r : o.xf->inverse_ray(r);
+Ray object_ray(const Placed& o, const Ray& r) {
+    o.hand_across();
+    return o.identity ? r : o.local_ray(r);
 }
 
 // Partial crossings in ray order, ties by object: the same for any traversal order.
@@ -199,25 +225,20 @@ std::uint32_t morton_code(Vec3 p, const Bounds3& within) {
     return code;
 }
 
-// The indices of the points along a Morton curve through their bounding box.
+// The indices of the points along a Morton curve through their bounding box; points that are
+// not finite last.
 std::vector<std::uint32_t> space_order(std::span<const Vec3> points) {
     Bounds3 all;
-    for (const Vec3& p : points) all = merge(all, p);
+    for (const Vec3& p : points)
+        if (is_finite(p)) all = merge(all, p);
     std::vector<std::pair<std::uint32_t, std::uint32_t>> keys(points.size());
-    for (std::uint32_t i = 0; i < points.size(); ++i) keys[i] = {morton_code(points[i], all), i};
+    for (std::uint32_t i = 0; i < points.size(); ++i)
+        keys[i] = {is_finite(points[i]) ? morton_code(points[i], all) : ~0u, i};
     std::sort(keys.begin(), keys.end());
     std::vector<std::uint32_t> order;
     order.reserve(keys.size());
     for (const auto& key : keys) order.push_back(key.second);
     return order;
-}
-
-template <class T>
-std::vector<T> permuted(const std::vector<T>& v, std::span<const std::uint32_t> order) {
-    std::vector<T> out;
-    out.reserve(v.size());
-    for (const std::uint32_t i : order) out.push_back(v[i]);
-    return out;
 }
 
 // Embree's closest-hit traversal; the callbacks record what they find in ctx.
@@ -260,13 +281,37 @@ void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax) {
 struct EmbreeAccel::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
-    std::vector<AccelObject> objects;
-    std::vector<bool> similar;  // per object: keeps_directions_across
-    // Per object: placed as direct primitives (one Embree primitive per cull part, whose
-    // callbacks test the whole shape), so that a shadow ray leaving it can test it after the
-    // traversal instead (test_self_last). Culling is conservative, so the test unculled
-    // answers as the callbacks' would.
-    std::vector<bool> direct_object;
+    std::vector<Placed> objects;  // in the accelerator's order (Placed)
+    std::vector<std::uint32_t> numbered;  // an object's index given -> its index in objects
+    // A crossing as the caller numbers objects.
+    AccelHit given(double t, std::uint32_t obj, const Crossing& c) const {
+        return {t, objects[obj].original, c};
+    }
+    // The object a ray leaves, as the caller numbers it, in the accelerator's numbering.
+    std::uint32_t own_number(std::uint32_t given_self) const {
+        return given_self < numbered.size() ? numbered[given_self] : EmbreeAccel::kNoObject;
+    }
+    // objects, in the order of a Morton curve through the centres of their world boxes
+    // (returned in bounds, in that order); empty and unbounded ones last.
+    void number_objects(std::span<const AccelObject> given_objects, std::vector<Bounds3>& bounds) {
+        std::vector<Bounds3> given_bounds;
+        std::vector<Vec3> centres;
+        for (const AccelObject& o : given_objects) {
+            given_bounds.push_back(o.shape->placed_bounds(*o.xf));
+            const Bounds3& b = given_bounds.back();
+            const bool held = embree_can_hold(b) && !b.empty();
+            centres.push_back(held ? b.center() : Vec3{kInfinity, 0, 0});
+        }
+        const std::vector<std::uint32_t> order = space_order(centres);
+        numbered.resize(given_objects.size());
+        for (const std::uint32_t i : order) {
+            const AccelObject& o = given_objects[i];
+            numbered[i] = static_cast<std::uint32_t>(objects.size());
+            objects.push_back({o.shape, o.xf, o.xf->inverse_map(), o.widest_footprint, i,
+                               o.xf->is_identity(), keeps_directions_across(*o.xf)});
+            bounds.push_back(given_bounds[i]);
+        }
+    }
     // The top-level user geometry of single-part objects: one primitive per cull part
     // (Shape::cull_count).
     // Read on every callback, so kept small: 36 bytes, the bounds (read only while Embree
@@ -280,24 +325,7 @@ struct EmbreeAccel::Impl {
     };
     static_assert(sizeof(DirectPrim) == 36);
     static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
-                                  const AccelObject& o);
-    // The direct and flat primitives in the order of a space-filling curve through their
-    // boxes' centres. Embree names a primitive by its index, and a ray's callbacks are for
-    // primitives near each other: neighbours in space then share cache lines (scattered objects
-    // come in random order; grass 4 % faster).
-    void sort_in_space() {
-        std::vector<Vec3> centres;
-        for (const Bounds3& b : direct_bounds) centres.push_back(b.center());
-        const std::vector<std::uint32_t> d = space_order(centres);
-        direct = permuted(direct, d);
-        direct_bounds = permuted(direct_bounds, d);
-        centres.clear();
-        for (const FlatPrim& f : flat) {
-            const AccelObject& o = objects[f.object];
-            centres.push_back(o.shape->primitive_bounds(f.part, *o.xf).center());
-        }
-        flat = permuted(flat, space_order(centres));
-    }
+                                  const Placed& o);
     std::vector<DirectPrim> direct;
     std::vector<Bounds3> direct_bounds;  // world space, per direct primitive
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
@@ -331,7 +359,7 @@ struct EmbreeAccel::Impl {
     const Ray& local_ray(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->cached_obj != obj) {
             ctx->cached_obj = obj;
-            ctx->cached_local = objects[obj].xf->inverse_ray(ctx->ray);
+            ctx->cached_local = objects[obj].local_ray(ctx->ray);
         }
         return ctx->cached_local;
     }
@@ -341,7 +369,7 @@ struct EmbreeAccel::Impl {
     void hand_across(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->across_obj == obj) return;
         ctx->across_obj = obj;
-        set_across_ray_in_object(*objects[obj].xf, similar[obj], objects[obj].widest_footprint);
+        objects[obj].hand_across();
     }
 
     // Whether a direct primitive's object is to be tested: it was not tested already for this
@@ -365,7 +393,7 @@ struct EmbreeAccel::Impl {
                 unsigned geom, unsigned prim, unsigned inst) const {
         assert(ctx->hit);  // closest-hit queries only (plain occlusion queries have none)
         ctx->found = true;
-        *ctx->hit = {c.t, obj, c};
+        *ctx->hit = given(c.t, obj, c);
         rh->ray.tfar = float_above(c.t);
         rh->hit.geomID = geom;
         rh->hit.primID = prim;
@@ -416,7 +444,7 @@ struct EmbreeAccel::Impl {
         auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
         // Partial crossings are kept, and the ray goes on.
         if (ctx->partial && c.coverage < 1.0f) {
-            ctx->add_camera_partial({c.t, t.object, c}, rh->ray.tfar);
+            ctx->add_camera_partial(self->given(c.t, t.object, c), rh->ray.tfar);
             return;
         }
         self->record(ctx, rh, t.object, c, args->geomID, args->primID,
@@ -436,8 +464,8 @@ struct EmbreeAccel::Impl {
                              ? shape.intersect(local, tmin, ctx->tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, ctx->tmax, c);
         if (!hit) return false;
-        if (c.coverage < 1.0f && !ctx->add_shadow_partial({c.t, t.object, c})) return false;
-        *ctx->hit = {c.t, t.object, c};
+        if (c.coverage < 1.0f && !ctx->add_shadow_partial(given(c.t, t.object, c))) return false;
+        *ctx->hit = given(c.t, t.object, c);
         return true;
     }
 
@@ -447,9 +475,9 @@ struct EmbreeAccel::Impl {
     // the shadow rays' sheet tests were of their own object, 1.2 % of them blocking.) Only a
     // direct object's: the direct callbacks are the ones that skip it.
     void test_self_last(QueryContext& ctx) const {
-        if (ctx.found || ctx.self >= objects.size() || !direct_object[ctx.self]) return;
-        const AccelObject& o = objects[ctx.self];
-        const Ray local = object_ray(o, similar[ctx.self], ctx.ray);
+        if (ctx.found || ctx.self >= objects.size() || !objects[ctx.self].direct) return;
+        const Placed& o = objects[ctx.self];
+        const Ray local = object_ray(o, ctx.ray);
         const double tmin = occlusion_tmin(&ctx, ctx.self, local);
         const Target t{ctx.self, 0};
         if (ctx.stop.shadow())
@@ -488,7 +516,7 @@ struct EmbreeAccel::Impl {
     static void bounds_flat(const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
         const FlatPrim fp = self->flat[args->primID];
-        const AccelObject& o = self->objects[fp.object];
+        const Placed& o = self->objects[fp.object];
         *args->bounds_o = to_rtc_bounds(o.shape->primitive_bounds(fp.part, *o.xf));
     }
 
@@ -536,7 +564,7 @@ static void on_embree_error(void* user, RTCError, const char* str) {
 
 EmbreeAccel::Impl::DirectPrim EmbreeAccel::Impl::direct_prim(std::uint32_t object,
                                                              std::uint32_t cull, bool shared,
-                                                             const AccelObject& o) {
+                                                             const Placed& o) {
     DirectPrim d{object, cull, shared, {}};
     if (Capsule c; shared && o.shape->cull_capsule(cull, *o.xf, o.widest_footprint, c))
         d.capsule = FloatCapsule::holding(c);
@@ -546,9 +574,8 @@ EmbreeAccel::Impl::DirectPrim EmbreeAccel::Impl::direct_prim(std::uint32_t objec
 EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOptions& opt)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
-    m.objects.assign(objects.begin(), objects.end());
-    for (const AccelObject& o : m.objects) m.similar.push_back(keeps_directions_across(*o.xf));
-    m.direct_object.assign(m.objects.size(), false);
+    std::vector<Bounds3> placed_bounds;
+    m.number_objects(objects, placed_bounds);
     m.device = rtcNewDevice(nullptr);
     if (!m.device) throw std::runtime_error("Embree: cannot create a device");
     rtcSetDeviceErrorFunction(m.device, on_embree_error, &m);
@@ -556,14 +583,14 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
     rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_HIGH);
 
     std::size_t parts = 0;
-    for (const AccelObject& o : m.objects)
+    for (const Placed& o : m.objects)
         if (o.shape->primitive_count() > 1) parts += o.shape->primitive_count();
     m.flatten = opt.instancing == Instancing::kNever ||
                 (opt.instancing == Instancing::kAuto && parts <= opt.flatten_budget);
 
     for (std::uint32_t i = 0; i < m.objects.size(); ++i) {
-        const AccelObject& o = m.objects[i];
-        const Bounds3 wb = o.shape->placed_bounds(*o.xf);
+        Placed& o = m.objects[i];
+        const Bounds3& wb = placed_bounds[i];
         if (wb.empty()) continue;
         if (!embree_can_hold(wb)) {
             m.unbounded.push_back(i);
@@ -591,19 +618,22 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
                 lat::intersect(wb, o.shape->cull_bounds(0, *o.xf, o.widest_footprint));
             if (b.empty()) continue;
             m.direct.push_back(Impl::direct_prim(i, 0, false, o));
-            m.direct_object[i] = true;
+            o.direct = true;
             m.direct_bounds.push_back(b);
         } else {
             for (std::uint32_t c = 0; c < o.shape->cull_count(); ++c) {
                 const Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);
                 if (b.empty()) continue;
                 m.direct.push_back(Impl::direct_prim(i, c, true, o));
-                m.direct_object[i] = true;
+                o.direct = true;
                 m.direct_bounds.push_back(b);
             }
         }
     }
-    m.sort_in_space();
+    // Tested one after another: in the order given, as before they were numbered in space.
+    std::sort(m.unbounded.begin(), m.unbounded.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return m.objects[a].original < m.objects[b].original;
+    });
     if (!m.direct.empty())
         m.attach_user_geometry(m.scene, m.direct.size(), &m, Impl::bounds_direct,
                                Impl::intersect_cb<Impl::Kind::kDirect>,
@@ -628,12 +658,12 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
     if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax);
 
     for (const std::uint32_t i : m.unbounded) {
-        const AccelObject& o = m.objects[i];
-        const Ray local = object_ray(o, m.similar[i], r);
+        const Placed& o = m.objects[i];
+        const Ray local = object_ray(o, r);
         Crossing c;
         if (o.shape->intersect(local, tmin, ctx.found ? hit.t : tmax, c)) {
             ctx.found = true;
-            hit = {c.t, i, c};
+            hit = m.given(c.t, i, c);
         }
     }
     return ctx.found;
@@ -647,7 +677,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, &hit);
-    ctx.self = self;
+    ctx.self = m.own_number(self);
     ctx.partial = &partial;
     ctx.stop = stop;
     if (traceable && stop.shadow()) {
@@ -658,16 +688,16 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     const bool blocked = ctx.found && stop.shadow();
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;
-        const AccelObject& o = m.objects[i];
-        const Ray local = object_ray(o, m.similar[i], r);
+        const Placed& o = m.objects[i];
+        const Ray local = object_ray(o, r);
         Crossing c;
         const double t1 = ctx.found ? std::min(hit.t, ctx.tmax) : ctx.tmax;
         if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), t1, c)) continue;
         if (c.coverage < 1.0f) {
-            partial.push_back({c.t, i, c});
+            partial.push_back(m.given(c.t, i, c));
         } else {
             ctx.found = true;
-            hit = {c.t, i, c};
+            hit = m.given(c.t, i, c);
         }
     }
     // Partial crossings met before a closer opaque one was found lie behind it.
@@ -683,10 +713,10 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, nullptr);
-    ctx.self = self;
+    ctx.self = m.own_number(self);
     for (const std::uint32_t i : m.unbounded) {
-        const AccelObject& o = m.objects[i];
-        const Ray local = object_ray(o, m.similar[i], r);
+        const Placed& o = m.objects[i];
+        const Ray local = object_ray(o, r);
         if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) return true;
     }
 

@@ -22,12 +22,16 @@ const AcrossRay& across_ray() { return t_world; }
 const AcrossRay& across_ray_in_object() { return t_object; }
 void clear_across_ray_in_object() { t_object = {}; }
 void set_across_ray_in_object(const Transform& xf, bool similar, double widest) {
+    set_across_ray_in_object(xf.inverse_map(), xf.is_identity(), similar, widest);
+}
+
+void set_across_ray_in_object(const Affine& inverse, bool identity, bool similar, double widest) {
     AcrossRay& a = t_object;
     a.widest = widest;
-    a.set = t_world.set && (similar || xf.is_identity());
+    a.set = t_world.set && (similar || identity);
     if (!a.set) return;
-    a.u = xf.is_identity() ? t_world.u : xf.inverse_vector(t_world.u);
-    a.v = xf.is_identity() ? t_world.v : xf.inverse_vector(t_world.v);
+    a.u = identity ? t_world.u : inverse.vector(t_world.u);
+    a.v = identity ? t_world.v : inverse.vector(t_world.v);
 }
 
 double LayerComposite::add(double coverage, std::uint8_t sub_rays) {
