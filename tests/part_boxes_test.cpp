@@ -85,6 +85,40 @@ TEST(PartBoxes, FloatTestNeverRejectsAPartTheRayMeets) {
     EXPECT_GT(met, 20000);
 }
 
+// meets_listed answers for each listed part (one to four, in any order, repeats allowed) what
+// meets answers for it alone, in float and in the double fallback.
+TEST(PartBoxes, ListedPartsFourAtATimeAnswerAsOneAtATime) {
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(0, 1);
+    const Boxes prim = random_boxes(rng, 40, 0.3, 1.5);
+    const PartBoxes boxes(prim, prim.bounds());
+    std::uniform_int_distribution<std::uint32_t> pick(0, static_cast<std::uint32_t>(prim.parts.size() - 1));
+    int met = 0, missed = 0;
+    for (int n = 0; n < 5000; ++n) {
+        const std::uint32_t aimed = pick(rng);  // listed too, in some lane
+        const Bounds3& target = prim.parts[aimed];
+        const Vec3 p = target.lo + (target.hi - target.lo) * Vec3{u(rng), u(rng), u(rng)};
+        Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+        if (n % 7 == 0) d = {0, 0, 1};  // along an axis: the double fallback
+        const Ray r{p - d * 20.0, d};
+        const PartBoxes::Ray4 q(boxes, r);
+        const PartBoxes::Ray4::Range range = q.range(n % 2 ? 0.0 : 20 * u(rng), n % 3 ? kInfinity : 25.0);
+        std::uint32_t parts[4];
+        const std::size_t count = 1 + static_cast<std::size_t>(n % 4);
+        for (std::size_t j = 0; j < count; ++j) parts[j] = pick(rng);
+        parts[static_cast<std::size_t>(n / 4) % count] = aimed;
+        const unsigned mask = q.meets_listed(parts, count, range);
+        EXPECT_EQ(mask >> count, 0u) << "ray " << n;
+        for (std::size_t j = 0; j < count; ++j) {
+            const bool alone = q.meets(parts[j], range);
+            ASSERT_EQ((mask >> j & 1u) != 0, alone) << "ray " << n << " lane " << j;
+            (alone ? met : missed) += 1;
+        }
+    }
+    EXPECT_GT(met, 1000);
+    EXPECT_GT(missed, 1000);
+}
+
 // near_parts keeps every part that a ray parallel to r, shifted by up to g along each axis (the
 // box grown by g), meets after tmin: the sub-rays of a filtered lattice's exact blend.
 TEST(PartBoxes, NearPartsKeepEveryPartAParallelRayWithinGrowMeets) {

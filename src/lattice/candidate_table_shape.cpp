@@ -24,7 +24,7 @@ bool CandidateTableShape::candidates(const Ray& r, CandidateList& list,
 bool CandidateTableShape::listed_spans(const Ray& r, const CandidateList& list,
                                        const LatticeFrame::Snap& s, SpanList& out) const {
     const std::size_t first = out.size();
-    primitive_->pieces_spans({list.parts, static_cast<std::size_t>(list.count)}, r, out);
+    primitive_->pieces_spans(list.span(), r, out);
     if (out.size() == first) return true;  // no spans: no chord to keep them in
     LatticeFrame::Chord c;
     if (!frame_.chord(s.o, s.d, c)) return false;
@@ -46,7 +46,7 @@ bool CandidateTableShape::intersect(const Ray& r, double tmin, double tmax, Cros
     LatticeFrame::Snap s;
     if (!candidates(r, list, s)) return false;
     if (!union_) return tree_crossing(r, list, s, tmin, tmax, hit);
-    return boxes_.first_crossing(*primitive_, {list.parts, static_cast<std::size_t>(list.count)},
+    return boxes_.first_crossing(*primitive_, list.span(),
                                  r, tmin, tmax, hit);
 }
 
@@ -60,12 +60,9 @@ bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const
     }
     const PartBoxes::Ray4 slabs(boxes_, r);
     const PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);
-    for (int k = 0; k < list.count; ++k) {
-        const std::uint32_t part = list.parts[k];
-        if (slabs.meets(part, range) && primitive_->occluded_primitive(part, r, tmin, tmax))
-            return true;
-    }
-    return false;
+    return slabs.any_listed(list.span(), range, [&](std::uint32_t part) {
+        return primitive_->occluded_primitive(part, r, tmin, tmax);
+    });
 }
 
 void CandidateTableShape::spans(const Ray& r, SpanList& out) const {
@@ -82,8 +79,10 @@ void CandidateTableShape::spans(const Ray& r, SpanList& out) const {
     }
     const PartBoxes::Ray4 slabs(boxes_, r);
     const PartBoxes::Ray4::Range range = slabs.range(-kInfinity, kInfinity);
-    for (int k = 0; k < list.count; ++k)
-        if (slabs.meets(list.parts[k], range)) primitive_->primitive_spans(list.parts[k], r, out);
+    slabs.any_listed(list.span(), range, [&](std::uint32_t part) {
+        primitive_->primitive_spans(part, r, out);
+        return false;
+    });
     merge_span_union(out, first);  // the union of the candidate parts' spans
 }
 

@@ -53,14 +53,16 @@ bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint
     const Ray4 slabs(*this, r);
     Ray4::Range range = slabs.range(tmin, tmax);
     bool found = false;
-    for (const std::uint32_t part : parts) {
-        if (!slabs.meets(part, range)) continue;
+    slabs.any_listed(parts, range, [&](std::uint32_t part) {
+        // A part met before a crossing of its four narrowed the range: tested again.
+        if (found && !slabs.meets(part, range)) return false;
         if (primitive.intersect_primitive(part, r, tmin, tmax, hit)) {
             tmax = hit.t;
             range = slabs.range(tmin, tmax);
             found = true;
         }
-    }
+        return false;
+    });
     return found;
 }
 
@@ -86,6 +88,41 @@ std::size_t PartBoxes::near_parts(const Ray& r, double grow, double tmin,
             out[n++] = static_cast<std::uint32_t>(4 * k + std::countr_zero(m));
     }
     return n;
+}
+
+// Lane j: the test meets_float runs on parts[j]'s box, axis by axis in the lanes (a maximum or
+// minimum rounds nothing, so the order they are taken in changes no answer).
+unsigned PartBoxes::Ray4::meets_listed(const std::uint32_t* parts, std::size_t n,
+                                       const Range& r) const {
+    assert(n >= 1 && n <= 4);
+    if (!use_float_) {
+        unsigned m = 0;
+        for (std::size_t j = 0; j < n; ++j) m |= static_cast<unsigned>(meets(parts[j], r)) << j;
+        return m;
+    }
+    const Box4* f = boxes_.f_.data();
+    // Lanes past n repeat the last part; they are masked off.
+    const Box4& b0 = f[parts[0]];
+    const Box4& b1 = f[parts[std::min<std::size_t>(1, n - 1)]];
+    const Box4& b2 = f[parts[std::min<std::size_t>(2, n - 1)]];
+    const Box4& b3 = f[parts[n - 1]];
+    __m128 lx = _mm_load_ps(b0.lo), ly = _mm_load_ps(b1.lo), lz = _mm_load_ps(b2.lo),
+           lw = _mm_load_ps(b3.lo);
+    __m128 hx = _mm_load_ps(b0.hi), hy = _mm_load_ps(b1.hi), hz = _mm_load_ps(b2.hi),
+           hw = _mm_load_ps(b3.hi);
+    _MM_TRANSPOSE4_PS(lx, ly, lz, lw);  // lx: the four boxes' low x, ly: y, lz: z
+    _MM_TRANSPOSE4_PS(hx, hy, hz, hw);
+    const __m128 lo[3] = {lx, ly, lz}, hi[3] = {hx, hy, hz};
+    __m128 tn = _mm_set1_ps(-INFINITY), tf = _mm_set1_ps(INFINITY);
+    for (std::size_t a = 0; a < 3; ++a) {
+        const __m128 o = _mm_set1_ps(o_[a]), inv = _mm_set1_ps(inv_[a]);
+        const __m128 t0 = _mm_mul_ps(_mm_sub_ps(lo[a], o), inv);
+        const __m128 t1 = _mm_mul_ps(_mm_sub_ps(hi[a], o), inv);
+        tn = _mm_max_ps(tn, _mm_min_ps(t0, t1));
+        tf = _mm_min_ps(tf, _mm_max_ps(t0, t1));
+    }
+    const __m128 lo_t = _mm_max_ps(tn, _mm_set1_ps(r.lo)), hi_t = _mm_min_ps(tf, _mm_set1_ps(r.hi));
+    return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(lo_t, hi_t))) & ((1u << n) - 1);
 }
 
 // In float, lo - g rounds by at most 2^-24 (D + g) (coordinates relative to the box centre are

@@ -15,6 +15,7 @@
 // component too small for a float reciprocal take the same test in double.
 #include <immintrin.h>
 
+#include <bit>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -54,6 +55,22 @@ public:
         // Whether the ray's line meets part i's box at some t in the range.
         bool meets(std::uint32_t i, const Range& r) const {
             return use_float_ ? meets_float(boxes_.f_[i], r) : meets_double(boxes_.exact_[i], r);
+        }
+        // The same for the listed parts parts[0] to parts[n - 1] (n from 1 to 4) at once: bit
+        // j for parts[j]. Candidate lists run to a hundred parts (a tuft of 10,000 strands'
+        // segments), of which a ray meets about one.
+        unsigned meets_listed(const std::uint32_t* parts, std::size_t n, const Range& r) const;
+        // Calls f(part) for each listed part whose box the ray meets within r, in list order,
+        // until f returns true; returns whether it did. r is read before each four parts, so f
+        // may narrow it (the parts of a four already met are handed over all the same).
+        template <class F>
+        bool any_listed(std::span<const std::uint32_t> parts, const Range& r, F&& f) const {
+            for (std::size_t k = 0; k < parts.size(); k += 4) {
+                const std::size_t n = parts.size() - k < 4 ? parts.size() - k : 4;
+                for (unsigned m = meets_listed(&parts[k], n, r); m != 0; m &= m - 1)
+                    if (f(parts[k + static_cast<std::size_t>(std::countr_zero(m))])) return true;
+            }
+            return false;
         }
         // A growth of every box by g on every side, prepared once for meets_grown.
         struct Grow {

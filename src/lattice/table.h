@@ -84,6 +84,7 @@ inline std::string sigma_inv_error(long long k) {
 struct CandidateList {
     int count = 0;
     const std::uint32_t* parts = nullptr;
+    std::span<const std::uint32_t> span() const { return {parts, static_cast<std::size_t>(count)}; }
 };
 
 // A prefiltered table's answer for a pair (issue 10, lattice/coverage.h): the share of the rays
