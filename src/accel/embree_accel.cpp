@@ -283,16 +283,16 @@ struct EmbreeAccel::Impl {
     RTCScene scene = nullptr;
     std::vector<Placed> objects;  // in the accelerator's order (Placed)
     std::vector<std::uint32_t> numbered;  // an object's index given -> its index in objects
-    // A crossing as the caller numbers objects.
-    AccelHit given(double t, std::uint32_t obj, const Crossing& c) const {
+    // A crossing of objects[obj], under the number the caller gave the object.
+    AccelHit caller_hit(double t, std::uint32_t obj, const Crossing& c) const {
         return {t, objects[obj].original, c};
     }
-    // The object a ray leaves, as the caller numbers it, in the accelerator's numbering.
-    std::uint32_t own_number(std::uint32_t given_self) const {
+    // The index in objects of the object the caller numbers given_self (kNoObject: none).
+    std::uint32_t our_number(std::uint32_t given_self) const {
         return given_self < numbered.size() ? numbered[given_self] : EmbreeAccel::kNoObject;
     }
-    // objects, in the order of a Morton curve through the centres of their world boxes
-    // (returned in bounds, in that order); empty and unbounded ones last.
+    // Fills objects with the objects given, in the order of a Morton curve through the centres
+    // of their world boxes (empty and unbounded ones last), and bounds with those boxes.
     void number_objects(std::span<const AccelObject> given_objects, std::vector<Bounds3>& bounds) {
         std::vector<Bounds3> given_bounds;
         std::vector<Vec3> centres;
@@ -393,7 +393,7 @@ struct EmbreeAccel::Impl {
                 unsigned geom, unsigned prim, unsigned inst) const {
         assert(ctx->hit);  // closest-hit queries only (plain occlusion queries have none)
         ctx->found = true;
-        *ctx->hit = given(c.t, obj, c);
+        *ctx->hit = caller_hit(c.t, obj, c);
         rh->ray.tfar = float_above(c.t);
         rh->hit.geomID = geom;
         rh->hit.primID = prim;
@@ -444,7 +444,7 @@ struct EmbreeAccel::Impl {
         auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
         // Partial crossings are kept, and the ray goes on.
         if (ctx->partial && c.coverage < 1.0f) {
-            ctx->add_camera_partial(self->given(c.t, t.object, c), rh->ray.tfar);
+            ctx->add_camera_partial(self->caller_hit(c.t, t.object, c), rh->ray.tfar);
             return;
         }
         self->record(ctx, rh, t.object, c, args->geomID, args->primID,
@@ -464,8 +464,8 @@ struct EmbreeAccel::Impl {
                              ? shape.intersect(local, tmin, ctx->tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, ctx->tmax, c);
         if (!hit) return false;
-        if (c.coverage < 1.0f && !ctx->add_shadow_partial(given(c.t, t.object, c))) return false;
-        *ctx->hit = given(c.t, t.object, c);
+        if (c.coverage < 1.0f && !ctx->add_shadow_partial(caller_hit(c.t, t.object, c))) return false;
+        *ctx->hit = caller_hit(c.t, t.object, c);
         return true;
     }
 
@@ -663,7 +663,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
         Crossing c;
         if (o.shape->intersect(local, tmin, ctx.found ? hit.t : tmax, c)) {
             ctx.found = true;
-            hit = m.given(c.t, i, c);
+            hit = m.caller_hit(c.t, i, c);
         }
     }
     return ctx.found;
@@ -677,7 +677,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, &hit);
-    ctx.self = m.own_number(self);
+    ctx.self = m.our_number(self);
     ctx.partial = &partial;
     ctx.stop = stop;
     if (traceable && stop.shadow()) {
@@ -694,10 +694,10 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
         const double t1 = ctx.found ? std::min(hit.t, ctx.tmax) : ctx.tmax;
         if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), t1, c)) continue;
         if (c.coverage < 1.0f) {
-            partial.push_back(m.given(c.t, i, c));
+            partial.push_back(m.caller_hit(c.t, i, c));
         } else {
             ctx.found = true;
-            hit = m.given(c.t, i, c);
+            hit = m.caller_hit(c.t, i, c);
         }
     }
     // Partial crossings met before a closer opaque one was found lie behind it.
@@ -713,7 +713,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, nullptr);
-    ctx.self = m.own_number(self);
+    ctx.self = m.our_number(self);
     for (const std::uint32_t i : m.unbounded) {
         const Placed& o = m.objects[i];
         const Ray local = object_ray(o, r);

@@ -26,11 +26,12 @@ double shadow_width(const Ray& ray, const SurfaceHit& hit, const Ray& shadow, do
 // of detail for its shadow rays, narrowing to the point light.
 Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, double width,
                  ShadeCounters& counters) {
-    return shade_with(rs, ray, hit, counters, [&](const Ray& r, double tmin, double tmax, double dist) {
+    const auto visible = [&](std::size_t, const Ray& r, double tmin, double tmax, double dist) {
         const double w = shadow_width(ray, hit, r, width);
         set_ray_footprint({w, -w / dist, true});
         return transmittance(rs, r, tmin, tmax, hit.object);
-    });
+    };
+    return shade_with(rs, ray, hit, counters, visible);
 }
 
 }  // namespace

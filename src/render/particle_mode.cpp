@@ -145,14 +145,12 @@ private:
     bool valid_ = false;
 };
 
-// Light reaching p from light i: shadow rays against the base, then the particles' map.
-double light_visibility(const Scene& s, const RenderScene& base, const std::vector<ShadowMap>& maps,
-                        std::size_t i, Vec3 p, Vec3 l, double dist, std::uint32_t self,
-                        ShadeCounters& counters) {
-    if (!s.shadows) return 1.0;
-    ++counters.shadow_rays;
-    if (base.occluded({p, l}, shadow_epsilon(p), dist * (1 - 1e-12), self)) return 0.0;
-    return maps[i].visibility(p);
+// Light i reaching the start of shadow ray r (for_each_light's visible): the ray against the
+// base, then the particles' map.
+double light_visibility(const RenderScene& base, const std::vector<ShadowMap>& maps, std::size_t i,
+                        const Ray& r, double tmin, double tmax, std::uint32_t self) {
+    if (base.occluded(r, tmin, tmax, self)) return 0.0;
+    return maps[i].visibility(r.o);
 }
 
 // Kajiya-Kay (1989): diffuse by the sine between tangent and light, specular by the sine
@@ -167,36 +165,34 @@ Vec3 shade_particle(const Scene& s, const RenderScene& base, const std::vector<S
     // A point particle has no tangent: take the one across the view, which shades as a disc.
     const Vec3 t = length_squared(axis) > 0 ? normalize(axis) : normalize(cross(view, Vec3{0, 0, 1}) + Vec3{1e-9, 0, 0});
     Vec3 c = m.ka * m.color * s.ambient;
-    for (std::size_t i = 0; i < s.lights.size(); ++i) {
-        const Vec3 to_light = s.lights[i].position - mid;
-        const double dist = length(to_light);
-        if (dist == 0) continue;
-        const Vec3 l = to_light / dist;
-        const double vis = light_visibility(s, base, maps, i, mid, l, dist, EmbreeAccel::kNoObject, counters);
-        if (vis == 0) continue;
+    // The light's intensity and what the strand reflects of it, apart: the share that arrives
+    // scales the intensity first.
+    struct Term {
+        Vec3 intensity, reflected;
+        bool operator==(const Term&) const = default;
+    };
+    const auto term = [&](const PointLight& light, Vec3 l) {
         const double tl = dot(t, l), th = dot(t, normalize(l + view));
         const double diffuse = m.kd * std::sqrt(std::max(0.0, 1 - tl * tl));
         const double spec = m.ks * std::pow(std::sqrt(std::max(0.0, 1 - th * th)), m.shininess);
-        c += vis * s.lights[i].intensity * (diffuse * m.color + Vec3{spec, spec, spec});
-    }
+        const Vec3 reflected = diffuse * m.color + Vec3{spec, spec, spec};
+        return reflected == Vec3{} ? Term{} : Term{light.intensity, reflected};
+    };
+    const auto visible = [&](std::size_t i, const Ray& r, double tmin, double tmax, double) {
+        return light_visibility(base, maps, i, r, tmin, tmax, EmbreeAccel::kNoObject);
+    };
+    const auto lit = [&](const Term& k, double seen) { c += seen * k.intensity * k.reflected; };
+    for_each_light(base, mid, counters, term, visible, lit);
     return c;
 }
 
-Vec3 shade_base(const Scene& s, const RenderScene& base, const std::vector<ShadowMap>& maps,
-                const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters) {
-    const Material& m = s.materials[hit.material];
-    const Vec3 v = normalize(-ray.d);
-    const Vec3 n = dot(hit.n, v) < 0 ? -hit.n : hit.n;
-    Vec3 c = m.ka * m.color * s.ambient;
-    for (std::size_t i = 0; i < s.lights.size(); ++i) {
-        const Vec3 to_light = s.lights[i].position - hit.p;
-        const double dist = length(to_light);
-        if (dist == 0) continue;
-        const Vec3 l = to_light / dist;
-        const double vis = light_visibility(s, base, maps, i, hit.p, l, dist, hit.object, counters);
-        if (vis > 0) c += vis * phong_term(m, m.color, n, l, v, s.lights[i].intensity);
-    }
-    return c;
+// Phong, as exact mode shades; the particles' shadows from their maps.
+Vec3 shade_base(const RenderScene& base, const std::vector<ShadowMap>& maps, const Ray& ray,
+                const SurfaceHit& hit, ShadeCounters& counters) {
+    const auto visible = [&](std::size_t i, const Ray& r, double tmin, double tmax, double) {
+        return light_visibility(base, maps, i, r, tmin, tmax, hit.object);
+    };
+    return shade_with(base, ray, hit, counters, visible);
 }
 
 }  // namespace
@@ -306,7 +302,7 @@ RenderOutput render_particles(const Scene& scene, const ParticleSet& set, const 
                     const std::size_t k = static_cast<std::size_t>(sy) * sw + sx;
                     if (base.intersect(ray, 0.0, kInfinity, hit)) {
                         depth[k] = hit.t * dot(ray.d, view.w);
-                        rgb[k] = shade_base(scene, base, maps, ray, hit, counters);
+                        rgb[k] = shade_base(base, maps, ray, hit, counters);
                     }
                 }
             primary.fetch_add(static_cast<std::uint64_t>(sw) * th * ny, std::memory_order_relaxed);

@@ -67,21 +67,22 @@ double shadow_epsilon(Vec3 p);
 
 // The lights that reach p, each with its shadow ray cast (when the scene has shadows):
 // term(light, unit direction to it) is the light's contribution unshadowed, a value that
-// compares equal to its default (zero) when the light adds nothing; visible(shadow ray, tmin,
-// tmax, distance) gives the share of the light that arrives, and lit(term, share) is called
-// when that is above 0. A light whose term is zero casts no shadow ray: shadowed or not, it
+// compares equal to its default (zero) when the light adds nothing; visible(light's index,
+// shadow ray, tmin, tmax, distance) gives the share of the light that arrives, and lit(term,
+// share) is called when that is above 0. A light whose term is zero casts no shadow ray: shadowed or not, it
 // adds nothing, and the image is the same. With a unit normal that is a surface turned from
 // the light, N.L and R.V both at most 0 (6 to 9 % of the shadow rays of the ball scenes and
 // grass); a prefiltered lattice's mean normal spreads its diffuse term past the terminator,
-// so its layers rarely skip one. The one home of the ray-traced light loop: shade(), layered
-// shading and the texture mode's baked surfaces go through it (particle mode, which reads
-// shadow maps per light, has its own).
+// so its layers rarely skip one. The one home of the light loop: shade(), layered shading, the
+// texture mode's baked surfaces and particle mode (whose visibility reads a shadow map per
+// light) go through it.
 template <class Term, class Visible, class Lit>
 void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Term&& term,
                     Visible&& visible, Lit&& lit) {
     const Scene& s = rs.scene();
     const double eps = shadow_epsilon(p);
-    for (const PointLight& light : s.lights) {
+    for (std::size_t i = 0; i < s.lights.size(); ++i) {
+        const PointLight& light = s.lights[i];
         const Vec3 to_light = light.position - p;
         const double dist = length(to_light);
         if (dist == 0) continue;
@@ -91,16 +92,16 @@ void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Term
         double seen = 1;
         if (s.shadows) {
             ++counters.shadow_rays;
-            seen = visible(Ray{p, l}, eps, dist * (1 - 1e-12), dist);
+            seen = visible(i, Ray{p, l}, eps, dist * (1 - 1e-12), dist);
             if (seen <= 0) continue;
         }
         lit(unshadowed, seen);
     }
 }
 
-// Phong with shadows; visible(shadow ray, tmin, tmax, distance) is the share of the light that
-// arrives: 0 or 1 for shade(), a transmittance through partial hits for layered rays
-// (render/layers.h).
+// Phong with shadows; visible(light's index, shadow ray, tmin, tmax, distance) is the share of
+// the light that arrives: 0 or 1 for shade(), a transmittance through partial hits for layered
+// rays (render/layers.h), a shadow map's for particle mode's base.
 template <class Visible>
 Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters,
                 Visible&& visible) {
