@@ -82,6 +82,8 @@ bool in_ray_order(const AccelHit& a, const AccelHit& b) {
 
 // Per-query state. Embree hands our callbacks the RTCIntersectContext; ours extends it with
 // the double-precision ray and the best hit so far (the documented way to pass query data).
+// Objects go by two numbers: the accelerator's (an index into Impl::objects: self, the cache
+// and the ring of tested objects) and the caller's (AccelHit::object: hit, partial).
 struct QueryContext {
     // h: where the closest hit goes (for a shadow ray's transmittance, what blocked it); null
     // for plain occlusion, which needs none.
@@ -100,15 +102,16 @@ struct QueryContext {
     double tmin, tmax;
     AccelHit* hit;
     bool found = false;
-    std::uint32_t self = EmbreeAccel::kNoObject;  // occlusion: the object the ray leaves
+    // Occlusion: the object the ray leaves (the accelerator's number).
+    std::uint32_t self = EmbreeAccel::kNoObject;
     // intersect_layers: where crossings of partial coverage go (they do not end the ray), how
     // far to look, and for shadow rays what they let through (LayerComposite, which does not
     // depend on the order they are met in).
     std::vector<AccelHit>* partial = nullptr;
     LayerStop stop;
     LayerComposite transmitted;
-    // An object answers a ray with one sheet; met again (it fell out of the ring of tested
-    // objects), it is not counted twice.
+    // An object (the caller's number) answers a ray with one sheet; met again (it fell out of
+    // the ring of tested objects), it is not counted twice.
     bool met_already(std::uint32_t object) const {
         for (const AccelHit& p : *partial)
             if (p.object == object) return true;
@@ -464,8 +467,9 @@ struct EmbreeAccel::Impl {
                              ? shape.intersect(local, tmin, ctx->tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, ctx->tmax, c);
         if (!hit) return false;
-        if (c.coverage < 1.0f && !ctx->add_shadow_partial(caller_hit(c.t, t.object, c))) return false;
-        *ctx->hit = caller_hit(c.t, t.object, c);
+        const AccelHit h = caller_hit(c.t, t.object, c);
+        if (c.coverage < 1.0f && !ctx->add_shadow_partial(h)) return false;
+        *ctx->hit = h;
         return true;
     }
 

@@ -90,8 +90,7 @@ std::size_t PartBoxes::near_parts(const Ray& r, double grow, double tmin,
     return n;
 }
 
-// Lane j: the test meets_float runs on parts[j]'s box, axis by axis in the lanes (a maximum or
-// minimum rounds nothing, so the order they are taken in changes no answer).
+// Lane j: the test meets_float runs on parts[j]'s box (meets4).
 unsigned PartBoxes::Ray4::meets_listed(const std::uint32_t* parts, std::size_t n,
                                        const Range& r) const {
     assert(n >= 1 && n <= 4);
@@ -113,16 +112,26 @@ unsigned PartBoxes::Ray4::meets_listed(const std::uint32_t* parts, std::size_t n
     _MM_TRANSPOSE4_PS(lx, ly, lz, lw);  // lx: the four boxes' low x, ly: y, lz: z
     _MM_TRANSPOSE4_PS(hx, hy, hz, hw);
     const __m128 lo[3] = {lx, ly, lz}, hi[3] = {hx, hy, hz};
-    __m128 tn = _mm_set1_ps(-INFINITY), tf = _mm_set1_ps(INFINITY);
+    return meets4(lo, hi, r) & ((1u << n) - 1);
+}
+
+// Lane j: meets_float's test of box j, operation for operation: the slabs' entries and exits
+// combined in its order (max(max(x, y), max(z, -inf)), which matters for a NaN).
+unsigned PartBoxes::Ray4::meets4(const __m128 lo[3], const __m128 hi[3], const Range& r) const {
+    __m128 entry[3], exit[3];
     for (std::size_t a = 0; a < 3; ++a) {
         const __m128 o = _mm_set1_ps(o_[a]), inv = _mm_set1_ps(inv_[a]);
         const __m128 t0 = _mm_mul_ps(_mm_sub_ps(lo[a], o), inv);
         const __m128 t1 = _mm_mul_ps(_mm_sub_ps(hi[a], o), inv);
-        tn = _mm_max_ps(tn, _mm_min_ps(t0, t1));
-        tf = _mm_min_ps(tf, _mm_max_ps(t0, t1));
+        entry[a] = _mm_min_ps(t0, t1);
+        exit[a] = _mm_max_ps(t0, t1);
     }
+    const __m128 tn = _mm_max_ps(_mm_max_ps(entry[0], entry[1]),
+                                 _mm_max_ps(entry[2], _mm_set1_ps(-INFINITY)));
+    const __m128 tf = _mm_min_ps(_mm_min_ps(exit[0], exit[1]),
+                                 _mm_min_ps(exit[2], _mm_set1_ps(INFINITY)));
     const __m128 lo_t = _mm_max_ps(tn, _mm_set1_ps(r.lo)), hi_t = _mm_min_ps(tf, _mm_set1_ps(r.hi));
-    return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(lo_t, hi_t))) & ((1u << n) - 1);
+    return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(lo_t, hi_t)));
 }
 
 // In float, lo - g rounds by at most 2^-24 (D + g) (coordinates relative to the box centre are
@@ -141,22 +150,17 @@ bool PartBoxes::Ray4::meets_grown(std::uint32_t i, const Range& r, const Grow& g
     return meets_float(grown, r);
 }
 
-// Lane j: part 4 k + j's test as meets_float runs it on one box, operation for operation (its
-// neutral fourth lane, (-inf, inf), changes no maximum or minimum).
+// Lane j: part 4 k + j's grown box, tested as meets_grown tests one (meets4).
 unsigned PartBoxes::Ray4::meets_grown4(std::size_t k, const Range& r, const Grow& g) const {
     assert(use_float_);
     const BoxQuad& b = boxes_.quads_[k];
     const __m128 gf = _mm_set1_ps(g.f);
-    __m128 tn = _mm_set1_ps(-INFINITY), tf = _mm_set1_ps(INFINITY);
+    __m128 lo[3], hi[3];
     for (std::size_t a = 0; a < 3; ++a) {
-        const __m128 o = _mm_set1_ps(o_[a]), inv = _mm_set1_ps(inv_[a]);
-        const __m128 t0 = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_load_ps(b.lo[a]), gf), o), inv);
-        const __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(_mm_load_ps(b.hi[a]), gf), o), inv);
-        tn = _mm_max_ps(tn, _mm_min_ps(t0, t1));
-        tf = _mm_min_ps(tf, _mm_max_ps(t0, t1));
+        lo[a] = _mm_sub_ps(_mm_load_ps(b.lo[a]), gf);
+        hi[a] = _mm_add_ps(_mm_load_ps(b.hi[a]), gf);
     }
-    const __m128 lo = _mm_max_ps(tn, _mm_set1_ps(r.lo)), hi = _mm_min_ps(tf, _mm_set1_ps(r.hi));
-    return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(lo, hi)));
+    return meets4(lo, hi, r);
 }
 
 PartBoxes::Ray4::Ray4(const PartBoxes& boxes, const Ray& r) : boxes_(boxes), ray_(r) {

@@ -91,6 +91,9 @@ public:
         double shift_ = 0;  // the float test's t is the ray's t minus this
         alignas(16) float o_[4], inv_[4];
         bool meets_double(const Bounds3& b, const Range& r) const;
+        // Four boxes at once, given axis by axis (lane j: box j): bit j, whether the ray meets
+        // box j within r.
+        unsigned meets4(const __m128 lo[3], const __m128 hi[3], const Range& r) const;
         template <class B>
         bool meets_float(const B& b, const Range& r) const {
             const __m128 o = _mm_load_ps(o_), inv = _mm_load_ps(inv_);

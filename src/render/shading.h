@@ -69,8 +69,8 @@ double shadow_epsilon(Vec3 p);
 // term(light, unit direction to it) is the light's contribution unshadowed, a value that
 // compares equal to its default (zero) when the light adds nothing; visible(light's index,
 // shadow ray, tmin, tmax, distance) gives the share of the light that arrives, and lit(term,
-// share) is called when that is above 0. A light whose term is zero casts no shadow ray: shadowed or not, it
-// adds nothing, and the image is the same. With a unit normal that is a surface turned from
+// share) is called when that is above 0. A light whose term is zero casts no shadow ray:
+// shadowed or not, it adds nothing, and the image is the same. With a unit normal that is a surface turned from
 // the light, N.L and R.V both at most 0 (6 to 9 % of the shadow rays of the ball scenes and
 // grass); a prefiltered lattice's mean normal spreads its diffuse term past the terminator,
 // so its layers rarely skip one. The one home of the light loop: shade(), layered shading, the
