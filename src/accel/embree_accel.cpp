@@ -549,6 +549,55 @@ struct EmbreeAccel::Impl {
         rtcReleaseGeometry(g);
     }
 
+    // Object i, whose world box is wb: tested outside Embree (unbounded), its parts placed
+    // flat, an Embree instance of its prototype, or one direct primitive per cull part.
+    void place(std::uint32_t i, const Bounds3& wb) {
+        Placed& o = objects[i];
+        if (wb.empty()) return;
+        if (!embree_can_hold(wb)) {
+            unbounded.push_back(i);
+        } else if (o.shape->primitive_count() > 1 && flatten) {
+            for (std::uint32_t p = 0; p < o.shape->primitive_count(); ++p) flat.push_back({i, p});
+        } else if (o.shape->primitive_count() > 1) {
+            place_instance(i);
+        } else if (o.shape->cull_count() == 1) {
+            const Bounds3 b = lat::intersect(wb, o.shape->cull_bounds(0, *o.xf, o.widest_footprint));
+            if (b.empty()) return;
+            direct.push_back(direct_prim(i, 0, false, o));
+            o.direct = true;
+            direct_bounds.push_back(b);
+        } else {
+            for (std::uint32_t c = 0; c < o.shape->cull_count(); ++c) {
+                const Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);
+                if (b.empty()) continue;
+                direct.push_back(direct_prim(i, c, true, o));
+                o.direct = true;
+                direct_bounds.push_back(b);
+            }
+        }
+    }
+
+    // Object i as an Embree instance of its shape's prototype scene.
+    void place_instance(std::uint32_t i) {
+        const Placed& o = objects[i];
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(g, prototype_scene(o.shape));
+        const Affine& a = o.xf->forward();
+        float xfm[12];
+        for (int r = 0; r < 3; ++r) {
+            for (int c = 0; c < 3; ++c)
+                xfm[r * 4 + c] = static_cast<float>(
+                    a.m.r[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)]);
+            xfm[r * 4 + 3] = static_cast<float>(a.t[static_cast<std::size_t>(r)]);
+        }
+        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xfm);
+        rtcCommitGeometry(g);
+        const unsigned id = rtcAttachGeometry(scene, g);
+        rtcReleaseGeometry(g);
+        if (inst_object.size() <= id) inst_object.resize(id + 1, 0);
+        inst_object[id] = i;
+    }
+
     RTCScene prototype_scene(const Shape* shape) {
         auto it = prototypes.find(shape);
         if (it != prototypes.end()) return it->second.scene;
@@ -592,48 +641,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
     m.flatten = opt.instancing == Instancing::kNever ||
                 (opt.instancing == Instancing::kAuto && parts <= opt.flatten_budget);
 
-    for (std::uint32_t i = 0; i < m.objects.size(); ++i) {
-        Placed& o = m.objects[i];
-        const Bounds3& wb = placed_bounds[i];
-        if (wb.empty()) continue;
-        if (!embree_can_hold(wb)) {
-            m.unbounded.push_back(i);
-        } else if (o.shape->primitive_count() > 1 && m.flatten) {
-            for (std::uint32_t p = 0; p < o.shape->primitive_count(); ++p) m.flat.push_back({i, p});
-        } else if (o.shape->primitive_count() > 1) {
-            RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_INSTANCE);
-            rtcSetGeometryInstancedScene(g, m.prototype_scene(o.shape));
-            const Affine& a = o.xf->forward();
-            float xfm[12];
-            for (int r = 0; r < 3; ++r) {
-                for (int c = 0; c < 3; ++c)
-                    xfm[r * 4 + c] = static_cast<float>(
-                        a.m.r[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)]);
-                xfm[r * 4 + 3] = static_cast<float>(a.t[static_cast<std::size_t>(r)]);
-            }
-            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xfm);
-            rtcCommitGeometry(g);
-            const unsigned id = rtcAttachGeometry(m.scene, g);
-            rtcReleaseGeometry(g);
-            if (m.inst_object.size() <= id) m.inst_object.resize(id + 1, 0);
-            m.inst_object[id] = i;
-        } else if (o.shape->cull_count() == 1) {
-            const Bounds3 b =
-                lat::intersect(wb, o.shape->cull_bounds(0, *o.xf, o.widest_footprint));
-            if (b.empty()) continue;
-            m.direct.push_back(Impl::direct_prim(i, 0, false, o));
-            o.direct = true;
-            m.direct_bounds.push_back(b);
-        } else {
-            for (std::uint32_t c = 0; c < o.shape->cull_count(); ++c) {
-                const Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);
-                if (b.empty()) continue;
-                m.direct.push_back(Impl::direct_prim(i, c, true, o));
-                o.direct = true;
-                m.direct_bounds.push_back(b);
-            }
-        }
-    }
+    for (std::uint32_t i = 0; i < m.objects.size(); ++i) m.place(i, placed_bounds[i]);
     // Tested one after another: in the order given, as before they were numbered in space.
     std::sort(m.unbounded.begin(), m.unbounded.end(), [&](std::uint32_t a, std::uint32_t b) {
         return m.objects[a].original < m.objects[b].original;
