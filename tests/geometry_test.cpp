@@ -312,3 +312,51 @@ TEST(Torus, RingSpheresHoldTheSolid) {
 
 }  // namespace
 }  // namespace lat
+
+namespace lat {
+namespace {
+
+// Poly3::along_ray unrolls its terms at compile time; it must give, bit for bit, the loop over
+// the terms it replaced (images stayed the same), and the restriction itself must be right:
+// c(t) = f(o + t d) at sample points.
+TEST(Poly3, AlongRayIsTheLoopOverTermsBitForBit) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-2, 2);
+    for (int n = 0; n < 500; ++n) {
+        Poly3 f;
+        for (double& a : f.a) a = n % 3 == 0 && u(rng) < 0 ? 0.0 : u(rng);  // some terms absent
+        const Vec3 o{u(rng), u(rng), u(rng)}, d{u(rng), u(rng), u(rng)};
+        double c[5];
+        f.along_ray(o, d, c);
+        // The loop, as it was written.
+        double px[5][5] = {}, py[5][5] = {}, pz[5][5] = {};
+        const auto powers = [](double oo, double dd, double p[5][5]) {
+            p[0][0] = 1.0;
+            for (int m = 1; m <= 4; ++m)
+                for (int k = 0; k <= m; ++k)
+                    p[m][k] = oo * p[m - 1][k] + (k > 0 ? dd * p[m - 1][k - 1] : 0.0);
+        };
+        powers(o.x, d.x, px);
+        powers(o.y, d.y, py);
+        powers(o.z, d.z, pz);
+        double want[5] = {0, 0, 0, 0, 0};
+        for (int t = 0; t < Poly3::kTerms; ++t) {
+            const double coef = f.a[static_cast<std::size_t>(t)];
+            if (coef == 0.0) continue;
+            const auto [i, j, k] = Poly3::exponents(t);
+            double xy[5] = {0, 0, 0, 0, 0};
+            for (int a = 0; a <= i; ++a)
+                for (int b = 0; b <= j; ++b) xy[a + b] += px[i][a] * py[j][b];
+            for (int ab = 0; ab <= i + j; ++ab)
+                for (int w = 0; w <= k; ++w) want[ab + w] += coef * xy[ab] * pz[k][w];
+        }
+        for (int m = 0; m < 5; ++m) ASSERT_EQ(c[m], want[m]) << "polynomial " << n << " c" << m;
+        for (const double t : {-1.5, 0.25, 2.0}) {
+            const double at = c[0] + t * (c[1] + t * (c[2] + t * (c[3] + t * c[4])));
+            EXPECT_NEAR(at, f.eval(o + d * t), 1e-9 * (1 + std::abs(at))) << n;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace lat

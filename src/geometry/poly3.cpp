@@ -3,24 +3,31 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace lat {
 namespace {
 
-// Monomials ordered by total degree, then by descending powers of x, then of y.
+// Monomials' exponents by dense index: ordered by total degree, then by descending powers of
+// x, then of y.
+constexpr std::array<std::array<int, 3>, Poly3::kTerms> kExponents = [] {
+    std::array<std::array<int, 3>, Poly3::kTerms> e{};
+    std::size_t n = 0;
+    for (int d = 0; d <= Poly3::kMaxDegree; ++d)
+        for (int i = d; i >= 0; --i)
+            for (int j = d - i; j >= 0; --j) e[n++] = {i, j, d - i - j};
+    return e;
+}();
+static_assert(kExponents.back() == std::array<int, 3>{0, 0, 4});  // every index filled
+
+// Dense index by exponents.
 struct MonomialTable {
-    std::array<std::array<int, 3>, Poly3::kTerms> exps{};
     int lookup[5][5][5]{};
     MonomialTable() {
-        int n = 0;
-        for (int d = 0; d <= Poly3::kMaxDegree; ++d)
-            for (int i = d; i >= 0; --i)
-                for (int j = d - i; j >= 0; --j) {
-                    const int k = d - i - j;
-                    exps[static_cast<std::size_t>(n)] = {i, j, k};
-                    lookup[i][j][k] = n++;
-                }
-        assert(n == Poly3::kTerms);
+        for (std::size_t n = 0; n < kExponents.size(); ++n) {
+            const auto [i, j, k] = kExponents[n];
+            lookup[i][j][k] = static_cast<int>(n);
+        }
     }
 };
 
@@ -46,7 +53,7 @@ int Poly3::index(int i, int j, int k) {
     return table().lookup[i][j][k];
 }
 
-std::array<int, 3> Poly3::exponents(int n) { return table().exps[static_cast<std::size_t>(n)]; }
+std::array<int, 3> Poly3::exponents(int n) { return kExponents[static_cast<std::size_t>(n)]; }
 
 int Poly3::degree() const {
     int deg = -1;
@@ -88,23 +95,39 @@ Vec3 Poly3::gradient(Vec3 p) const {
     return g;
 }
 
+namespace {
+
+// Term N of f(o + t d): the product of three polynomials in t of degrees i, j, k (i + j + k
+// <= 4), added to c. With the degrees known at compile time the loops unroll; the sums are
+// taken in the same order as a loop over the terms would (same bits).
+template <std::size_t N>
+void add_term(double coef, const double px[5][5], const double py[5][5], const double pz[5][5],
+              double c[5]) {
+    constexpr int i = kExponents[N][0], j = kExponents[N][1], k = kExponents[N][2];
+    if (coef == 0.0) return;
+    double xy[5] = {0, 0, 0, 0, 0};
+    for (int u = 0; u <= i; ++u)
+        for (int v = 0; v <= j; ++v) xy[u + v] += px[i][u] * py[j][v];
+    for (int uv = 0; uv <= i + j; ++uv)
+        for (int w = 0; w <= k; ++w) c[uv + w] += coef * xy[uv] * pz[k][w];
+}
+
+template <std::size_t... N>
+void add_terms(const std::array<double, Poly3::kTerms>& a, const double px[5][5],
+               const double py[5][5], const double pz[5][5], double c[5],
+               std::index_sequence<N...>) {
+    (add_term<N>(a[N], px, py, pz, c), ...);  // terms 0, 1, ... in order
+}
+
+}  // namespace
+
 void Poly3::along_ray(Vec3 o, Vec3 d, double c[5]) const {
     double px[5][5], py[5][5], pz[5][5];
     binomial_powers(o.x, d.x, px);
     binomial_powers(o.y, d.y, py);
     binomial_powers(o.z, d.z, pz);
     for (int m = 0; m < 5; ++m) c[m] = 0.0;
-    for (int n = 0; n < kTerms; ++n) {
-        const double coef = a[static_cast<std::size_t>(n)];
-        if (coef == 0.0) continue;
-        const auto [i, j, k] = exponents(n);
-        // Product of three polynomials in t of degrees i, j, k (i + j + k <= 4).
-        double xy[5] = {0, 0, 0, 0, 0};
-        for (int u = 0; u <= i; ++u)
-            for (int v = 0; v <= j; ++v) xy[u + v] += px[i][u] * py[j][v];
-        for (int uv = 0; uv <= i + j; ++uv)
-            for (int w = 0; w <= k; ++w) c[uv + w] += coef * xy[uv] * pz[k][w];
-    }
+    add_terms(a, px, py, pz, c, std::make_index_sequence<kTerms>{});
 }
 
 std::string Poly3::to_string() const {
