@@ -317,7 +317,7 @@ void expect_instances_culled_by_their_own_bound(const Shape& primitive) {
                     const Ray world{xf.point(r.o), xf.vector(r.d)};
                     const Ray local = xf.inverse_ray(world);
                     // Outside a traversal: no directions across, the instance's bound.
-                    set_across_ray_in_object(Transform{}, true, widest);
+                    set_across_ray_in_object(Affine{}, true, true, widest);
                     Crossing c;
                     const bool hit = s.intersect(local, 0.0, kInfinity, c);
                     hits += hit;
@@ -360,7 +360,8 @@ TEST(FilteredCloseUps, TheAcceleratorHandsEachInstanceItsBound) {
         bool found = false;
         for (std::uint32_t i = 0; i < 2; ++i) {
             const Transform& xf = *objects[i].xf;
-            set_across_ray_in_object(xf, true, i == 0 ? near_bound : kInfinity);
+            set_across_ray_in_object(xf.inverse_map(), xf.is_identity(), true,
+                                     i == 0 ? near_bound : kInfinity);
             Crossing c;
             if (s.intersect(xf.inverse_ray(world), 0.0, found ? out.t : kInfinity, c))
                 found = true, out = {c.t, i, c};

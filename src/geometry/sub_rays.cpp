@@ -21,10 +21,6 @@ ScopedAcrossRay::~ScopedAcrossRay() {
 const AcrossRay& across_ray() { return t_world; }
 const AcrossRay& across_ray_in_object() { return t_object; }
 void clear_across_ray_in_object() { t_object = {}; }
-void set_across_ray_in_object(const Transform& xf, bool similar, double widest) {
-    set_across_ray_in_object(xf.inverse_map(), xf.is_identity(), similar, widest);
-}
-
 void set_across_ray_in_object(const Affine& inverse, bool identity, bool similar, double widest) {
     AcrossRay& a = t_object;
     a.widest = widest;

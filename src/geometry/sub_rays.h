@@ -48,8 +48,7 @@ private:
 // object uses its own directions), and the object's widest footprint (AcrossRay::widest).
 // Written in place: a copy built on the caller's stack and handed over stalled store
 // forwarding (4 % of a candidates lattice's samples).
-void set_across_ray_in_object(const Transform& xf, bool similar, double widest);
-// The same, from xf's inverse map and whether xf is the identity.
+// inverse: xf's inverse map; identity: whether xf is the identity.
 void set_across_ray_in_object(const Affine& inverse, bool identity, bool similar, double widest);
 // After a query: no object copy, so that a shape tested directly never sees the last object's.
 void clear_across_ray_in_object();

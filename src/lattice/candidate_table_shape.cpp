@@ -46,8 +46,7 @@ bool CandidateTableShape::intersect(const Ray& r, double tmin, double tmax, Cros
     LatticeFrame::Snap s;
     if (!candidates(r, list, s)) return false;
     if (!union_) return tree_crossing(r, list, s, tmin, tmax, hit);
-    return boxes_.first_crossing(*primitive_, list.span(),
-                                 r, tmin, tmax, hit);
+    return boxes_.first_crossing(*primitive_, list.span(), r, tmin, tmax, hit);
 }
 
 bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const {

@@ -57,8 +57,8 @@ public:
             return use_float_ ? meets_float(boxes_.f_[i], r) : meets_double(boxes_.exact_[i], r);
         }
         // The same for the listed parts parts[0] to parts[n - 1] (n from 1 to 4) at once: bit
-        // j for parts[j]. Candidate lists run to a hundred parts (a tuft of 10,000 strands'
-        // segments), of which a ray meets about one.
+        // j for parts[j]. Candidate lists run to a hundred parts (a tuft of 10,000 segments),
+        // of which a ray meets about one.
         unsigned meets_listed(const std::uint32_t* parts, std::size_t n, const Range& r) const;
         // Calls f(part) for each listed part whose box the ray meets within r, in list order,
         // until f returns true; returns whether it did. r is read before each four parts, so f
