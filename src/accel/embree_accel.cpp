@@ -560,17 +560,13 @@ struct EmbreeAccel::Impl {
             for (std::uint32_t p = 0; p < o.shape->primitive_count(); ++p) flat.push_back({i, p});
         } else if (o.shape->primitive_count() > 1) {
             place_instance(i);
-        } else if (o.shape->cull_count() == 1) {
-            const Bounds3 b = lat::intersect(wb, o.shape->cull_bounds(0, *o.xf, o.widest_footprint));
-            if (b.empty()) return;
-            direct.push_back(direct_prim(i, 0, false, o));
-            o.direct = true;
-            direct_bounds.push_back(b);
         } else {
-            for (std::uint32_t c = 0; c < o.shape->cull_count(); ++c) {
-                const Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);
+            const std::size_t parts = o.shape->cull_count();
+            for (std::uint32_t c = 0; c < parts; ++c) {
+                Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);
+                if (parts == 1) b = lat::intersect(wb, b);  // a lone part: within the object's box
                 if (b.empty()) continue;
-                direct.push_back(direct_prim(i, c, true, o));
+                direct.push_back(direct_prim(i, c, parts > 1, o));
                 o.direct = true;
                 direct_bounds.push_back(b);
             }

@@ -70,12 +70,12 @@ double shadow_epsilon(Vec3 p);
 // compares equal to its default (zero) when the light adds nothing; visible(light's index,
 // shadow ray, tmin, tmax, distance) gives the share of the light that arrives, and lit(term,
 // share) is called when that is above 0. A light whose term is zero casts no shadow ray:
-// shadowed or not, it adds nothing, and the image is the same. With a unit normal that is a surface turned from
-// the light, N.L and R.V both at most 0 (6 to 9 % of the shadow rays of the ball scenes and
-// grass); a prefiltered lattice's mean normal spreads its diffuse term past the terminator,
-// so its layers rarely skip one. The one home of the light loop: shade(), layered shading, the
-// texture mode's baked surfaces and particle mode (whose visibility reads a shadow map per
-// light) go through it.
+// shadowed or not, it adds nothing, and the image is the same. With a unit normal that is a
+// surface turned from the light, N.L and R.V both at most 0 (6 to 9 % of the shadow rays of
+// the ball scenes and grass); a prefiltered lattice's mean normal spreads its diffuse term past
+// the terminator, so its layers rarely skip one. The one home of the light loop: shade(),
+// layered shading, the texture mode's baked surfaces and particle mode (whose visibility reads
+// a shadow map per light) go through it.
 template <class Term, class Visible, class Lit>
 void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Term&& term,
                     Visible&& visible, Lit&& lit) {
