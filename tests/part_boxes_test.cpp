@@ -223,5 +223,46 @@ TEST(PartBoxes, FirstCrossingOverAllPartsIsTheUnions) {
     EXPECT_GT(hits, 5000);
 }
 
+// Lists of every length, the short ones answered without boxes (kFewParts) and the long ones
+// with them, answer as a loop over the listed parts: the same crossing, bit for bit, and the
+// same occlusion.
+TEST(PartBoxes, ListsOfEveryLengthAnswerAsALoopOverTheirParts) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<ChainSphere> spheres;
+    std::vector<ChainCylinder> cylinders;
+    for (int i = 0; i < 10; ++i) {
+        spheres.push_back({{3.5 + std::sin(i * 0.9), 3.5 + std::cos(i * 0.4), 1 + 1.8 * i}, 0.35});
+        if (i > 0) cylinders.push_back({i - 1, i, 0.35});
+    }
+    const ChainShape hair(spheres, cylinders);
+    const PartBoxes boxes(hair, Bounds3{{0, 0, 0}, {7, 7, 20}});
+    int boxed_hits = 0, short_hits = 0;
+    for (int n = 0; n < 20000; ++n) {
+        std::vector<std::uint32_t> listed;
+        const std::size_t length = 1 + static_cast<std::size_t>(n) % hair.primitive_count();
+        for (std::uint32_t i = 0; i < hair.primitive_count(); ++i)
+            if (u(rng) < double(length) / double(hair.primitive_count())) listed.push_back(i);
+        if (listed.empty()) listed.push_back(static_cast<std::uint32_t>(n) % 19);
+        const ChainSphere& aim = spheres[static_cast<std::size_t>(n) % spheres.size()];
+        const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+        const Vec3 jitter = Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * 1.2;
+        const Ray r{aim.center + jitter - d * (1 + 30 * u(rng)), d * (0.1 + 3 * u(rng))};
+        const double tmin = n % 4 == 0 ? 0.5 : 0.0, tmax = n % 5 == 0 ? 3.0 : kInfinity;
+        Crossing want, got;
+        const bool w = first_crossing_of_parts(hair, listed, r, tmin, tmax, want);
+        ASSERT_EQ(w, boxes.first_crossing(hair, listed, r, tmin, tmax, got)) << "ray " << n;
+        ASSERT_EQ(any_part_occludes(hair, listed, r, tmin, tmax),
+                  boxes.any_occludes(hair, listed, r, tmin, tmax))
+            << "ray " << n;
+        if (!w) continue;
+        (listed.size() > PartBoxes::kFewParts ? boxed_hits : short_hits) += 1;
+        ASSERT_EQ(want.t, got.t) << "ray " << n;
+        ASSERT_EQ(want.part, got.part) << "ray " << n;
+    }
+    EXPECT_GT(boxed_hits, 1000);  // crossings found through the boxes
+    EXPECT_GT(short_hits, 1000);  // and without them
+}
+
 }  // namespace
 }  // namespace lat

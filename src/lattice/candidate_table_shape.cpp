@@ -57,11 +57,7 @@ bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const
         Crossing c;  // a tree's occlusion is its first crossing (CsgShape has no cheaper one)
         return tree_crossing(r, list, s, tmin, tmax, c);
     }
-    const PartBoxes::Ray4 slabs(boxes_, r);
-    const PartBoxes::Ray4::Range range = slabs.range(tmin, tmax);
-    return slabs.any_listed(list.span(), range, [&](std::uint32_t part) {
-        return primitive_->occluded_primitive(part, r, tmin, tmax);
-    });
+    return boxes_.any_occludes(*primitive_, list.span(), r, tmin, tmax);
 }
 
 void CandidateTableShape::spans(const Ray& r, SpanList& out) const {

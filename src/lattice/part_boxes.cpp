@@ -50,6 +50,8 @@ PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box) : center_(box.c
 
 bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint32_t> parts,
                                const Ray& r, double tmin, double tmax, Crossing& hit) const {
+    if (parts.size() <= kFewParts)
+        return first_crossing_of_parts(primitive, parts, r, tmin, tmax, hit);
     const Ray4 slabs(*this, r);
     Ray4::Range range = slabs.range(tmin, tmax);
     bool found = false;
@@ -64,6 +66,15 @@ bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint
         return false;
     });
     return found;
+}
+
+bool PartBoxes::any_occludes(const Shape& primitive, std::span<const std::uint32_t> parts,
+                             const Ray& r, double tmin, double tmax) const {
+    if (parts.size() <= kFewParts) return any_part_occludes(primitive, parts, r, tmin, tmax);
+    const Ray4 slabs(*this, r);
+    return slabs.any_listed(parts, slabs.range(tmin, tmax), [&](std::uint32_t part) {
+        return primitive.occluded_primitive(part, r, tmin, tmax);
+    });
 }
 
 std::size_t PartBoxes::near_parts(const Ray& r, double grow, double tmin,
