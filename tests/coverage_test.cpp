@@ -496,12 +496,12 @@ std::string near_and_far(bool row, bool far_bead) {
     return text;
 }
 
-// How many levels scene_lattices builds for a primitive's near and far copies, with levels of
-// detail on, within a pair budget.
-std::size_t levels_built(bool row, bool far_bead, double max_pairs) {
+// How many levels scene_lattices builds for a scene's one primitive, with levels of detail on,
+// within a pair budget.
+std::size_t levels_built(const std::string& scene, double max_pairs) {
     test::TempDir dir;
     const std::string path = (dir.path() / "near-and-far.json").string();
-    std::ofstream(path) << near_and_far(row, far_bead);
+    std::ofstream(path) << scene;
     const Scene s = load_scene(path);
     const TableCache cache(dir.path().string(), true);
     TableSpec spec;
@@ -518,7 +518,9 @@ TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
     const double p1 = static_cast<double>(BoundaryGrid::pair_count({4, 2, 4}));
     const double p2 = static_cast<double>(BoundaryGrid::pair_count({8, 4, 8}));
     for (const bool far_bead : {true, false}) {
-        const auto levels = [&](double max_pairs) { return levels_built(true, far_bead, max_pairs); };
+        const auto levels = [&](double max_pairs) {
+            return levels_built(near_and_far(true, far_bead), max_pairs);
+        };
         // Levels 0-2 (or 2) within the budget; 0-1 (or 1); 0 (or 0).
         const std::size_t all = far_bead ? 3 : 1;
         EXPECT_EQ(levels(kMaxLodPairs), all);
@@ -561,10 +563,19 @@ TEST(Coverage, FootprintsRangeOverTheCopiesBoxesInPrimitiveUnits) {
     EXPECT_GT(none_lo, none_hi);
 }
 
-// A primitive cheap to intersect is answered by its own crossings: only the lattice asked for
-// is built, however near and far its copies.
-TEST(Coverage, PrimitivesAnsweredByTheirCrossingsBuildOneLevel) {
-    EXPECT_EQ(levels_built(false, true, kMaxLodPairs), 1u);
+// A primitive cheap to intersect is answered by its own crossings, however near and far its
+// copies: no ray reads its tables, and none is built, unless a CSG tree holds a copy (its spans
+// are point-sampled from the lattice asked for, which alone is built).
+TEST(Coverage, PrimitivesAnsweredByTheirCrossingsBuildATableOnlyForCsg) {
+    const std::string copies = near_and_far(false, true);
+    EXPECT_EQ(levels_built(copies, kMaxLodPairs), 0u);
+    std::string with_tree = copies;
+    with_tree.insert(with_tree.rfind(']'),
+                     R"(, {"type": "csg", "op": "union", "material": "w", "children": [)"
+                     R"({"type": "instance", "primitive": "bead", "transform": [)"
+                     R"({"translate": [0, 0, 3]}]}, {"type": "sphere", "center": [5, 5, 5],)"
+                     R"( "radius": 0.5}]})");
+    EXPECT_EQ(levels_built(with_tree, kMaxLodPairs), 1u);
 }
 
 }  // namespace

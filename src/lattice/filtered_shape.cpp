@@ -68,12 +68,14 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
       primitive_(levels.back().ctx.primitive),
       exact_(exact_width > 0 && primitive_ && answered_by_primitive(*primitive_)),
       exact_width_(exact_width),
-      sub_ray_reach_(farthest_sub_ray(exact_width)),
-      point_(levels.back().table, levels.back().ctx,
-             levels.back().ctx.cell * kSnapReach + table_error) {
+      sub_ray_reach_(farthest_sub_ray(exact_width)) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
-    assert(std::all_of(levels.begin(), levels.end(),
-                       [&](const FilterLevel& l) { return l.ctx.primitive == primitive_; }));
+    assert(std::all_of(levels.begin(), levels.end(), [&](const FilterLevel& l) {
+        return l.ctx.primitive == primitive_ && (l.table || exact_);
+    }));
+    if (levels.back().table)
+        point_.emplace(levels.back().table, levels.back().ctx,
+                       levels.back().ctx.cell * kSnapReach + table_error);
     // One level's frame culls: the coarsest level's reach would keep every ray its filter
     // reaches, but the next level's, half as far, keeps nearly all of its coverage (the far
     // part of the support carries little weight: see kSmoothCullCells; `box`, which blends the
@@ -84,7 +86,8 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // Both cuts, smooth, 1 spp: Plates 4 and 5 render 18 % and 23 % faster, the furry bunny
     // and grass 37 % and 44 %, with the same PSNR against exact ground truth to 0.06 dB
     // (docs/filtering.md, "Culling").
-    // A primitive answered by its own crossings reads no table (but point_): its one level's
+    // A primitive answered by its own crossings reads no table (point_ serves it as a CSG leaf,
+    // and scene_lattices loads none elsewhere): its one level's
     // frame culls, with the parts grown by the farthest sub-ray's distance from the ray (a
     // bound; each instance by its own, cull_bounds, and each ray by its own, cull_meets), and
     // a ray whose line passes that close outside the box can have sub-rays that enter it.
@@ -98,7 +101,7 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
         levels_.push_back({l.table, LatticeFrame(l.ctx, reach, exact_ ? sub_ray_reach_ : 0.0),
                            BoundaryGrid(l.ctx.cells)});
     }
-    bounds_ = exact_ ? expand(point_.bounds(), sub_ray_reach_) : point_.bounds();
+    bounds_ = exact_ ? expand(box(), sub_ray_reach_) : box();
     // A chain's crossing is the first of its parts' in order (ChainShape::intersect), so any
     // superset of the parts a sub-ray can meet, in order, gives it bit for bit. Boxes pay for
     // their set-up on a hair of 19 parts, not on a thistle spike of 3 (Plate 2 rendered 9 %
@@ -106,7 +109,16 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     chain_ = exact_ ? dynamic_cast<const ChainShape*>(primitive_) : nullptr;
     if (chain_ && chain_->primitive_count() >= kMinBoxedParts &&
         chain_->primitive_count() <= kMaxNearParts)
-        part_boxes_ = std::make_unique<const PartBoxes>(*chain_, point_.bounds());
+        part_boxes_ = std::make_unique<const PartBoxes>(*chain_, box());
+}
+
+void FilteredLatticeShape::spans(const Ray& r, SpanList& out) const {
+    if (point_) point_->spans(r, out);
+    else primitive_->spans(r, out);
+}
+
+bool FilteredLatticeShape::inside(Vec3 p) const {
+    return point_ ? point_->inside(p) : primitive_->inside(p);
 }
 
 void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bool smooth,
@@ -327,7 +339,7 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
             q.ox[k] = o.x, q.oy[k] = o.y, q.oz[k] = o.z;
             double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
             // A lane clipped away gets a range of 0: its tests run, masked off.
-            if (!clip_ray(point_.bounds(), {o, r.d}, t0, t1)) t0 = t1 = 0;
+            if (!clip_ray(box(), {o, r.d}, t0, t1)) t0 = t1 = 0;
             q.tmin[k] = t0, q.tmax[k] = normal ? t1 : std::min(t1, tmax);
             if (q.tmin[k] < q.tmax[k]) live |= 1u << k;
         }

@@ -14,6 +14,7 @@
 // level's own hits, exactly as without filtering.
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -68,9 +69,10 @@ double lod_blend(double f, double band);
 // its own crossings, not its tables, for every ray with a footprint: those of kExactSubRays^2
 // sub-rays parallel to the ray across its footprint (add_exact), for camera rays shaded once
 // with their mean point and normal (the pixel's box filter on this primitive), for shadow rays
-// their share as the coverage. Its tables then serve rays without a footprint, CSG and
-// `inside` only, and no finer level is built (scene_lattices). A costly primitive is answered
-// by its tables and their levels alone.
+// their share as the coverage (a ray without a footprint: its own line's). Its table then
+// serves CSG (spans, `inside`) only, and is built only when a CSG tree holds a copy, no finer
+// level ever (scene_lattices). A costly primitive is answered by its tables and their levels
+// alone.
 //   Why: where intersecting the primitive is cheap, its sub-rays give a better image than the
 // tables in less time, at every footprint tried. 1 spp, 2 threads, ms and PSNR against exact
 // ground truth (256 spp; 64 for the bunny and grass), on Plates 2 / 3 / 4 / 5, the furry bunny,
@@ -114,7 +116,8 @@ bool answered_by_primitive(const Shape& primitive);
 // Chains of at most this many parts find the parts near a ray first (PartBoxes::near_parts).
 inline constexpr std::size_t kMaxNearParts = 64;
 
-// One level: a coverage table and its lattice.
+// One level: a coverage table and its lattice. The table may be null for a primitive answered
+// by its own crossings (the shape then reads none; see spans and inside).
 struct FilterLevel {
     std::shared_ptr<const LatticeTable> table;
     TableContext ctx;
@@ -138,10 +141,12 @@ public:
     // Shadow rays that need transmittance ask intersect for the coverage; as an any-hit test, a
     // sheet occludes when it covers at least half.
     bool occluded(const Ray& r, double tmin, double tmax) const override;
-    void spans(const Ray& r, SpanList& out) const override { point_.spans(r, out); }
+    // As a CSG leaf: the finest level point-sampled; without a table (FilterLevel), the
+    // primitive's own.
+    void spans(const Ray& r, SpanList& out) const override;
     // The mean of unit normals: of length 1 or less (see intersect).
     Vec3 normal(const Ray&, const Crossing& c) const override { return c.stored.n; }
-    bool inside(Vec3 p) const override { return point_.inside(p); }
+    bool inside(Vec3 p) const override;
     // Culled by the frame of level cull_level_ (see the constructor).
     std::size_t cull_count() const override { return cull_frame().cull_count(); }
     // An instance whose rays span at most `widest` has its capsules and boxes narrowed by the
@@ -165,8 +170,10 @@ public:
     // tables: 31.01 dB with 2 cells, 30.97 with 1, 30.55 with 1/2).
     double surface_tolerance() const override { return exact_ ? exact_width_ : span_tolerance(); }
     // Spans are point_'s, point-sampled from a table: its sheets' 2 cells (of the coarsest
-    // level, as for every filtered lattice before sub-rays).
-    double span_tolerance() const override { return 2.0 * levels_.front().frame.cell(); }
+    // level, as for every filtered lattice before sub-rays); without one, the primitive's.
+    double span_tolerance() const override {
+        return point_ ? 2.0 * levels_.front().frame.cell() : primitive_->span_tolerance();
+    }
 
 private:
     struct Level {
@@ -214,9 +221,11 @@ private:
     // A chain's parts' boxes: a sub-ray is intersected with the parts whose box it meets only.
     std::unique_ptr<const PartBoxes> part_boxes_;
     const ChainShape* chain_ = nullptr;  // primitive_, when it is a chain
-    HitTableShape point_;  // the finest level, point-sampled
+    std::optional<HitTableShape> point_;  // the finest level, point-sampled (if it has a table)
 
     const LatticeFrame& cull_frame() const { return levels_[cull_level_].frame; }
+    // The lattice box (primitive units), the same at every level.
+    const Bounds3& box() const { return levels_.back().frame.box(); }
     // The ray's footprint's width at the box (primitive units; 0 without one).
     double footprint_width(const Ray& r) const;
     // How much of sub_ray_reach_ the sub-rays of footprints at most `width` wide leave unused:

@@ -26,7 +26,8 @@ struct SceneLattices {
 // How lattices are filtered (issue 10): the filter, and whether levels of detail are built. With
 // lod, each primitive gets the levels sigma^-1 = K 2^j whose cells match the footprints of the
 // camera's pixels (spread: a pixel's angle) somewhere on its instances, at most kMaxLodLevels;
-// a primitive answered_by_primitive gets the lattice asked for alone.
+// a primitive answered_by_primitive gets the lattice asked for alone, and only if a CSG tree
+// holds a copy (no ray reads it elsewhere).
 // Levels of detail beyond sigma^-1 = K are built only up to kMaxLodPairs ordered pairs of
 // boundary points: rays that want finer get the finest level within it, not a table that takes
 // half an hour to build. 2^27 holds the hair of Plates 4 and 5 at 4K (111 M pairs); a CSG ring
