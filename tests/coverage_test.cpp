@@ -464,31 +464,35 @@ TEST(Coverage, TurnedCopiesOfABeadRenderAsOne) {
 }
 
 // Two copies of a primitive, one near the camera and one far: levels of detail want 1K, 2K and
-// 4K. The primitive is a bead, or a row of 65 beads, which costs more to intersect than
-// kMaxExactCost and so is answered by its tables and their levels.
+// 4K. The primitive is a bead, or a row of six small tori (a CSG union of cost 72, quartics
+// counting 12), which costs more to intersect than kMaxExactCost and so is answered by its
+// tables and their levels.
 constexpr const char* kNearAndFar = R"({
   "format": "lattice-reference/1",
   "camera": {"eye": [1, -3, 1], "look_at": [1, 0.5, 1], "up": [0, 0, 1], "fov_y_deg": 30,
              "width": 16, "height": 16},
   "background": [0, 0, 0], "ambient": [1, 1, 1], "shadows": false, "lights": [],
   "materials": {"w": {"color": [1, 1, 1], "ka": 1, "kd": 0, "ks": 0, "shininess": 1}},
-  "primitives": {"bead": {"spheres": [SPHERES], "cylinders": [],
-                          "lattice": {"sigma": 1, "cells": [2, 1, 2]}}},
+  "primitives": {"bead": PRIMITIVE},
   "objects": [{"type": "instance", "primitive": "bead", "material": "w"},
               {"type": "instance", "primitive": "bead",
                "transform": [{"translate": [0, 400, 0]}], "material": "w"}]
 })";
 
 std::string near_and_far(bool row, bool far_bead) {
-    std::string spheres = "[1, 0.5, 1, 0.3]";
+    const std::string lattice = R"("lattice": {"sigma": 1, "cells": [2, 1, 2]})";
+    std::string primitive = R"({"spheres": [[1, 0.5, 1, 0.3]], "cylinders": [], )" + lattice + "}";
     if (row) {
-        constexpr double kBeads = kMaxExactCost + 1;
-        spheres.clear();
-        for (int i = 0; i < int(kBeads); ++i)
-            spheres += (i ? ", [" : "[") + std::to_string(0.2 + 1.6 * i / (kBeads - 1)) + ", 0.5, 1, 0.05]";
+        std::string tori;
+        for (int i = 0; i < 6; ++i)
+            tori += (i ? ", " : "") + std::string(R"({"type": "torus", "center": [)") +
+                    std::to_string(0.4 + 0.24 * i) +
+                    R"(, 0.5, 1], "axis": [0, 0, 1], "major_radius": 0.3, "minor_radius": 0.05})";
+        primitive = R"({"object": {"type": "csg", "op": "union", "children": [)" + tori + "]}, " +
+                    lattice + "}";
     }
     std::string text = kNearAndFar;
-    text.replace(text.find("SPHERES"), 7, spheres);
+    text.replace(text.find("PRIMITIVE"), 9, primitive);
     if (!far_bead) {
         text.erase(text.find(",\n              {\"type\": \"instance\""));
         text += "]}";

@@ -499,12 +499,35 @@ ChainShape beads(std::size_t parts) {
     return ChainShape(b, {});
 }
 
-// A primitive whose exact intersection costs more than kMaxExactCost simple tests keeps to its
-// tables: a chain would test every part, for every sub-ray.
-TEST(FilteredCloseUps, PrimitivesOfManyPartsKeepToTheirTables) {
-    const auto most = static_cast<std::size_t>(kMaxExactCost);
-    EXPECT_EQ(differing_answers(beads(most + 1)), 0);
-    EXPECT_GT(differing_answers(beads(most)), 500);  // the crossings show where they are allowed
+// A chain answers from its crossings whatever its parts: its sub-rays test only the parts near
+// the ray (PartBoxes, through a tree of their boxes past kTreeFrom parts), not every part. Its
+// answers are its line's crossings (a vanishing footprint), so they differ from the tables'.
+TEST(FilteredCloseUps, ChainsOfAnyPartsAnswerFromTheirCrossings) {
+    for (const std::size_t parts : {std::size_t(kMaxExactCost) + 1, std::size_t(400)}) {
+        const ChainShape row = beads(parts);
+        EXPECT_GT(row.intersect_cost(), kMaxExactCost);
+        EXPECT_TRUE(answered_by_primitive(row));
+        EXPECT_GT(differing_answers(row), 500) << parts << " parts";
+        const TableContext ctx{{4, 2, 4}, 1.0, 1.0, &row};
+        const Encoding& e = find_encoding("coverage");
+        const RasterizeResult raster = rasterize(ctx);
+        const ByteBuffer payload = e.build(raster.raw, ctx, {});
+        const FilteredLatticeShape asked(
+            {{e.open(payload.data(), payload.size(), raster.hits, ctx), ctx}},
+            LatticeFilter::kSmooth, e.error_bound(ctx, {}), kExactWidth);
+        set_ray_footprint({0, 0, false});
+        int hits = 0;
+        for (const Ray& r : rays(3000)) {
+            Crossing exact, got;
+            const bool hit = row.intersect(r, 0.0, kInfinity, exact);
+            ASSERT_EQ(asked.intersect(r, 0.0, kInfinity, got), hit) << parts << " parts";
+            if (!hit) continue;
+            ++hits;
+            EXPECT_NEAR(got.t, exact.t, 1e-9);
+        }
+        set_ray_footprint({});
+        EXPECT_GT(hits, 300) << parts << " parts";
+    }
 }
 
 // A mesh descends its own hierarchy: one of many more triangles than kMaxExactCost is answered

@@ -186,6 +186,49 @@ TEST(PartBoxes, NearPartsFourAtATimeAreTheOneBoxTests) {
     }
 }
 
+// Primitives of more than kTreeFrom parts are searched through a tree of their boxes: the
+// parts it keeps, in order, are those of the flat scan (every four boxes tested), for rays from
+// near and very far, grazing or inside the boxes, along axes, and with growths from nothing to
+// more than the box.
+TEST(PartBoxes, NearPartsThroughTheTreeAreTheFlatScans) {
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::size_t through_tree = 0;
+    for (const int parts : {int(PartBoxes::kTreeFrom) + 1, 100, 1000, 5000}) {
+        const Boxes prim = random_boxes(rng, parts, parts > 500 ? 0.1 : 0.4, 1.0);
+        const PartBoxes boxes(prim, prim.bounds());
+        std::vector<std::uint32_t> near(prim.parts.size()), flat;
+        std::size_t kept = 0;
+        for (int n = 0; n < 3000; ++n) {
+            const Vec3 p = Vec3{u(rng), u(rng), u(rng)} * Vec3{7, 7, 20};
+            Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+            if (n % 11 == 0) d = {0, 0, 1};                       // the double fallback
+            const double dist = std::pow(10.0, 12 * u(rng) - 2);  // inside the box to 1e10 away
+            const Ray r{p - d * dist, d * std::pow(10.0, 4 * u(rng) - 2)};
+            const double g = n % 5 == 0 ? 0.0 : std::pow(10.0, 4 * u(rng) - 3);
+            const double tmin = n % 2 ? -kInfinity : dist / length(r.d) * u(rng);
+            const std::size_t count = boxes.near_parts(r, g, tmin, near);
+            const PartBoxes::Ray4 slabs(boxes, r);
+            const PartBoxes::Ray4::Range range = slabs.range(tmin, kInfinity);
+            const PartBoxes::Ray4::Grow grow = PartBoxes::Ray4::grow(g);
+            flat.clear();
+            for (std::uint32_t i = 0; i < prim.parts.size(); ++i) {
+                const bool met = slabs.in_float()
+                                     ? (slabs.meets_grown4(i / 4, range, grow) >> (i % 4) & 1u)
+                                     : slabs.meets_grown(i, range, grow);
+                if (met) flat.push_back(i);
+            }
+            ASSERT_EQ(std::vector<std::uint32_t>(near.begin(), near.begin() + count), flat)
+                << parts << " parts, ray " << n;
+            kept += count;
+            through_tree += slabs.in_float() && slabs.tame(grow) ? 1 : 0;
+        }
+        EXPECT_GT(kept, 100u);                           // parts are met
+        EXPECT_LT(kept, 3000u * prim.parts.size() / 2);  // and left out
+    }
+    EXPECT_GT(through_tree, 8000u);
+}
+
 // A union's first crossing over its parts, box-tested first (what filtered lattices blend in),
 // is the primitive's own, bit for bit: the same t, part and stored point, and none where it has
 // none; rays aimed at joints (where a sphere and its cylinders meet) and grazing the hair.

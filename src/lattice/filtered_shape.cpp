@@ -53,7 +53,8 @@ double farthest_sub_ray(double width) {
 }
 
 bool answered_by_primitive(const Shape& primitive) {
-    return primitive.intersect_cost() <= kMaxExactCost;
+    return dynamic_cast<const ChainShape*>(&primitive) != nullptr ||
+           primitive.intersect_cost() <= kMaxExactCost;
 }
 
 double lod_blend(double f, double band) {
@@ -107,8 +108,7 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // their set-up on a hair of 19 parts, not on a thistle spike of 3 (Plate 2 rendered 9 %
     // slower when every sub-ray tested the boxes).
     chain_ = exact_ ? dynamic_cast<const ChainShape*>(primitive_) : nullptr;
-    if (chain_ && chain_->primitive_count() >= kMinBoxedParts &&
-        chain_->primitive_count() <= kMaxNearParts)
+    if (chain_ && chain_->primitive_count() >= kMinBoxedParts)
         part_boxes_ = std::make_unique<const PartBoxes>(*chain_, box());
 }
 
@@ -320,11 +320,12 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
     // sub-ray's distance from r, at least its offset along any axis. Plates 4 and 5 render 6 %
     // faster than with every part intersected by every sub-ray; images identical. (Boxes grown
     // by (n - 1) / n of the width, as first written, kept more parts: 2 % slower.)
-    std::array<std::uint32_t, kMaxNearParts> near;
+    thread_local std::vector<std::uint32_t> near;
     std::span<const std::uint32_t> parts;
-    if (part_boxes_)
+    if (part_boxes_) {
+        near.resize(chain_->primitive_count());
         parts = {near.data(), part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, near)};
-    else if (chain_)
+    } else if (chain_)
         parts = chain_->all_parts();
     // The sub-rays, lane k = i n + j (bit k of Sheet::sub_rays), each clipped to the box.
     static_assert(n * n == 4, "a RayQuad holds a ray's sub-rays");

@@ -45,7 +45,9 @@ PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box) : center_(box.c
         for (std::size_t k = 0; k < 3; ++k) {
             quads_[i / 4].lo[k][i % 4] = f_[i].lo[k];
             quads_[i / 4].hi[k][i % 4] = f_[i].hi[k];
+            extent_ = std::max({extent_, std::abs(f_[i].lo[k]), std::abs(f_[i].hi[k])});
         }
+    if (f_.size() > kTreeFrom) build_tree();
 }
 
 bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint32_t> parts,
@@ -89,6 +91,7 @@ std::size_t PartBoxes::near_parts(const Ray& r, double grow, double tmin,
             if (slabs.meets_grown(part, range, g)) out[n++] = part;
         return n;
     }
+    if (!nodes_.empty() && slabs.tame(g)) return tree_near_parts(slabs, range, g, out);
     // Four boxes a test: Plate 5 renders 3 % faster than with one a test (260 -> 252 ms), the
     // same parts.
     const unsigned last = (1u << (f_.size() % 4 == 0 ? 4 : f_.size() % 4)) - 1;
@@ -159,19 +162,6 @@ bool PartBoxes::Ray4::meets_grown(std::uint32_t i, const Range& r, const Grow& g
     _mm_store_ps(grown.lo, _mm_sub_ps(_mm_load_ps(b.lo), gf));
     _mm_store_ps(grown.hi, _mm_add_ps(_mm_load_ps(b.hi), gf));
     return meets_float(grown, r);
-}
-
-// Lane j: part 4 k + j's grown box, tested as meets_grown tests one (meets4).
-unsigned PartBoxes::Ray4::meets_grown4(std::size_t k, const Range& r, const Grow& g) const {
-    assert(use_float_);
-    const BoxQuad& b = boxes_.quads_[k];
-    const __m128 gf = _mm_set1_ps(g.f);
-    __m128 lo[3], hi[3];
-    for (std::size_t a = 0; a < 3; ++a) {
-        lo[a] = _mm_sub_ps(_mm_load_ps(b.lo[a]), gf);
-        hi[a] = _mm_add_ps(_mm_load_ps(b.hi[a]), gf);
-    }
-    return meets4(lo, hi, r);
 }
 
 PartBoxes::Ray4::Ray4(const PartBoxes& boxes, const Ray& r) : boxes_(boxes), ray_(r) {
