@@ -243,7 +243,8 @@ Command add_render_command(CLI::App& parent) {
                       "coverage encoding")
         ->check(CLI::IsMember(kFilters));
     c.app->add_option("--lod", args->lod,
-                      "lattice mode with a filter: a primitive cheap to intersect (at most " +
+                      "lattice mode with a filter: a chain of spheres and cylinders (any number "
+                      "of parts) or another primitive cheap to intersect (at most " +
                           std::to_string(static_cast<int>(kMaxExactCost)) +
                           " simple tests) answered by the crossings of " +
                           std::to_string(kExactSubRays) + " x " + std::to_string(kExactSubRays) +
