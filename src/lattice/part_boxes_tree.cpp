@@ -33,7 +33,11 @@ void set_lane(Quad& q, std::size_t lane, const std::array<float, 3>& lo,
 void PartBoxes::build_tree() {
     std::vector<std::uint32_t> order(f_.size());
     std::iota(order.begin(), order.end(), 0u);
-    const auto centre = [&](std::uint32_t p, std::size_t a) { return f_[p].lo[a] + f_[p].hi[a]; };
+    // (Twice the centre; 0 for a box without one, so that the order stays a strict one.)
+    const auto centre = [&](std::uint32_t p, std::size_t a) {
+        const float c = f_[p].lo[a] + f_[p].hi[a];
+        return std::isfinite(c) ? c : 0.0f;
+    };
     // Splits order[first, last) at its median along its centres' widest axis.
     const auto halve = [&](std::size_t first, std::size_t last) {
         std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
