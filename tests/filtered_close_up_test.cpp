@@ -499,6 +499,51 @@ ChainShape beads(std::size_t parts) {
     return ChainShape(b, {});
 }
 
+// Without its table (scene_lattices loads none for a primitive answered by its crossings and
+// held by no CSG tree) the shape answers every ray as with it, bit for bit, camera and shadow
+// rays with footprints or none; its spans and `inside` are the primitive's own. A level
+// without a table for a primitive that does not answer by its crossings is refused.
+TEST(FilteredCloseUps, APrimitiveAnsweredByItsCrossingsNeedsNoTable) {
+    const HookLattice h = hook_lattice(long_hook());
+    TableContext ctx = kFine;
+    ctx.primitive = &long_hook();
+    const FilteredLatticeShape bare({{nullptr, ctx}}, LatticeFilter::kSmooth, 0.0, kExactWidth);
+    EXPECT_EQ(bare.bounds().lo, h.exact->bounds().lo);
+    EXPECT_EQ(bare.bounds().hi, h.exact->bounds().hi);
+    int hits = 0, spans = 0;
+    for (const RayFootprint f : {RayFootprint{0.4, 0.01, false}, RayFootprint{0.8, -0.05, true},
+                                 RayFootprint{0, 0, false}}) {
+        set_ray_footprint(f);
+        for (const Ray& r : rays(2000)) {
+            Crossing a, b;
+            const bool ha = h.exact->intersect(r, 0.0, kInfinity, a);
+            ASSERT_EQ(bare.intersect(r, 0.0, kInfinity, b), ha);
+            ASSERT_EQ(bare.occluded(r, 0.0, 20.0), h.exact->occluded(r, 0.0, 20.0));
+            if (!ha) continue;
+            ++hits;
+            EXPECT_EQ(a.t, b.t);
+            EXPECT_EQ(a.coverage, b.coverage);
+            EXPECT_EQ(a.sub_rays, b.sub_rays);
+            EXPECT_EQ(a.stored.n, b.stored.n);
+        }
+    }
+    set_ray_footprint({});
+    for (const Ray& r : rays(500)) {
+        SpanList own, got;
+        long_hook().spans(r, own);
+        bare.spans(r, got);
+        ASSERT_EQ(got.size(), own.size());
+        for (std::size_t k = 0; k < own.size(); ++k) EXPECT_EQ(got[k].in.t, own[k].in.t);
+        spans += static_cast<int>(own.size());
+        const Vec3 p = r.o + r.d * 2.0;
+        EXPECT_EQ(bare.inside(p), long_hook().inside(p));
+    }
+    EXPECT_GT(hits, 1000);
+    EXPECT_GT(spans, 100);
+    EXPECT_THROW(FilteredLatticeShape({{nullptr, ctx}}, LatticeFilter::kSmooth, 0.0, 0.0),
+                 std::logic_error);
+}
+
 // A chain answers from its crossings whatever its parts: its sub-rays test only the parts near
 // the ray (PartBoxes, through a tree of their boxes past kTreeFrom parts), not every part. Its
 // answers are its line's crossings (a vanishing footprint), so they differ from the tables'.

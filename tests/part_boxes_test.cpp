@@ -125,7 +125,7 @@ TEST(PartBoxes, NearPartsKeepEveryPartAParallelRayWithinGrowMeets) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(0, 1);
     const Boxes prim = random_boxes(rng, 60, 0.2, 1.0);
-    const PartBoxes boxes(prim, prim.bounds());
+    const PartBoxes boxes(prim, prim.bounds(), true);  // 60 parts: through the tree
     std::vector<std::uint32_t> near(prim.parts.size());
     int kept = 0, met = 0;
     for (int n = 0; n < 20000; ++n) {
@@ -196,7 +196,7 @@ TEST(PartBoxes, NearPartsThroughTheTreeAreTheFlatScans) {
     std::size_t through_tree = 0;
     for (const int parts : {int(PartBoxes::kTreeFrom) + 1, 100, 1000, 5000}) {
         const Boxes prim = random_boxes(rng, parts, parts > 500 ? 0.1 : 0.4, 1.0);
-        const PartBoxes boxes(prim, prim.bounds());
+        const PartBoxes boxes(prim, prim.bounds(), true);
         std::vector<std::uint32_t> near(prim.parts.size()), flat;
         std::size_t kept = 0;
         for (int n = 0; n < 3000; ++n) {
@@ -227,6 +227,47 @@ TEST(PartBoxes, NearPartsThroughTheTreeAreTheFlatScans) {
         EXPECT_LT(kept, 3000u * prim.parts.size() / 2);  // and left out
     }
     EXPECT_GT(through_tree, 8000u);
+}
+
+// A primitive with a part of unbounded box still builds its tree (the median split sorts such a
+// part as if centred at 0) and near_parts answers as the flat scan: the part is near every ray.
+TEST(PartBoxes, AnUnboundedPartLeavesTheTreeAnsweringAsTheFlatScan) {
+    std::mt19937 rng(19);
+    std::uniform_real_distribution<double> u(0, 1);
+    class Unbounded final : public Shape {
+    public:
+        Boxes inner;
+        Bounds3 bounds() const override { return inner.bounds(); }
+        bool intersect(const Ray&, double, double, Crossing&) const override { return false; }
+        void spans(const Ray&, SpanList&) const override {}
+        Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
+        bool inside(Vec3) const override { return false; }
+        using Shape::primitive_bounds;
+        std::size_t primitive_count() const override { return inner.parts.size() + 1; }
+        Bounds3 primitive_bounds(std::size_t i) const override {
+            return i == 7 ? Bounds3{Vec3{-kInfinity, 0, 0}, Vec3{kInfinity, 1, 1}}
+                          : inner.parts[i < 7 ? i : i - 1];
+        }
+    } prim;
+    prim.inner = random_boxes(rng, 60, 0.4, 1.0);
+    const PartBoxes boxes(prim, prim.bounds(), true);
+    std::vector<std::uint32_t> near(prim.primitive_count());
+    for (int n = 0; n < 500; ++n) {
+        const Vec3 p = Vec3{u(rng), u(rng), u(rng)} * Vec3{7, 7, 20};
+        const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+        const Ray r{p - d * 30.0, d};
+        const std::size_t count = boxes.near_parts(r, 0.1, 0.0, near);
+        const PartBoxes::Ray4 slabs(boxes, r);
+        std::vector<std::uint32_t> flat;
+        for (std::uint32_t i = 0; i < prim.primitive_count(); ++i)
+            if (slabs.meets_grown4(i / 4, slabs.range(0.0, kInfinity),
+                                   PartBoxes::Ray4::grow(0.1)) >>
+                    (i % 4) &
+                1u)
+                flat.push_back(i);
+        ASSERT_EQ(std::vector<std::uint32_t>(near.begin(), near.begin() + count), flat) << n;
+        EXPECT_TRUE(std::find(flat.begin(), flat.end(), 7u) != flat.end());
+    }
 }
 
 // A union's first crossing over its parts, box-tested first (what filtered lattices blend in),
@@ -286,18 +327,24 @@ TEST(PartBoxes, ListsOfEveryLengthAnswerAsALoopOverTheirParts) {
         const std::size_t length = 1 + static_cast<std::size_t>(n) % hair.primitive_count();
         for (std::uint32_t i = 0; i < hair.primitive_count(); ++i)
             if (u(rng) < double(length) / double(hair.primitive_count())) listed.push_back(i);
-        if (listed.empty()) listed.push_back(static_cast<std::uint32_t>(n) % 19);
+        if (listed.empty())
+            listed.push_back(static_cast<std::uint32_t>(n % int(hair.primitive_count())));
         const ChainSphere& aim = spheres[static_cast<std::size_t>(n) % spheres.size()];
         const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
         const Vec3 jitter = Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * 1.2;
         const Ray r{aim.center + jitter - d * (1 + 30 * u(rng)), d * (0.1 + 3 * u(rng))};
         const double tmin = n % 4 == 0 ? 0.5 : 0.0, tmax = n % 5 == 0 ? 3.0 : kInfinity;
+        // The loop written out: each listed part in order, the range narrowed by each hit.
         Crossing want, got;
-        const bool w = first_crossing_of_parts(hair, listed, r, tmin, tmax, want);
+        bool w = false, blocks = false;
+        double until = tmax;
+        for (const std::uint32_t part : listed) {
+            Crossing c;
+            if (hair.intersect_primitive(part, r, tmin, until, c)) want = c, until = c.t, w = true;
+            blocks = blocks || hair.occluded_primitive(part, r, tmin, tmax);
+        }
         ASSERT_EQ(w, boxes.first_crossing(hair, listed, r, tmin, tmax, got)) << "ray " << n;
-        ASSERT_EQ(any_part_occludes(hair, listed, r, tmin, tmax),
-                  boxes.any_occludes(hair, listed, r, tmin, tmax))
-            << "ray " << n;
+        ASSERT_EQ(blocks, boxes.any_occludes(hair, listed, r, tmin, tmax)) << "ray " << n;
         if (!w) continue;
         (listed.size() > PartBoxes::kFewParts ? boxed_hits : short_hits) += 1;
         ASSERT_EQ(want.t, got.t) << "ray " << n;

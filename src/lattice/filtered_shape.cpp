@@ -4,6 +4,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <stdexcept>
 
 #include "geometry/ray_quad.h"
 #include "geometry/sub_rays.h"
@@ -74,6 +75,12 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     assert(std::all_of(levels.begin(), levels.end(), [&](const FilterLevel& l) {
         return l.ctx.primitive == primitive_ && (l.table || exact_);
     }));
+    // scene_lattices leaves the table out only where exact_ holds (the same rule): without it,
+    // add_tables would read null.
+    for (const FilterLevel& l : levels)
+        if (!l.table && !exact_)
+            throw std::logic_error(
+                "a filtered lattice without a table must answer by its crossings");
     if (levels.back().table)
         point_.emplace(levels.back().table, levels.back().ctx,
                        levels.back().ctx.cell * kSnapReach + table_error);
@@ -87,11 +94,11 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // Both cuts, smooth, 1 spp: Plates 4 and 5 render 18 % and 23 % faster, the furry bunny
     // and grass 37 % and 44 %, with the same PSNR against exact ground truth to 0.06 dB
     // (docs/filtering.md, "Culling").
-    // A primitive answered by its own crossings reads no table (point_ serves it as a CSG leaf,
-    // and scene_lattices loads none elsewhere): its one level's
-    // frame culls, with the parts grown by the farthest sub-ray's distance from the ray (a
-    // bound; each instance by its own, cull_bounds, and each ray by its own, cull_meets), and
-    // a ray whose line passes that close outside the box can have sub-rays that enter it.
+    // A primitive answered by its own crossings reads no table (point_ serves it as a CSG
+    // leaf, and scene_lattices loads none elsewhere): its one level's frame culls, with the
+    // parts grown by the farthest sub-ray's distance from the ray (a bound; each instance by
+    // its own, cull_bounds, and each ray by its own, cull_meets), and a ray whose line passes
+    // that close outside the box can have sub-rays that enter it.
     assert(!exact_ || levels.size() == 1);
     cull_level_ = std::min<std::size_t>(1, levels.size() - 1);
     for (std::size_t i = 0; i < levels.size(); ++i) {
@@ -109,7 +116,7 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // slower when every sub-ray tested the boxes).
     chain_ = exact_ ? dynamic_cast<const ChainShape*>(primitive_) : nullptr;
     if (chain_ && chain_->primitive_count() >= kMinBoxedParts)
-        part_boxes_ = std::make_unique<const PartBoxes>(*chain_, box());
+        part_boxes_ = std::make_unique<const PartBoxes>(*chain_, box(), true);
 }
 
 void FilteredLatticeShape::spans(const Ray& r, SpanList& out) const {
@@ -320,11 +327,13 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
     // sub-ray's distance from r, at least its offset along any axis. Plates 4 and 5 render 6 %
     // faster than with every part intersected by every sub-ray; images identical. (Boxes grown
     // by (n - 1) / n of the width, as first written, kept more parts: 2 % slower.)
-    thread_local std::vector<std::uint32_t> near;
+    thread_local std::vector<std::uint32_t> near;  // grown, never shrunk: no zeroing a ray
     std::span<const std::uint32_t> parts;
     if (part_boxes_) {
-        near.resize(chain_->primitive_count());
-        parts = {near.data(), part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, near)};
+        const std::size_t all = chain_->primitive_count();
+        if (near.size() < all) near.resize(all);
+        const std::span<std::uint32_t> out(near.data(), all);
+        parts = {near.data(), part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, out)};
     } else if (chain_)
         parts = chain_->all_parts();
     // The sub-rays, lane k = i n + j (bit k of Sheet::sub_rays), each clipped to the box.

@@ -129,13 +129,14 @@ struct FilterLevel {
 
 class FilteredLatticeShape final : public Shape {
 public:
-    // levels: coarse to fine, the same box, cells doubling; every table has coverage; the
-    // primitive (ctx.primitive) must outlive the shape. table_error: Encoding::error_bound of
-    // the finest level. exact_width: above 0, rays take the primitive's own crossings (levels
-    // of detail on; one level) if it is answered_by_primitive; their footprints are narrowed to
-    // at most exact_width (primitive units), which bounds how far from a ray its sub-rays go and
-    // so how far culling must reach; each instance narrower still by its own bound (cull_bounds,
-    // AcrossRay::widest). A ray without a footprint gets the crossing of its own line.
+    // levels: coarse to fine, the same box, cells doubling; every table has coverage (or is null:
+    // FilterLevel); the primitive (ctx.primitive) must outlive the shape. table_error:
+    // Encoding::error_bound of the finest level. exact_width: above 0, rays take the primitive's
+    // own crossings (levels of detail on; one level) if it is answered_by_primitive; their
+    // footprints are narrowed to at most exact_width (primitive units), which bounds how far from a
+    // ray its sub-rays go and so how far culling must reach; each instance narrower still by its
+    // own bound (cull_bounds, AcrossRay::widest). A ray without a footprint gets the crossing of
+    // its own line.
     FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter, double table_error,
                          double exact_width = 0);
 

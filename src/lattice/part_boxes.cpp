@@ -28,7 +28,8 @@ float up(double x) {
 
 }  // namespace
 
-PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box) : center_(box.center()) {
+PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box, bool tree)
+    : center_(box.center()) {
     const double d = length(box.extent()) + max_component(abs(box.lo)) + max_component(abs(box.hi));
     for (std::size_t i = 0; i < primitive.primitive_count(); ++i) {
         const Bounds3 b = padded(primitive.primitive_bounds(i));
@@ -47,7 +48,7 @@ PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box) : center_(box.c
             quads_[i / 4].hi[k][i % 4] = f_[i].hi[k];
             extent_ = std::max({extent_, std::abs(f_[i].lo[k]), std::abs(f_[i].hi[k])});
         }
-    if (f_.size() > kTreeFrom) build_tree();
+    if (tree && f_.size() > kTreeFrom) build_tree();
 }
 
 bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint32_t> parts,

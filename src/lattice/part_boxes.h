@@ -15,6 +15,7 @@
 // component too small for a float reciprocal take the same test in double.
 #include <immintrin.h>
 
+#include <array>
 #include <bit>
 #include <cassert>
 #include <cstdint>
@@ -29,8 +30,9 @@ class PartBoxes {
     struct Node;  // of the tree (below)
 
 public:
-    // box: the lattice box (primitive units) that every part and every crossing lies in.
-    PartBoxes(const Shape& primitive, const Bounds3& box);
+    // box: the lattice box (primitive units) that every part and every crossing lies in. tree:
+    // build the tree near_parts searches (more than kTreeFrom parts; `candidates` never asks).
+    PartBoxes(const Shape& primitive, const Bounds3& box, bool tree = false);
 
     // The first crossing in (tmin, tmax) of the union of the listed parts of primitive (the
     // one the boxes were made for): each part whose box the ray meets within the range left
@@ -43,15 +45,16 @@ public:
                       double tmin, double tmax) const;
     // Lists up to this long are intersected without their boxes: for so few parts, preparing
     // the four-lane test costs more than the exact tests it saves (Plate 4 in `candidates`, hair
-    // lists of about 3 parts: 77 -> 69 ms; Plate 5 99 -> 90; lists of 8 and more unchanged).
+    // lists of about 3 parts: 77 -> 69 ms; Plate 5 99 -> 90; the tufts' longer lists unchanged).
     static constexpr std::size_t kFewParts = 8;
     // The parts, in order, whose box grown by `grow` on every side the ray's line meets after
     // tmin: all that a ray parallel to r within grow of its line can meet there (same t). out
     // holds at least the part count; returns how many were written. Primitives of more than
-    // kTreeFrom parts are searched through a tree of their boxes (the same parts).
+    // kTreeFrom parts, made with the tree, are searched through it (the same parts); rays with
+    // a direction component too small for the float test scan every part in double.
     std::size_t near_parts(const Ray& r, double grow, double tmin,
                            std::span<std::uint32_t> out) const;
-    // The parts from which near_parts searches a tree: a tuft of 200 parts spent half its
+    // Primitives of more than this many parts get the tree: a tuft of 200 parts spent half its
     // render testing every box (sub-rays of 455 ms, tables of 608, exact at 4 spp 287).
     static constexpr std::size_t kTreeFrom = 32;
 
@@ -171,7 +174,14 @@ private:
     float extent_ = 0;  // the largest coordinate of any box (relative to center_)
     Vec3 center_;
 
+    struct Made {
+        std::uint32_t node;
+        std::array<float, 3> lo, hi;  // the box of all it holds
+    };
     void build_tree();
+    float centre(std::uint32_t p, std::size_t a) const;
+    std::size_t halve(std::vector<std::uint32_t>& order, std::size_t first, std::size_t last) const;
+    Made make_node(std::vector<std::uint32_t>& order, std::size_t first, std::size_t last);
     std::size_t tree_near_parts(const Ray4& slabs, const Ray4::Range& range, const Ray4::Grow& g,
                                 std::span<std::uint32_t> out) const;
 };

@@ -16,84 +16,74 @@
 #include "lattice/part_boxes.h"
 
 namespace lat {
-namespace {
 
-// The lane of a node's box that holds a child's box (lo, hi per axis).
-template <class Quad>
-void set_lane(Quad& q, std::size_t lane, const std::array<float, 3>& lo,
-              const std::array<float, 3>& hi) {
-    for (std::size_t a = 0; a < 3; ++a) q.lo[a][lane] = lo[a], q.hi[a][lane] = hi[a];
+// Twice part p's centre along axis a; 0 for a box without one, so that orders stay strict.
+float PartBoxes::centre(std::uint32_t p, std::size_t a) const {
+    const float c = f_[p].lo[a] + f_[p].hi[a];
+    return std::isfinite(c) ? c : 0.0f;
 }
 
-}  // namespace
+// Splits order[first, last) at its median along its centres' widest axis (ties by index).
+std::size_t PartBoxes::halve(std::vector<std::uint32_t>& order, std::size_t first,
+                             std::size_t last) const {
+    std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+    for (std::size_t i = first; i < last; ++i)
+        for (std::size_t a = 0; a < 3; ++a)
+            lo[a] = std::min(lo[a], centre(order[i], a)),
+            hi[a] = std::max(hi[a], centre(order[i], a));
+    std::size_t axis = 0;
+    for (std::size_t a = 1; a < 3; ++a)
+        if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+    const std::size_t mid = first + (last - first) / 2;
+    const auto at = [&](std::size_t i) { return order.begin() + static_cast<std::ptrdiff_t>(i); };
+    std::nth_element(at(first), at(mid), at(last), [&](std::uint32_t x, std::uint32_t y) {
+        return centre(x, axis) < centre(y, axis) || (centre(x, axis) == centre(y, axis) && x < y);
+    });
+    return mid;
+}
 
-// Top down, four children a node: the parts' centres are split at the median along their
-// widest axis, and each half again along its own, until a group holds four parts or fewer
-// (a leaf). Children are made before their parent, so the root is the last node.
+// The node over order[first, last): a leaf of its parts when they are four or fewer, else a
+// node over its quarters (its halves halved). Children are made before their parent, so the
+// root is the last node.
+PartBoxes::Made PartBoxes::make_node(std::vector<std::uint32_t>& order, std::size_t first,
+                                     std::size_t last) {
+    Node node{};
+    Made made{0, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    const auto hold = [&](std::uint32_t child, const std::array<float, 3>& lo,
+                          const std::array<float, 3>& hi) {
+        const std::size_t lane = node.count++;
+        node.child[lane] = child;
+        for (std::size_t a = 0; a < 3; ++a) {
+            node.box.lo[a][lane] = lo[a], node.box.hi[a][lane] = hi[a];
+            made.lo[a] = std::min(made.lo[a], lo[a]), made.hi[a] = std::max(made.hi[a], hi[a]);
+        }
+    };
+    node.leaf = last - first <= 4;
+    if (node.leaf) {
+        for (std::size_t i = first; i < last; ++i) {
+            const Box4& b = f_[order[i]];
+            hold(order[i], {b.lo[0], b.lo[1], b.lo[2]}, {b.hi[0], b.hi[1], b.hi[2]});
+        }
+    } else {
+        const std::size_t mid = halve(order, first, last);
+        const std::array<std::size_t, 5> cut{first, halve(order, first, mid), mid,
+                                             halve(order, mid, last), last};
+        for (std::size_t c = 0; c < 4; ++c) {
+            if (cut[c] == cut[c + 1]) continue;
+            const Made m = make_node(order, cut[c], cut[c + 1]);
+            hold(m.node, m.lo, m.hi);
+        }
+    }
+    nodes_.push_back(node);
+    made.node = static_cast<std::uint32_t>(nodes_.size() - 1);
+    return made;
+}
+
+// Top down, four children a node, split at medians of the parts' centres.
 void PartBoxes::build_tree() {
     std::vector<std::uint32_t> order(f_.size());
     std::iota(order.begin(), order.end(), 0u);
-    // (Twice the centre; 0 for a box without one, so that the order stays a strict one.)
-    const auto centre = [&](std::uint32_t p, std::size_t a) {
-        const float c = f_[p].lo[a] + f_[p].hi[a];
-        return std::isfinite(c) ? c : 0.0f;
-    };
-    // Splits order[first, last) at its median along its centres' widest axis.
-    const auto halve = [&](std::size_t first, std::size_t last) {
-        std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-        for (std::size_t i = first; i < last; ++i)
-            for (std::size_t a = 0; a < 3; ++a)
-                lo[a] = std::min(lo[a], centre(order[i], a)),
-                hi[a] = std::max(hi[a], centre(order[i], a));
-        std::size_t axis = 0;
-        for (std::size_t a = 1; a < 3; ++a)
-            if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
-        const std::size_t mid = first + (last - first) / 2;
-        std::nth_element(order.begin() + static_cast<std::ptrdiff_t>(first),
-                         order.begin() + static_cast<std::ptrdiff_t>(mid),
-                         order.begin() + static_cast<std::ptrdiff_t>(last),
-                         [&](std::uint32_t x, std::uint32_t y) {
-                             return centre(x, axis) < centre(y, axis) ||
-                                    (centre(x, axis) == centre(y, axis) && x < y);
-                         });
-        return mid;
-    };
-    struct Made {
-        std::uint32_t node;
-        std::array<float, 3> lo, hi;  // the box of all it holds
-    };
-    const auto make = [&](auto&& self, std::size_t first, std::size_t last) -> Made {
-        Node node{};
-        std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-        const auto hold = [&](std::size_t lane, std::uint32_t child, const std::array<float, 3>& l,
-                              const std::array<float, 3>& h) {
-            node.child[lane] = child;
-            set_lane(node.box, lane, l, h);
-            for (std::size_t a = 0; a < 3; ++a)
-                lo[a] = std::min(lo[a], l[a]), hi[a] = std::max(hi[a], h[a]);
-        };
-        if (last - first <= 4) {
-            node.leaf = true;
-            node.count = static_cast<std::uint32_t>(last - first);
-            for (std::size_t i = first; i < last; ++i) {
-                const Box4& b = f_[order[i]];
-                hold(i - first, order[i], {b.lo[0], b.lo[1], b.lo[2]}, {b.hi[0], b.hi[1], b.hi[2]});
-            }
-        } else {
-            const std::size_t mid = halve(first, last);
-            const std::array<std::size_t, 5> cut{first, halve(first, mid), mid, halve(mid, last),
-                                                 last};
-            node.count = 0;
-            for (std::size_t c = 0; c < 4; ++c) {
-                if (cut[c] == cut[c + 1]) continue;
-                const Made m = self(self, cut[c], cut[c + 1]);
-                hold(node.count++, m.node, m.lo, m.hi);
-            }
-        }
-        nodes_.push_back(node);
-        return {static_cast<std::uint32_t>(nodes_.size() - 1), lo, hi};
-    };
-    make(make, 0, order.size());
+    make_node(order, 0, order.size());
 }
 
 bool PartBoxes::Ray4::tame(const Grow& g) const {

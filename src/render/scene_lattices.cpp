@@ -51,11 +51,11 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     // A primitive answered by its own crossings reads its table only as a CSG leaf (spans,
     // `inside`): the lattice asked for serves it there, and elsewhere no table is loaded or
     // built (the first run of Plates 3, 4 and 5 and of the furry bunny built a 4 MB table,
-    // 0.4 s, that no ray read). On each instance its
-    // sub-rays, and so its culling, span at most kSubRayWidening times the widest footprint of
-    // the camera's pixels on that instance (AccelObject::widest_footprint): the farthest
-    // instance's is 1.4 times the nearest's on Plates 4 and 5, 1.9 times on the furry bunny,
-    // 3.7 on grass. The shape's own bound is the widest over its instances.
+    // 0.4 s, that no ray read). On each instance its sub-rays, and so its culling, span at
+    // most kSubRayWidening times the widest footprint of the camera's pixels on that instance
+    // (AccelObject::widest_footprint): the farthest instance's is 1.4 times the nearest's on
+    // Plates 4 and 5, 1.9 times on the furry bunny, 3.7 on grass. The shape's own bound is the
+    // widest over its instances; above 0 exactly when the shape answers by its crossings.
     const TableContext base = plan_table(p, spec, scene.file).context;
     const bool lod = filtering.lod && filtering.spread > 0;
     std::pair<int, int> range{0, 0};
