@@ -45,7 +45,7 @@ public:
                       double tmin, double tmax) const;
     // Lists up to this long are intersected without their boxes: for so few parts, preparing
     // the four-lane test costs more than the exact tests it saves (Plate 4 in `candidates`, hair
-    // lists of about 3 parts: 77 -> 69 ms; Plate 5 99 -> 90; the tufts' longer lists unchanged).
+    // lists of about 3 parts: 76 -> 72 ms; Plate 5 100 -> 91; the tufts' longer lists unchanged).
     static constexpr std::size_t kFewParts = 8;
     // The parts, in order, whose box grown by `grow` on every side the ray's line meets after
     // tmin: all that a ray parallel to r within grow of its line can meet there (same t). out
