@@ -270,19 +270,28 @@ TEST(PartBoxes, AnUnboundedPartLeavesTheTreeAnsweringAsTheFlatScan) {
     }
 }
 
+// Ten spheres of radius r up the box, wandering in x and y at frequencies fx and fy, chained
+// by cylinders of the same radius.
+struct WavyHair {
+    std::vector<ChainSphere> spheres;
+    std::vector<ChainCylinder> cylinders;
+    WavyHair(double fx, double fy, double r) {
+        for (int i = 0; i < 10; ++i) {
+            spheres.push_back({{3.5 + std::sin(i * fx), 3.5 + std::cos(i * fy), 1 + 1.8 * i}, r});
+            if (i > 0) cylinders.push_back({i - 1, i, r});
+        }
+    }
+};
+
 // A union's first crossing over its parts, box-tested first (what filtered lattices blend in),
 // is the primitive's own, bit for bit: the same t, part and stored point, and none where it has
 // none; rays aimed at joints (where a sphere and its cylinders meet) and grazing the hair.
 TEST(PartBoxes, FirstCrossingOverAllPartsIsTheUnions) {
     std::mt19937 rng(9);
     std::uniform_real_distribution<double> u(0, 1);
-    std::vector<ChainSphere> spheres;
-    std::vector<ChainCylinder> cylinders;
-    for (int i = 0; i < 10; ++i) {
-        spheres.push_back({{3.5 + std::sin(i * 0.7), 3.5 + std::cos(i * 0.5), 1 + 1.8 * i}, 0.3});
-        if (i > 0) cylinders.push_back({i - 1, i, 0.3});
-    }
-    const ChainShape hair(spheres, cylinders);
+    const WavyHair wavy(0.7, 0.5, 0.3);
+    const std::vector<ChainSphere>& spheres = wavy.spheres;
+    const ChainShape hair(spheres, wavy.cylinders);
     const PartBoxes boxes(hair, Bounds3{{0, 0, 0}, {7, 7, 20}});
     std::vector<std::uint32_t> all(hair.primitive_count());
     for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
@@ -313,13 +322,9 @@ TEST(PartBoxes, FirstCrossingOverAllPartsIsTheUnions) {
 TEST(PartBoxes, ListsOfEveryLengthAnswerAsALoopOverTheirParts) {
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> u(0, 1);
-    std::vector<ChainSphere> spheres;
-    std::vector<ChainCylinder> cylinders;
-    for (int i = 0; i < 10; ++i) {
-        spheres.push_back({{3.5 + std::sin(i * 0.9), 3.5 + std::cos(i * 0.4), 1 + 1.8 * i}, 0.35});
-        if (i > 0) cylinders.push_back({i - 1, i, 0.35});
-    }
-    const ChainShape hair(spheres, cylinders);
+    const WavyHair wavy(0.9, 0.4, 0.35);
+    const std::vector<ChainSphere>& spheres = wavy.spheres;
+    const ChainShape hair(spheres, wavy.cylinders);
     const PartBoxes boxes(hair, Bounds3{{0, 0, 0}, {7, 7, 20}});
     int boxed_hits = 0, short_hits = 0;
     for (int n = 0; n < 20000; ++n) {
