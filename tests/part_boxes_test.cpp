@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <tuple>
 
 #include "geometry/chain.h"
 #include "lattice/part_boxes.h"
@@ -283,16 +284,25 @@ struct WavyHair {
     }
 };
 
+// A wavy hair as a chain, with its parts' boxes in the Plate 4 hair's lattice box.
+struct WavyHairBoxes {
+    WavyHair wavy;
+    ChainShape hair;
+    PartBoxes boxes;
+    WavyHairBoxes(double fx, double fy, double r)
+        : wavy(fx, fy, r),
+          hair(wavy.spheres, wavy.cylinders),
+          boxes(hair, {{0, 0, 0}, {7, 7, 20}}) {}
+};
+
 // A union's first crossing over its parts, box-tested first (what filtered lattices blend in),
 // is the primitive's own, bit for bit: the same t, part and stored point, and none where it has
 // none; rays aimed at joints (where a sphere and its cylinders meet) and grazing the hair.
 TEST(PartBoxes, FirstCrossingOverAllPartsIsTheUnions) {
     std::mt19937 rng(9);
     std::uniform_real_distribution<double> u(0, 1);
-    const WavyHair wavy(0.7, 0.5, 0.3);
-    const std::vector<ChainSphere>& spheres = wavy.spheres;
-    const ChainShape hair(spheres, wavy.cylinders);
-    const PartBoxes boxes(hair, Bounds3{{0, 0, 0}, {7, 7, 20}});
+    const WavyHairBoxes h(0.7, 0.5, 0.3);
+    const auto& [spheres, hair, boxes] = std::tie(h.wavy.spheres, h.hair, h.boxes);
     std::vector<std::uint32_t> all(hair.primitive_count());
     for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
     int hits = 0;
@@ -322,10 +332,8 @@ TEST(PartBoxes, FirstCrossingOverAllPartsIsTheUnions) {
 TEST(PartBoxes, ListsOfEveryLengthAnswerAsALoopOverTheirParts) {
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> u(0, 1);
-    const WavyHair wavy(0.9, 0.4, 0.35);
-    const std::vector<ChainSphere>& spheres = wavy.spheres;
-    const ChainShape hair(spheres, wavy.cylinders);
-    const PartBoxes boxes(hair, Bounds3{{0, 0, 0}, {7, 7, 20}});
+    const WavyHairBoxes h(0.9, 0.4, 0.35);
+    const auto& [spheres, hair, boxes] = std::tie(h.wavy.spheres, h.hair, h.boxes);
     int boxed_hits = 0, short_hits = 0;
     for (int n = 0; n < 20000; ++n) {
         std::vector<std::uint32_t> listed;

@@ -72,9 +72,8 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
       exact_width_(exact_width),
       sub_ray_reach_(farthest_sub_ray(exact_width)) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
-    assert(std::all_of(levels.begin(), levels.end(), [&](const FilterLevel& l) {
-        return l.ctx.primitive == primitive_ && (l.table || exact_);
-    }));
+    assert(std::all_of(levels.begin(), levels.end(),
+                       [&](const FilterLevel& l) { return l.ctx.primitive == primitive_; }));
     // scene_lattices leaves the table out only where exact_ holds (the same rule): without it,
     // add_tables would read null.
     for (const FilterLevel& l : levels)

@@ -99,6 +99,14 @@ void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Term
     }
 }
 
+// visible for for_each_light and shade_with where nothing is partly covered: the light
+// arrives whole (1) unless the shadow ray, leaving object self, meets something (0).
+inline auto hard_shadows(const RenderScene& rs, std::uint32_t self) {
+    return [&rs, self](std::size_t, const Ray& r, double tmin, double tmax, double) {
+        return rs.occluded(r, tmin, tmax, self) ? 0.0 : 1.0;
+    };
+}
+
 // Phong with shadows; visible(light's index, shadow ray, tmin, tmax, distance) is the share of
 // the light that arrives: 0 or 1 for shade(), a transmittance through partial hits for layered
 // rays (render/layers.h), a shadow map's for particle mode's base.

@@ -199,9 +199,7 @@ RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const R
         Vec3 nf = normalize(base.xf.normal(t.normal));
         if (dot(nf, v) < 0) nf = -nf;
         Vec3 bare = m.ka * m.color * scene.ambient, furred = fur.ka * t.colour * scene.ambient;
-        auto visible = [&](std::size_t, const Ray& r, double tmin, double tmax, double) {
-            return rs.occluded(r, tmin, tmax, hit.object) ? 0.0 : 1.0;
-        };
+        const auto visible = hard_shadows(rs, hit.object);
         // Both surfaces' terms: a light that adds to neither casts no shadow ray.
         struct Terms {
             Vec3 bare, furred;
