@@ -37,6 +37,11 @@ public:
         c_.intersect.fetch_add(1, std::memory_order_relaxed);
         return s_->intersect(r, tmin, tmax, hit);
     }
+    int sheets(const lat::Ray& r, double tmin, double tmax,
+               std::span<lat::Crossing, kMaxSheets> out) const override {
+        c_.intersect.fetch_add(1, std::memory_order_relaxed);
+        return s_->sheets(r, tmin, tmax, out);
+    }
     bool occluded(const lat::Ray& r, double tmin, double tmax) const override {
         c_.occluded.fetch_add(1, std::memory_order_relaxed);
         return s_->occluded(r, tmin, tmax);

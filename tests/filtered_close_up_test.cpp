@@ -3,6 +3,8 @@
 // across its footprint (answered_by_primitive), not with its tables.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <bit>
 #include <cmath>
 #include <random>
 
@@ -213,6 +215,86 @@ TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
         expect_sheets_are_their_sub_rays_crossings(long_hook(), shadow, shadow ? 700 : 1500);
         expect_sheets_are_their_sub_rays_crossings(bitten_tori(), shadow, shadow ? 300 : 600);
     }
+}
+
+// A camera ray's sheets (Shape::sheets) split its sub-rays by depth: the sub-rays that meet the
+// primitive within kSheetDepth footprint widths of the nearest make the first sheet, those
+// within that of the nearest left the next, each sheet the mean of its sub-rays' points and
+// normals and their share as the coverage, in ray order; together, intersect's one sheet. With
+// the world's directions across the ray only; without them, intersect's sheet.
+TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
+    const HookLattice h = hook_lattice(long_hook());
+    const FilteredLatticeShape& s = *h.exact;
+    const Bounds3 box{{0, 0, 0}, Vec3{4, 2, 4}};
+    const int n = kExactSubRays;
+    int split = 0, whole = 0;
+    for (const double footprint : {0.4, 1.0, kExactWidth}) {
+        set_ray_footprint({footprint, 0, false});
+        for (const Ray& r : rays(2000)) {
+            const ScopedAcrossRay across(r.d);  // unit: the world's directions are r's basis
+            set_across_ray_in_object(Affine{}, true, true, kInfinity);
+            // Each sub-ray's first crossing, as the grid of
+            // expect_sheets_are_their_sub_rays_crossings.
+            std::array<double, kSubRays> t;
+            std::array<Vec3, kSubRays> p, nrm;
+            unsigned met = 0;
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j) {
+                    const int k = i * n + j;
+                    const Vec3 offset = across_ray().u * (((i + 0.5) / n - 0.5) * footprint) +
+                                        across_ray().v * (((j + 0.5) / n - 0.5) * footprint);
+                    const Ray sub{r.o + offset, r.d};
+                    double t0 = 0, t1 = kInfinity;
+                    Crossing c;
+                    if (!clip_ray(box, sub, t0, t1) || !long_hook().intersect(sub, t0, t1, c))
+                        continue;
+                    met |= 1u << k;
+                    t[k] = c.t, p[k] = sub.at(c.t), nrm[k] = normalize(long_hook().normal(sub, c));
+                }
+            std::array<Crossing, Shape::kMaxSheets> got;
+            const int count = s.sheets(r, 0.0, kInfinity, got);
+            int expected = 0;
+            for (unsigned left = met; left != 0; ++expected) {
+                double nearest = kInfinity;
+                for (int k = 0; k < kSubRays; ++k)
+                    if (left >> k & 1) nearest = std::min(nearest, t[k]);
+                unsigned group = 0;
+                Vec3 mean_p, mean_n;
+                for (int k = 0; k < kSubRays; ++k)
+                    if (left >> k & 1 && t[k] <= nearest + kSheetDepth * footprint)
+                        group |= 1u << k, mean_p += p[k], mean_n += nrm[k];
+                left &= ~group;
+                ASSERT_LT(expected, count) << "footprint " << footprint;
+                const Crossing& c = got[static_cast<std::size_t>(expected)];
+                const double share = double(std::popcount(group)) / kSubRays;
+                EXPECT_EQ(c.sub_rays, group);
+                EXPECT_NEAR(c.coverage, share, 1e-6);
+                EXPECT_NEAR(length(c.stored.p - mean_p / std::popcount(group)), 0.0, 1e-6);
+                EXPECT_NEAR(length(c.stored.n - mean_n / std::popcount(group)), 0.0, 1e-6);
+                if (expected > 0) {
+                    EXPECT_GT(c.t, got[static_cast<std::size_t>(expected - 1)].t);
+                }
+            }
+            EXPECT_EQ(count, expected);
+            split += count > 1;
+            whole += count == 1;
+            // Together: intersect's one sheet.
+            Crossing one;
+            ASSERT_EQ(s.intersect(r, 0.0, kInfinity, one), met != 0);
+            if (met != 0) {
+                EXPECT_EQ(one.sub_rays, met);
+            }
+            // Without the world's directions: that one sheet.
+            clear_across_ray_in_object();
+            if (met != 0) {
+                ASSERT_EQ(s.sheets(r, 0.0, kInfinity, got), 1);
+                EXPECT_NEAR(got[0].t, one.t, 1e-9);
+            }
+        }
+    }
+    set_ray_footprint({});
+    EXPECT_GT(split, 200);
+    EXPECT_GT(whole, 1000);
 }
 
 // Culling reaches as far as each ray's own sub-rays: a ray whose sheet has a crossing meets

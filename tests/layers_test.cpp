@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -197,6 +198,74 @@ double specular_integral(double normal_length) {
                std::sin(theta) * (M_PI / 2) / steps;
     }
     return sum;
+}
+
+// A lattice whose sub-rays meet it at two depths (Shape::sheets): half of them on a unit square
+// at height z, the other half at z + dz; culled by several boxes, as Sheet.
+class TwoSheets final : public Shape {
+public:
+    TwoSheets(double z, double dz) : z_(z), dz_(dz) {}
+    Bounds3 bounds() const override { return {{-1, -1, z_ - 0.01}, {1, 1, z_ + dz_ + 0.01}}; }
+    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override {
+        std::array<Crossing, kMaxSheets> c;
+        if (sheets(r, tmin, tmax, c) == 0) return false;
+        hit = c[0];
+        return true;
+    }
+    int sheets(const Ray& r, double tmin, double tmax,
+               std::span<Crossing, kMaxSheets> out) const override {
+        int n = 0;
+        for (const auto& [z, sub_rays] : {std::pair{z_, 0b0011}, std::pair{z_ + dz_, 0b1100}}) {
+            const double t = (z - r.o.z) / r.d.z;
+            if (!(t > tmin && t < tmax)) continue;
+            Crossing& c = out[static_cast<std::size_t>(n++)];
+            c = Crossing(t, 0, SurfacePoint{r.at(t), {0, 0, 1}});
+            c.coverage = 0.5f;
+            c.sub_rays = static_cast<std::uint8_t>(sub_rays);
+        }
+        return n;
+    }
+    void spans(const Ray&, SpanList&) const override {}
+    Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
+    bool inside(Vec3) const override { return false; }
+    std::size_t cull_count() const override { return 3; }
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf, double) const override {
+        return xf.bounds(Bounds3{{-1, -1, z_ - 6.0 * double(i) - 0.01}, {1, 1, z_ + dz_ + 0.01}});
+    }
+
+private:
+    double z_, dz_;
+};
+
+// A camera ray keeps every sheet of an object, in ray order among the other objects' crossings,
+// once however many of its cull boxes the traversal meets; a sheet beyond an opaque crossing
+// is cut.
+TEST(Layers, AnObjectsSheetsAreEachKeptOnce) {
+    const TwoSheets two(1, 2);
+    const Sheet between(2, 0.3f, 3), opaque(2.5, 1.0f, 3);
+    const Transform xf;
+    const std::vector<AccelObject> objects{{&two, &xf}, {&between, &xf}};
+    const EmbreeAccel accel(objects);
+    AccelHit hit;
+    std::vector<AccelHit> partial;
+    EXPECT_FALSE(accel.intersect_layers(kUp, 0, kInfinity, EmbreeAccel::kNoObject, hit, partial));
+    ASSERT_EQ(partial.size(), 3u);
+    const double t[] = {1, 2, 3};
+    const std::uint32_t object[] = {0, 1, 0};
+    for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_NEAR(partial[i].t, t[i], 1e-12);
+        EXPECT_EQ(partial[i].object, object[i]);
+    }
+    EXPECT_EQ(partial[0].crossing.sub_rays, 0b0011);
+    EXPECT_EQ(partial[2].crossing.sub_rays, 0b1100);
+
+    const std::vector<AccelObject> cut{{&two, &xf}, {&opaque, &xf}};
+    const EmbreeAccel cut_accel(cut);
+    EXPECT_TRUE(
+        cut_accel.intersect_layers(kUp, 0, kInfinity, EmbreeAccel::kNoObject, hit, partial));
+    EXPECT_NEAR(hit.t, 2.5, 1e-12);
+    ASSERT_EQ(partial.size(), 1u);
+    EXPECT_NEAR(partial[0].t, 1, 1e-12);
 }
 
 // Partial crossings compose: without sub-rays as independent draws (what is left is the

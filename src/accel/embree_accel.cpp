@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cassert>
 #include <cmath>
@@ -129,10 +130,11 @@ struct QueryContext {
     }
     // A camera ray's partial crossing: the crossings are kept in ray order and cut where
     // compositing will stop (LayerStop), and tmax and the traversal's tfar come down to the
-    // last one kept.
-    void add_camera_partial(const AccelHit& h, float& tfar) {
+    // last one kept. more: another sheet of the object whose first this visit added
+    // (Shape::sheets); an object visited again adds nothing.
+    void add_camera_partial(const AccelHit& h, float& tfar, bool more = false) {
         assert(!stop.shadow());
-        if (met_already(h.object)) return;
+        if (!more && met_already(h.object)) return;
         partial->insert(std::upper_bound(partial->begin(), partial->end(), h, in_ray_order), h);
         if (stop.max_layers <= 0) return;
         LayerComposite seen;
@@ -439,19 +441,34 @@ struct EmbreeAccel::Impl {
         assert(!ctx->stop.shadow());  // shadow rays: occluded_cb, blocks_transmittance
         const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
         const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
+        auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+        const unsigned geom = args->geomID, prim = args->primID;
+        const unsigned placed = K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID;
+        if constexpr (K == Kind::kDirect)
+            if (ctx->partial)
+                return self->add_sheets(ctx, rh, t.object, shape, local, tmin, tmax, geom, prim);
         Crossing c;
         const bool hit = K == Kind::kDirect
                              ? shape.intersect(local, tmin, tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, tmax, c);
-        if (!hit) return;
-        auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
-        // Partial crossings are kept, and the ray goes on.
-        if (ctx->partial && c.coverage < 1.0f) {
-            ctx->add_camera_partial(self->caller_hit(c.t, t.object, c), rh->ray.tfar);
+        if (hit) self->record(ctx, rh, t.object, c, geom, prim, placed);
+    }
+
+    // A camera ray through partial crossings: the object's sheets, partial ones kept (the ray
+    // goes on), in ray order up to the first opaque one, recorded as the hit.
+    void add_sheets(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Shape& shape,
+                    const Ray& local, double tmin, double tmax, unsigned geom,
+                    unsigned prim) const {
+        std::array<Crossing, Shape::kMaxSheets> c;
+        const int n = shape.sheets(local, tmin, tmax, c);
+        for (int i = 0; i < n; ++i) {
+            if (c[i].coverage < 1.0f) {
+                ctx->add_camera_partial(caller_hit(c[i].t, obj, c[i]), rh->ray.tfar, i > 0);
+                continue;
+            }
+            record(ctx, rh, obj, c[i], geom, prim, RTC_INVALID_GEOMETRY_ID);
             return;
         }
-        self->record(ctx, rh, t.object, c, args->geomID, args->primID,
-                     K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID);
     }
 
     // A shadow ray's transmittance (intersect_layers with LayerStop::blocked_below), traced by
@@ -694,6 +711,8 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     } else if (traceable)
         trace_closest(m.scene, ctx, r, tmin, tmax);
     const bool blocked = ctx.found && stop.shadow();
+    // Unbounded shapes answer their closest crossing: only a lattice, which has a box, has
+    // several sheets (Shape::sheets).
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;
         const Placed& o = m.objects[i];

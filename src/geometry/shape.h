@@ -130,6 +130,15 @@ public:
 
     // The closest boundary crossing with tmin < t < tmax.
     virtual bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const = 0;
+    // A camera ray's surfaces through partial coverage (render/layers.h): at most kMaxSheets
+    // crossings with tmin < t < tmax, in ray order; returns how many. A prefiltered lattice
+    // answered by its sub-rays gives one per depth at which they meet it (a tuft's strands one
+    // behind the other), each shaded as its own surface; every other shape its closest crossing.
+    static constexpr int kMaxSheets = 4;
+    virtual int sheets(const Ray& r, double tmin, double tmax,
+                       std::span<Crossing, kMaxSheets> out) const {
+        return intersect(r, tmin, tmax, out[0]) ? 1 : 0;
+    }
     // Whether any boundary crossing has tmin < t < tmax (shadow rays).
     virtual bool occluded(const Ray& r, double tmin, double tmax) const {
         Crossing c;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <stdexcept>
@@ -213,23 +214,70 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
 
 bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
                                  Crossing& hit) const {
-    const double dd = dot(r.d, r.d);
-    const double width = footprint_width(r);
     Sheet s;
     double finer = 0;  // how many levels finer than the finest table the footprint is
     if (exact_) {
-        // The instance's own bound, by which its culling was narrowed (cull_bounds).
-        const double widest = std::min(exact_width_, across_ray_in_object().widest);
-        add_exact(std::min(width, widest), normal, r, tmin, tmax, s);
+        SubRayHits h;
+        exact_sub_rays(sub_ray_width(r), normal, r, tmin, tmax, h);
+        add_sub_rays(h, h.met, s);
     } else {
         // Rays without a footprint read the finest table.
+        const double width = footprint_width(r);
         const double top = double(levels_.size() - 1);
         const double wanted = width > 0 ? lod_level(levels_.front().frame.cell(), width) : top;
         const double level = std::clamp(wanted, 0.0, top);
         finer = std::max(0.0, wanted - level);
         add_tables(level, normal, r, tmin, s);
     }
+    return to_crossing(s, finer, r, tmin, tmax, normal, hit);
+}
+
+int FilteredLatticeShape::sheets(const Ray& r, double tmin, double tmax,
+                                 std::span<Crossing, kMaxSheets> out) const {
+    const bool normal = !t_footprint.coverage_only;
+    // Sheets of sub-rays are told apart only where they compose sub-ray by sub-ray
+    // (LayerComposite): with the world's directions across the ray.
+    if (!exact_ || !normal || !across_ray_in_object().set)
+        return sheet(r, tmin, tmax, normal, out[0]) ? 1 : 0;
+    SubRayHits h;
+    const double width = sub_ray_width(r);
+    exact_sub_rays(width, true, r, tmin, tmax, h);
+    const double depth = kSheetDepth * width / std::sqrt(dot(r.d, r.d));  // in r's parameter
+    int n = 0;
+    // Front to back: the sub-rays within `depth` of the nearest one left make the next sheet.
+    for (unsigned left = h.met; left != 0;) {
+        double nearest = kInfinity;
+        for (unsigned m = left; m != 0; m &= m - 1)
+            nearest = std::min(nearest, h.t[std::countr_zero(m)]);
+        unsigned group = 0;
+        for (unsigned m = left; m != 0; m &= m - 1)
+            if (const int k = std::countr_zero(m); h.t[k] <= nearest + depth) group |= 1u << k;
+        left &= ~group;
+        Sheet s;
+        add_sub_rays(h, group, s);
+        if (to_crossing(s, 0, r, tmin, tmax, true, out[static_cast<std::size_t>(n)])) ++n;
+    }
+    return n;
+}
+
+double FilteredLatticeShape::sub_ray_width(const Ray& r) const {
+    // The instance's own bound, by which its culling was narrowed (cull_bounds).
+    return std::min({footprint_width(r), exact_width_, across_ray_in_object().widest});
+}
+
+void FilteredLatticeShape::add_sub_rays(const SubRayHits& h, unsigned which, Sheet& s) {
+    constexpr double w = 1.0 / kSubRays;
+    for (unsigned m = which; m != 0; m &= m - 1) {
+        const int k = std::countr_zero(m);
+        s.add_opaque(w, h.p[k], h.n[k]);
+        s.sub_rays |= static_cast<std::uint8_t>(1u << k);
+    }
+}
+
+bool FilteredLatticeShape::to_crossing(const Sheet& s, double finer, const Ray& r, double tmin,
+                                       double tmax, bool normal, Crossing& hit) const {
     if (s.alpha <= 1e-6) return false;
+    const double dd = dot(r.d, r.d);
     const Vec3 p = s.p / s.alpha;
     const double t = dot(p - r.o, r.d) / dd;
     if (!(t > tmin && t < tmax)) return false;
@@ -300,15 +348,15 @@ void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, d
 
 // The crossings of kExactSubRays^2 sub-rays parallel to r, on a grid across its footprint (for
 // camera rays the pixel's box filter, as exact mode at that many samples would, but on this
-// primitive only and shaded once). A camera ray's are those of the sub-rays' chords through the
-// box, however far r may go (tmax): what the tables answer does not depend on the order in
-// which the accelerator meets objects either, and the sheet is cut at tmax after. A shadow ray
+// primitive only and shaded once a depth: sheets). A camera ray's are those of the sub-rays' chords
+// through the box, however far r may go (tmax): what the tables answer does not depend on the order
+// in which the accelerator meets objects either, and the sheet is cut at tmax after. A shadow ray
 // wants only the share of its sub-rays blocked before tmax (the light), not where: any part's
 // crossing ends a sub-ray's tests, and the sheet lies halfway along the blocked ones' chords.
 // The footprint's width is taken across the ray as along it (instances scaled uniformly, as
 // instance_footprints assumes).
-void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, double tmin,
-                                     double tmax, Sheet& s) const {
+void FilteredLatticeShape::exact_sub_rays(double width, bool normal, const Ray& r, double tmin,
+                                          double tmax, SubRayHits& h) const {
     constexpr int n = kExactSubRays;
     // Along the world's directions across the ray where the renderer set them, so that the
     // k-th sub-ray is the same in every lattice (geometry/sub_rays.h).
@@ -321,7 +369,6 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
     } else {
         orthonormal_basis(r.d / length(r.d), u, v);
     }
-    constexpr double w = 1.0 / (n * n);
     // A union's sub-rays meet only parts near r: found once, with boxes grown by the farthest
     // sub-ray's distance from r, at least its offset along any axis. Plates 4 and 5 render 6 %
     // faster than with every part intersected by every sub-ray; images identical. (Boxes grown
@@ -353,21 +400,21 @@ void FilteredLatticeShape::add_exact(double width, bool normal, const Ray& r, do
             if (q.tmin[k] < q.tmax[k]) live |= 1u << k;
         }
     if (!normal) {
-        const unsigned blocked = blocked_sub_rays(parts, q, live);
-        for (int k = 0; k < kSubRays; ++k)
-            if (blocked >> k & 1)
-                s.add_opaque(w, q.ray(k).at(0.5 * (q.tmin[k] + q.tmax[k])), {}),
-                    s.sub_rays |= static_cast<std::uint8_t>(1u << k);
+        h.met = blocked_sub_rays(parts, q, live);
+        for (unsigned m = h.met; m != 0; m &= m - 1) {
+            const int k = std::countr_zero(m);
+            h.t[k] = 0.5 * (q.tmin[k] + q.tmax[k]);
+            h.p[k] = q.ray(k).at(h.t[k]), h.n[k] = {};
+        }
         return;
     }
     QuadCrossings hits;
-    const unsigned found = sub_ray_crossings(parts, q, live, hits);
-    for (int k = 0; k < kSubRays; ++k) {
-        if (!(found >> k & 1)) continue;
+    h.met = sub_ray_crossings(parts, q, live, hits);
+    for (unsigned m = h.met; m != 0; m &= m - 1) {
+        const int k = std::countr_zero(m);
         const SurfacePoint sp = primitive_->surface(q.ray(k), hits.c[k]);
         const double ln = length(sp.n);
-        s.add_opaque(w, sp.p, ln > 0 ? sp.n / ln : Vec3{});
-        s.sub_rays |= static_cast<std::uint8_t>(1u << k);
+        h.t[k] = hits.c[k].t, h.p[k] = sp.p, h.n[k] = ln > 0 ? sp.n / ln : Vec3{};
     }
 }
 
