@@ -38,7 +38,7 @@ public:
         return s_->intersect(r, tmin, tmax, hit);
     }
     int sheets(const lat::Ray& r, double tmin, double tmax,
-               std::span<lat::Crossing, kMaxSheets> out) const override {
+               std::span<lat::SheetCrossing, kMaxSheets> out) const override {
         c_.intersect.fetch_add(1, std::memory_order_relaxed);
         return s_->sheets(r, tmin, tmax, out);
     }

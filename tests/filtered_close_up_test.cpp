@@ -220,8 +220,9 @@ TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
 // A camera ray's sheets (Shape::sheets) split its sub-rays by depth: the sub-rays that meet the
 // primitive within kSheetDepth footprint widths of the nearest make the first sheet, those
 // within that of the nearest left the next, each sheet the mean of its sub-rays' points and
-// normals and their share as the coverage, in ray order; together, intersect's one sheet. With
-// the world's directions across the ray only; without them, intersect's sheet.
+// normals and their share as the coverage, with the sub-rays' own normals, in ray order;
+// together, intersect's one sheet. With the world's directions across the ray only; without
+// them, intersect's sheet (no normals).
 TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
     const HookLattice h = hook_lattice(long_hook());
     const FilteredLatticeShape& s = *h.exact;
@@ -251,7 +252,7 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
                     met |= 1u << k;
                     t[k] = c.t, p[k] = sub.at(c.t), nrm[k] = normalize(long_hook().normal(sub, c));
                 }
-            std::array<Crossing, Shape::kMaxSheets> got;
+            std::array<SheetCrossing, Shape::kMaxSheets> got;
             const int count = s.sheets(r, 0.0, kInfinity, got);
             int expected = 0;
             for (unsigned left = met; left != 0; ++expected) {
@@ -265,14 +266,20 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
                         group |= 1u << k, mean_p += p[k], mean_n += nrm[k];
                 left &= ~group;
                 ASSERT_LT(expected, count) << "footprint " << footprint;
-                const Crossing& c = got[static_cast<std::size_t>(expected)];
+                const Crossing& c = got[static_cast<std::size_t>(expected)].crossing;
+                const SubRayNormals& normals = got[static_cast<std::size_t>(expected)].normals;
+                ASSERT_EQ(normals.count, std::popcount(group));
+                for (int k = 0, i = 0; k < kSubRays; ++k)
+                    if (group >> k & 1) {
+                        EXPECT_NEAR(length(normals.n[i++] - nrm[k]), 0.0, 1e-6);
+                    }
                 const double share = double(std::popcount(group)) / kSubRays;
                 EXPECT_EQ(c.sub_rays, group);
                 EXPECT_NEAR(c.coverage, share, 1e-6);
                 EXPECT_NEAR(length(c.stored.p - mean_p / std::popcount(group)), 0.0, 1e-6);
                 EXPECT_NEAR(length(c.stored.n - mean_n / std::popcount(group)), 0.0, 1e-6);
                 if (expected > 0) {
-                    EXPECT_GT(c.t, got[static_cast<std::size_t>(expected - 1)].t);
+                    EXPECT_GT(c.t, got[static_cast<std::size_t>(expected - 1)].crossing.t);
                 }
             }
             EXPECT_EQ(count, expected);
@@ -288,7 +295,8 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
             clear_across_ray_in_object();
             if (met != 0) {
                 ASSERT_EQ(s.sheets(r, 0.0, kInfinity, got), 1);
-                EXPECT_NEAR(got[0].t, one.t, 1e-9);
+                EXPECT_NEAR(got[0].crossing.t, one.t, 1e-9);
+                EXPECT_EQ(got[0].normals.count, 0);
             }
         }
     }
@@ -446,7 +454,7 @@ TEST(FilteredCloseUps, TheAcceleratorHandsEachInstanceItsBound) {
                                      i == 0 ? near_bound : kInfinity);
             Crossing c;
             if (s.intersect(xf.inverse_ray(world), 0.0, found ? out.t : kInfinity, c))
-                found = true, out = {c.t, i, c};
+                found = true, out = {c.t, i, c, {}};
         }
         return found;
     };

@@ -201,29 +201,36 @@ double specular_integral(double normal_length) {
 }
 
 // A lattice whose sub-rays meet it at two depths (Shape::sheets): half of them on a unit square
-// at height z, the other half at z + dz; culled by several boxes, as Sheet.
+// at height z, the other half at z + dz, each sheet with its sub-rays' normals (k sheet's
+// k-th: turned k + 1 about x); culled by several boxes, as Sheet.
 class TwoSheets final : public Shape {
 public:
     TwoSheets(double z, double dz) : z_(z), dz_(dz) {}
     Bounds3 bounds() const override { return {{-1, -1, z_ - 0.01}, {1, 1, z_ + dz_ + 0.01}}; }
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override {
-        std::array<Crossing, kMaxSheets> c;
+        std::array<SheetCrossing, kMaxSheets> c;
         if (sheets(r, tmin, tmax, c) == 0) return false;
-        hit = c[0];
+        hit = c[0].crossing;
         return true;
     }
     int sheets(const Ray& r, double tmin, double tmax,
-               std::span<Crossing, kMaxSheets> out) const override {
+               std::span<SheetCrossing, kMaxSheets> out) const override {
         int n = 0;
         for (const auto& [z, sub_rays] : {std::pair{z_, 0b0011}, std::pair{z_ + dz_, 0b1100}}) {
             const double t = (z - r.o.z) / r.d.z;
             if (!(t > tmin && t < tmax)) continue;
-            Crossing& c = out[static_cast<std::size_t>(n++)];
-            c = Crossing(t, 0, SurfacePoint{r.at(t), {0, 0, 1}});
-            c.coverage = 0.5f;
-            c.sub_rays = static_cast<std::uint8_t>(sub_rays);
+            SheetCrossing& s = out[static_cast<std::size_t>(n++)];
+            s.crossing = Crossing(t, 0, SurfacePoint{r.at(t), {0, 0, 1}});
+            s.crossing.coverage = 0.5f;
+            s.crossing.sub_rays = static_cast<std::uint8_t>(sub_rays);
+            s.normals.count = 2;
+            for (std::size_t k = 0; k < 2; ++k) s.normals.n[k] = normal_of(k, sub_rays);
         }
         return n;
+    }
+    static Vec3 normal_of(std::size_t k, int sub_rays) {
+        const double a = 0.1 * double(k + 1) * (sub_rays == 0b0011 ? 1 : -1);
+        return {0, std::sin(a), std::cos(a)};
     }
     void spans(const Ray&, SpanList&) const override {}
     Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
@@ -258,6 +265,13 @@ TEST(Layers, AnObjectsSheetsAreEachKeptOnce) {
     }
     EXPECT_EQ(partial[0].crossing.sub_rays, 0b0011);
     EXPECT_EQ(partial[2].crossing.sub_rays, 0b1100);
+    for (const std::size_t i : {0u, 2u}) {  // each with its sub-rays' normals
+        ASSERT_EQ(partial[i].normals.count, 2);
+        for (std::size_t k = 0; k < 2; ++k)
+            EXPECT_EQ(partial[i].normals.n[k],
+                      TwoSheets::normal_of(k, partial[i].crossing.sub_rays));
+    }
+    EXPECT_EQ(partial[1].normals.count, 0);
 
     const std::vector<AccelObject> cut{{&two, &xf}, {&opaque, &xf}};
     const EmbreeAccel cut_accel(cut);

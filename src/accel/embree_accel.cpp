@@ -290,7 +290,7 @@ struct EmbreeAccel::Impl {
     std::vector<std::uint32_t> numbered;  // an object's index given -> its index in objects
     // A crossing of objects[obj], under the number the caller gave the object.
     AccelHit caller_hit(double t, std::uint32_t obj, const Crossing& c) const {
-        return {t, objects[obj].original, c};
+        return {t, objects[obj].original, c, {}};
     }
     // The index in objects of the object the caller numbers given_self (kNoObject: none).
     std::uint32_t our_number(std::uint32_t given_self) const {
@@ -459,14 +459,19 @@ struct EmbreeAccel::Impl {
     void add_sheets(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Shape& shape,
                     const Ray& local, double tmin, double tmax, unsigned geom,
                     unsigned prim) const {
-        std::array<Crossing, Shape::kMaxSheets> c;
-        const int n = shape.sheets(local, tmin, tmax, c);
+        std::array<SheetCrossing, Shape::kMaxSheets> sheets;
+        const int n = shape.sheets(local, tmin, tmax, sheets);
         for (int i = 0; i < n; ++i) {
-            if (c[i].coverage < 1.0f) {
-                ctx->add_camera_partial(caller_hit(c[i].t, obj, c[i]), rh->ray.tfar, i > 0);
+            const Crossing& c = sheets[static_cast<std::size_t>(i)].crossing;
+            const SubRayNormals& normals = sheets[static_cast<std::size_t>(i)].normals;
+            if (c.coverage < 1.0f) {
+                AccelHit h = caller_hit(c.t, obj, c);
+                h.normals = normals;
+                ctx->add_camera_partial(h, rh->ray.tfar, i > 0);
                 continue;
             }
-            record(ctx, rh, obj, c[i], geom, prim, RTC_INVALID_GEOMETRY_ID);
+            record(ctx, rh, obj, c, geom, prim, RTC_INVALID_GEOMETRY_ID);
+            ctx->hit->normals = normals;
             return;
         }
     }

@@ -38,6 +38,7 @@ struct AccelHit {
     double t = 0;
     std::uint32_t object = 0;  // index into the objects given to the constructor
     Crossing crossing;         // in the object's coordinates (same t)
+    SubRayNormals normals;     // a sheet's (Shape::sheets), in the object's coordinates
 };
 
 // How far a traversal through partial crossings needs to go (intersect_layers).

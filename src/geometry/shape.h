@@ -2,6 +2,7 @@
 // The solid-shape interface: every leaf of the scene (quartic, sphere, sphere/cylinder chain,
 // lattice instance) and every CSG tree implements it in its own coordinates.
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -114,6 +115,19 @@ struct Crossing {
     bool flipped() const { return (leaf & kFlipBit) != 0; }
 };
 
+// The unit normals (shape space) of the sub-rays a prefiltered lattice's sheet is made of
+// (Shape::sheets): the renderer averages their shading terms, where a mean normal's would blur
+// a hair's highlight and terminator across the pixel. count 0 for every other crossing.
+struct SubRayNormals {
+    std::uint8_t count = 0;
+    std::array<Vec3, 4> n;
+};
+// One of a camera ray's sheets (Shape::sheets).
+struct SheetCrossing {
+    Crossing crossing;
+    SubRayNormals normals;
+};
+
 // One interval of a ray's line inside a solid: enters at in.t, leaves at out.t (in.t < out.t).
 // Unbounded solids give in.t = -infinity or out.t = +infinity.
 struct Span {
@@ -133,11 +147,13 @@ public:
     // A camera ray's surfaces through partial coverage (render/layers.h): at most kMaxSheets
     // crossings with tmin < t < tmax, in ray order; returns how many. A prefiltered lattice
     // answered by its sub-rays gives one per depth at which they meet it (a tuft's strands one
-    // behind the other), each shaded as its own surface; every other shape its closest crossing.
+    // behind the other), each shaded as its own surface with its sub-rays' normals; every other
+    // shape its closest crossing.
     static constexpr int kMaxSheets = 4;
     virtual int sheets(const Ray& r, double tmin, double tmax,
-                       std::span<Crossing, kMaxSheets> out) const {
-        return intersect(r, tmin, tmax, out[0]) ? 1 : 0;
+                       std::span<SheetCrossing, kMaxSheets> out) const {
+        out[0].normals.count = 0;
+        return intersect(r, tmin, tmax, out[0].crossing) ? 1 : 0;
     }
     // Whether any boundary crossing has tmin < t < tmax (shadow rays).
     virtual bool occluded(const Ray& r, double tmin, double tmax) const {

@@ -233,12 +233,14 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
 }
 
 int FilteredLatticeShape::sheets(const Ray& r, double tmin, double tmax,
-                                 std::span<Crossing, kMaxSheets> out) const {
+                                 std::span<SheetCrossing, kMaxSheets> out) const {
     const bool normal = !t_footprint.coverage_only;
     // Sheets of sub-rays are told apart only where they compose sub-ray by sub-ray
     // (LayerComposite): with the world's directions across the ray.
-    if (!exact_ || !normal || !across_ray_in_object().set)
-        return sheet(r, tmin, tmax, normal, out[0]) ? 1 : 0;
+    if (!exact_ || !normal || !across_ray_in_object().set) {
+        out[0].normals.count = 0;
+        return sheet(r, tmin, tmax, normal, out[0].crossing) ? 1 : 0;
+    }
     SubRayHits h;
     const double width = sub_ray_width(r);
     exact_sub_rays(width, true, r, tmin, tmax, h);
@@ -254,8 +256,9 @@ int FilteredLatticeShape::sheets(const Ray& r, double tmin, double tmax,
             if (const int k = std::countr_zero(m); h.t[k] <= nearest + depth) group |= 1u << k;
         left &= ~group;
         Sheet s;
-        add_sub_rays(h, group, s);
-        if (to_crossing(s, 0, r, tmin, tmax, true, out[static_cast<std::size_t>(n)])) ++n;
+        SheetCrossing& c = out[static_cast<std::size_t>(n)];
+        add_sub_rays(h, group, s, &c.normals);
+        if (to_crossing(s, 0, r, tmin, tmax, true, c.crossing)) ++n;
     }
     return n;
 }
@@ -265,12 +268,15 @@ double FilteredLatticeShape::sub_ray_width(const Ray& r) const {
     return std::min({footprint_width(r), exact_width_, across_ray_in_object().widest});
 }
 
-void FilteredLatticeShape::add_sub_rays(const SubRayHits& h, unsigned which, Sheet& s) {
+void FilteredLatticeShape::add_sub_rays(const SubRayHits& h, unsigned which, Sheet& s,
+                                        SubRayNormals* normals) {
     constexpr double w = 1.0 / kSubRays;
+    if (normals) normals->count = 0;
     for (unsigned m = which; m != 0; m &= m - 1) {
         const int k = std::countr_zero(m);
         s.add_opaque(w, h.p[k], h.n[k]);
         s.sub_rays |= static_cast<std::uint8_t>(1u << k);
+        if (normals && h.n[k] != Vec3{}) normals->n[normals->count++] = h.n[k];
     }
 }
 

@@ -158,7 +158,7 @@ public:
     // the nearest make the first sheet, those within kSheetDepth of the nearest left the next,
     // and so on. Otherwise intersect's one sheet.
     int sheets(const Ray& r, double tmin, double tmax,
-               std::span<Crossing, kMaxSheets> out) const override;
+               std::span<SheetCrossing, kMaxSheets> out) const override;
     // Shadow rays that need transmittance ask intersect for the coverage; as an any-hit test, a
     // sheet occludes when it covers at least half.
     bool occluded(const Ray& r, double tmin, double tmax) const override;
@@ -269,8 +269,9 @@ private:
     // The width of r's sub-rays' footprint (primitive units): its own, narrowed to the shape's
     // and the instance's bound (cull_bounds).
     double sub_ray_width(const Ray& r) const;
-    // The sheet of h's sub-rays in `which`.
-    static void add_sub_rays(const SubRayHits& h, unsigned which, Sheet& s);
+    // The sheet of h's sub-rays in `which`; their unit normals into `normals`, if given.
+    static void add_sub_rays(const SubRayHits& h, unsigned which, Sheet& s,
+                             SubRayNormals* normals = nullptr);
     // A sheet as r's crossing, if within (tmin, tmax); finer: how many levels finer than the
     // finest table the footprint is.
     bool to_crossing(const Sheet& s, double finer, const Ray& r, double tmin, double tmax,

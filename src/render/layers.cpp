@@ -66,8 +66,9 @@ Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCou
     SurfaceHit opaque;
     const bool found = rs.intersect_layers(ray, 0.0, kInfinity, EmbreeAccel::kNoObject, opaque, partial,
                                            {.max_layers = kMaxLayers, .min_left = kMinTransmittance});
-    // Shading moves the footprint (shadow rays): the layers are all found first.
-    const std::vector<SurfaceHit> layers = partial;
+    // Shading moves the footprint (shadow rays): the layers are all found first. (Shadow rays
+    // leave `partial` as it is: transmittance has its own.)
+    const std::vector<SurfaceHit>& layers = partial;
     Vec3 c;
     LayerComposite seen;
     for (std::size_t i = 0; i < layers.size(); ++i) {

@@ -59,12 +59,15 @@ void RenderScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) 
     // Only a mean of normals (prefiltered lattices) is meant to be shorter than 1.
     const double len = length(s.n);
     hit.normal_length = len < 1 - 1e-6 ? len : 1.0;
+    hit.normals = h.normals;
     if (o.xf.is_identity()) {
         hit.p = s.p;
         hit.n = hit.normal_length < 1 && len > 0 ? s.n / len : s.n;
     } else {
         hit.p = o.xf.point(s.p);
         hit.n = normalize(o.xf.normal(s.n));
+        for (std::uint8_t k = 0; k < hit.normals.count; ++k)
+            hit.normals.n[k] = normalize(o.xf.normal(hit.normals.n[k]));
     }
 }
 

@@ -24,6 +24,9 @@ struct SurfaceHit {
     // its length, below 1 where they diverge, widens the specular lobe (phong_term). 1 for
     // every other surface.
     double normal_length = 1;
+    // A sheet of sub-rays' own unit normals (world space, SubRayNormals): shaded as the mean of
+    // their terms, n standing for them where one normal is wanted.
+    SubRayNormals normals;
 };
 
 class RenderScene {
