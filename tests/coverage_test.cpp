@@ -416,11 +416,10 @@ constexpr const char* kTurnedCopies = R"({
               {"type": "instance", "primitive": "bead", "material": "w"}COPIES]
 })";
 
-Image8 render_turned_copies(const std::string& copies) {
+// The scene `text` in lattice mode, the default filter, answered by sub-rays.
+Image8 render_filtered(const std::string& text) {
     test::TempDir dir;
     const std::string path = (dir.path() / "copies.json").string();
-    std::string text = kTurnedCopies;
-    text.replace(text.find("COPIES"), 6, copies);
     std::ofstream(path) << text;
     const Scene s = load_scene(path);
     const TableCache cache(dir.path().string(), true);
@@ -437,6 +436,38 @@ Image8 render_turned_copies(const std::string& copies) {
     tbb::task_arena(1).execute([&] { one = render_image(rs, opt).display; });
     EXPECT_EQ(one.rgb, image.rgb);
     return image;
+}
+
+Image8 render_turned_copies(const std::string& copies) {
+    std::string text = kTurnedCopies;
+    text.replace(text.find("COPIES"), 6, copies);
+    return render_filtered(text);
+}
+
+// A bead turned about its centre is the same solid, and shades the same in Phong light with
+// shadows: its sheets' sub-rays' own normals are turned into the world with it (SubRayNormals).
+TEST(Coverage, ATurnedBeadShadesAsTheBead) {
+    std::string text = kTurnedCopies;
+    text.replace(text.find("COPIES"), 6, "");
+    const std::string matte = R"("ka": 0.5, "kd": 0, "ks": 0, "shininess": 1)";
+    text.replace(text.find(matte), matte.size(),
+                 R"("ka": 0.1, "kd": 0.6, "ks": 0.5, "shininess": 12)");
+    const Image8 plain = render_filtered(text);
+    const std::string instance = R"("primitive": "bead", "material": "w")";
+    text.replace(
+        text.find(instance), instance.size(),
+        instance +
+            R"(, "transform": [{"translate": [-1, -1, -1]},)"
+            R"( {"rotate": {"axis": [1, 2, 3], "angle_deg": 70}}, {"translate": [1, 1, 1]}])");
+    const Image8 turned = render_filtered(text);
+    ASSERT_EQ(plain.rgb.size(), turned.rgb.size());
+    int off = 0, lit = 0;
+    for (std::size_t i = 0; i < plain.rgb.size(); ++i) {
+        off += std::abs(int(plain.rgb[i]) - int(turned.rgb[i])) > 1;
+        lit += plain.rgb[i] > 60;
+    }
+    EXPECT_EQ(off, 0);
+    EXPECT_GT(lit, 100);
 }
 
 TEST(Coverage, TurnedCopiesOfABeadRenderAsOne) {

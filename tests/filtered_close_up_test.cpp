@@ -283,6 +283,14 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
                 }
             }
             EXPECT_EQ(count, expected);
+            // A tmax between two sheets cuts the farther: the nearer are as they were.
+            if (count > 1) {
+                std::array<SheetCrossing, Shape::kMaxSheets> cut;
+                const double tmax = 0.5 * (got[0].crossing.t + got[1].crossing.t);
+                ASSERT_EQ(s.sheets(r, 0.0, tmax, cut), 1);
+                EXPECT_EQ(cut[0].crossing.t, got[0].crossing.t);
+                EXPECT_EQ(cut[0].crossing.sub_rays, got[0].crossing.sub_rays);
+            }
             split += count > 1;
             whole += count == 1;
             // Together: intersect's one sheet.

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <random>
 
@@ -205,7 +206,8 @@ double specular_integral(double normal_length) {
 // k-th: turned k + 1 about x); culled by several boxes, as Sheet.
 class TwoSheets final : public Shape {
 public:
-    TwoSheets(double z, double dz) : z_(z), dz_(dz) {}
+    // reach: how far back along the ray each cull box reaches beyond the one before.
+    TwoSheets(double z, double dz, double reach = 6) : z_(z), dz_(dz), reach_(reach) {}
     Bounds3 bounds() const override { return {{-1, -1, z_ - 0.01}, {1, 1, z_ + dz_ + 0.01}}; }
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override {
         std::array<SheetCrossing, kMaxSheets> c;
@@ -237,16 +239,35 @@ public:
     bool inside(Vec3) const override { return false; }
     std::size_t cull_count() const override { return 3; }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf, double) const override {
-        return xf.bounds(Bounds3{{-1, -1, z_ - 6.0 * double(i) - 0.01}, {1, 1, z_ + dz_ + 0.01}});
+        return xf.bounds(
+            Bounds3{{-1, -1, z_ - reach_ * double(i) - 0.01}, {1, 1, z_ + dz_ + 0.01}});
     }
 
 private:
-    double z_, dz_;
+    double z_, dz_, reach_;
+};
+
+// Met by a ray and never crossed, culled by two boxes: it fills the ring of tested objects.
+class Nothing final : public Shape {
+public:
+    explicit Nothing(double z) : z_(z) {}
+    Bounds3 bounds() const override { return {{-1, -1, z_ - 0.01}, {1, 1, z_ + 0.01}}; }
+    bool intersect(const Ray&, double, double, Crossing&) const override { return false; }
+    void spans(const Ray&, SpanList&) const override {}
+    Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
+    bool inside(Vec3) const override { return false; }
+    std::size_t cull_count() const override { return 2; }
+    Bounds3 cull_bounds(std::size_t, const Transform& xf, double) const override {
+        return xf.bounds(bounds());
+    }
+
+private:
+    double z_;
 };
 
 // A camera ray keeps every sheet of an object, in ray order among the other objects' crossings,
-// once however many of its cull boxes the traversal meets; a sheet beyond an opaque crossing
-// is cut.
+// once however many of its cull boxes the traversal meets (also when more objects than the
+// ring of tested ones holds lie between them); a sheet beyond an opaque crossing is cut.
 TEST(Layers, AnObjectsSheetsAreEachKeptOnce) {
     const TwoSheets two(1, 2);
     const Sheet between(2, 0.3f, 3), opaque(2.5, 1.0f, 3);
@@ -272,6 +293,22 @@ TEST(Layers, AnObjectsSheetsAreEachKeptOnce) {
                       TwoSheets::normal_of(k, partial[i].crossing.sub_rays));
     }
     EXPECT_EQ(partial[1].normals.count, 0);
+
+    // Its cull boxes 20 apart along the ray, 12 objects between them: visited again.
+    const TwoSheets far(1, 2, 20);
+    std::vector<std::unique_ptr<Nothing>> between_boxes;
+    std::vector<AccelObject> crowd{{&far, &xf}};
+    for (int i = 0; i < 12; ++i) {
+        between_boxes.push_back(std::make_unique<Nothing>(-35.0 + i));
+        crowd.push_back({between_boxes.back().get(), &xf});
+    }
+    const EmbreeAccel crowd_accel(crowd);
+    const Ray from_below{{0.1, 0.2, -50}, {0, 0, 1}};
+    EXPECT_FALSE(crowd_accel.intersect_layers(from_below, 0, kInfinity, EmbreeAccel::kNoObject, hit,
+                                              partial));
+    ASSERT_EQ(partial.size(), 2u);
+    EXPECT_EQ(partial[0].crossing.sub_rays, 0b0011);
+    EXPECT_EQ(partial[1].crossing.sub_rays, 0b1100);
 
     const std::vector<AccelObject> cut{{&two, &xf}, {&opaque, &xf}};
     const EmbreeAccel cut_accel(cut);

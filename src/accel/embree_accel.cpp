@@ -111,8 +111,8 @@ struct QueryContext {
     std::vector<AccelHit>* partial = nullptr;
     LayerStop stop;
     LayerComposite transmitted;
-    // An object (the caller's number) answers a ray with one sheet; met again (it fell out of
-    // the ring of tested objects), it is not counted twice.
+    // An object (the caller's number) answers a ray with its sheets at its first visit; met
+    // again (it fell out of the ring of tested objects), it is not counted twice.
     bool met_already(std::uint32_t object) const {
         for (const AccelHit& p : *partial)
             if (p.object == object) return true;
@@ -130,11 +130,9 @@ struct QueryContext {
     }
     // A camera ray's partial crossing: the crossings are kept in ray order and cut where
     // compositing will stop (LayerStop), and tmax and the traversal's tfar come down to the
-    // last one kept. more: another sheet of the object whose first this visit added
-    // (Shape::sheets); an object visited again adds nothing.
-    void add_camera_partial(const AccelHit& h, float& tfar, bool more = false) {
+    // last one kept. (add_sheets keeps an object's sheets from being added twice.)
+    void add_camera_partial(const AccelHit& h, float& tfar) {
         assert(!stop.shadow());
-        if (!more && met_already(h.object)) return;
         partial->insert(std::upper_bound(partial->begin(), partial->end(), h, in_ray_order), h);
         if (stop.max_layers <= 0) return;
         LayerComposite seen;
@@ -451,23 +449,31 @@ struct EmbreeAccel::Impl {
         const bool hit = K == Kind::kDirect
                              ? shape.intersect(local, tmin, tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, tmax, c);
+        // A shape of several parts (chains, meshes) is opaque: only a whole shape (a lattice)
+        // answers with partial sheets.
+        assert(!ctx->partial || c.coverage >= 1.0f || !hit);
         if (hit) self->record(ctx, rh, t.object, c, geom, prim, placed);
     }
 
     // A camera ray through partial crossings: the object's sheets, partial ones kept (the ray
-    // goes on), in ray order up to the first opaque one, recorded as the hit.
+    // goes on) unless a visit before this one kept them, in ray order up to the first opaque
+    // one, recorded as the hit.
     void add_sheets(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Shape& shape,
                     const Ray& local, double tmin, double tmax, unsigned geom,
                     unsigned prim) const {
-        std::array<SheetCrossing, Shape::kMaxSheets> sheets;
+        // Not on the stack: 4 sheets' default values written at every visit cost more than
+        // the visit of a shape that has one.
+        thread_local std::array<SheetCrossing, Shape::kMaxSheets> sheets;
         const int n = shape.sheets(local, tmin, tmax, sheets);
+        const bool met = n > 0 && ctx->met_already(objects[obj].original);
         for (int i = 0; i < n; ++i) {
             const Crossing& c = sheets[static_cast<std::size_t>(i)].crossing;
             const SubRayNormals& normals = sheets[static_cast<std::size_t>(i)].normals;
             if (c.coverage < 1.0f) {
+                if (met) continue;
                 AccelHit h = caller_hit(c.t, obj, c);
                 h.normals = normals;
-                ctx->add_camera_partial(h, rh->ray.tfar, i > 0);
+                ctx->add_camera_partial(h, rh->ray.tfar);
                 continue;
             }
             record(ctx, rh, obj, c, geom, prim, RTC_INVALID_GEOMETRY_ID);

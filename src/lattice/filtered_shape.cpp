@@ -354,7 +354,7 @@ void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, d
 
 // The crossings of kExactSubRays^2 sub-rays parallel to r, on a grid across its footprint (for
 // camera rays the pixel's box filter, as exact mode at that many samples would, but on this
-// primitive only and shaded once a depth: sheets). A camera ray's are those of the sub-rays' chords
+// primitive only and shaded once a sheet: sheets). A camera ray's are those of the sub-rays' chords
 // through the box, however far r may go (tmax): what the tables answer does not depend on the order
 // in which the accelerator meets objects either, and the sheet is cut at tmax after. A shadow ray
 // wants only the share of its sub-rays blocked before tmax (the light), not where: any part's

@@ -67,8 +67,9 @@ inline constexpr double kLodBlendBand = 0.25;
 double lod_blend(double f, double band);
 // With levels of detail, a primitive cheap to intersect (answered_by_primitive) is answered by
 // its own crossings, not its tables, for every ray with a footprint: those of kExactSubRays^2
-// sub-rays parallel to the ray across its footprint (add_exact), for camera rays shaded once
-// with their mean point and normal (the pixel's box filter on this primitive), for shadow rays
+// sub-rays parallel to the ray across its footprint (exact_sub_rays), for camera rays shaded
+// once a sheet (those within kSheetDepth of each other) at their mean point with their own
+// normals (the pixel's box filter on this primitive), for shadow rays
 // their share as the coverage (a ray without a footprint: its own line's). Its table then
 // serves CSG (spans, `inside`) only, and is built only when a CSG tree holds a copy, no finer
 // level ever (scene_lattices). A costly primitive is answered by its tables and their levels
@@ -104,7 +105,7 @@ inline constexpr int kExactSubRays = 2;
 static_assert(kExactSubRays * kExactSubRays == kSubRays);
 static_assert(kSubRays <= Shape::kMaxSheets, "a sheet per sub-ray at most");
 // A camera ray's sub-rays that meet the primitive within this many footprint widths (along the
-// ray) of the nearest one make one sheet, shaded once at their mean point and normal; those
+// ray) of the nearest one make one sheet, shaded once at their mean point; those
 // farther make sheets of their own, each shaded with its own shadow rays (sheets). One sheet
 // for them all had a tuft's strands one behind another shaded, and shadowed from the light, at
 // a point between them: PSNR against exact ground truth, 1 spp, ball-tuft216 / tuft200 /
@@ -206,7 +207,7 @@ private:
     struct Sheet {
         double alpha = 0;
         Vec3 p, n;
-        std::uint8_t sub_rays = 0;  // add_exact's: which sub-rays met the primitive
+        std::uint8_t sub_rays = 0;  // add_sub_rays': which sub-rays met the primitive
         void add(double w, const CoverageHit& h, const Vec3& p_prim) {
             alpha += w * h.alpha;
             p += p_prim * (w * h.alpha);

@@ -1,7 +1,6 @@
 #include "render/layers.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 
 #include "geometry/sub_rays.h"
@@ -24,12 +23,11 @@ double shadow_width(const Ray& ray, const SurfaceHit& hit, const Ray& shadow, do
 }
 
 // The footprint's width at a layer, `width` the ray's there: a sheet of sub-rays covers their
-// share of the footprint (Shape::sheets), and its shadow rays' footprint is as wide as that
-// share's area (ball-tuft216 +0.12 dB, tuft200 +0.08, the furry bunny +0.05; Plates 4 and 5
-// +0.01 and +0.03).
+// share of the footprint (Shape::sheets), its coverage, and its shadow rays' footprint is as
+// wide as that share's area (ball-tuft216 +0.12 dB, tuft200 +0.08, the furry bunny +0.05;
+// Plates 4 and 5 +0.01 and +0.03).
 double sheet_width(const SurfaceHit& h, double width) {
-    if (h.sub_rays == 0) return width;
-    return width * std::sqrt(std::popcount(unsigned(h.sub_rays)) / double(kSubRays));
+    return h.sub_rays == 0 ? width : width * std::sqrt(h.alpha);
 }
 
 // Radiance at a layer; `width`: its footprint (world units), which picks the lattices' levels
@@ -68,11 +66,9 @@ Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCou
                                            {.max_layers = kMaxLayers, .min_left = kMinTransmittance});
     // Shading moves the footprint (shadow rays): the layers are all found first. (Shadow rays
     // leave `partial` as it is: transmittance has its own.)
-    const std::vector<SurfaceHit>& layers = partial;
     Vec3 c;
     LayerComposite seen;
-    for (std::size_t i = 0; i < layers.size(); ++i) {
-        const SurfaceHit& h = layers[i];
+    for (const SurfaceHit& h : partial) {
         const double left = seen.left();
         // A layer whose sub-rays were all blocked in front of it adds nothing (not shaded);
         // the last one counted (the traversal looked no farther) is taken as opaque.
