@@ -17,6 +17,9 @@ struct ParamPoint {
 };
 
 ParamPoint eval(ParamKind kind, double minor, double u, double v) {
+    if (kind == ParamKind::kPlane) return {{u, v, 0}, {0, 0, 1}, 1};
+    // Every other surface goes around an axis: u is the angle (the plane, above, spares the
+    // area's integration a million sines on a ground patch).
     const double cu = std::cos(u), su = std::sin(u);
     switch (kind) {
         case ParamKind::kSphere: {  // (u, z): Archimedes' equal-area map, jac = 1
@@ -49,7 +52,7 @@ ParamPoint eval(ParamKind kind, double minor, double u, double v) {
             return {{ring * cu, ring * su, minor * sv}, {cv * cu, cv * su, sv}, minor * ring};
         }
         case ParamKind::kPlane:
-            return {{u, v, 0}, {0, 0, 1}, 1};
+            break;
     }
     return {};
 }
