@@ -22,9 +22,9 @@ double shadow_width(const Ray& ray, const SurfaceHit& hit, const Ray& shadow, do
     return width * std::clamp(std::sqrt(cl / cv), 1 / kMaxShadowWidening, kMaxShadowWidening);
 }
 
-// The footprint's width at a layer, `width` the ray's there: a sheet of sub-rays covers their
-// share of the footprint (Shape::sheets), its coverage, and its shadow rays' footprint is as
-// wide as that share's area (ball-tuft216 +0.12 dB, tuft200 +0.08, the furry bunny +0.05;
+// The footprint's width at a layer, `width` the ray's there: a sheet of sub-rays covers the
+// share of the footprint its coverage says (Shape::sheets), and its shadow rays' footprint is
+// as wide as that share's area (ball-tuft216 +0.12 dB, tuft200 +0.08, the furry bunny +0.05;
 // Plates 4 and 5 +0.01 and +0.03).
 double sheet_width(const SurfaceHit& h, double width) {
     return h.sub_rays == 0 ? width : width * std::sqrt(h.alpha);
