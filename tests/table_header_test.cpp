@@ -117,6 +117,30 @@ TEST_F(ForgedHeader, MetadataMustDescribeThePrimitive) {
     }
 }
 
+// The primitive the metadata describes must lie in the table's box, as a scene's must
+// (check_inside_box): certifying a table rasterizes it, and a grid point inside its solid has no
+// surface to answer with (the fuzzer's find: a hook moved half out of its box).
+TEST_F(ForgedHeader, MetadataPrimitiveMustLieInTheBox) {
+    const auto load = [&](const std::string& first_sphere) {
+        TableHeader h = good;
+        h.metadata = R"({"primitive": "hook", "definition": {"spheres": [)" + first_sphere +
+                     R"(, [1, 1, 3, 0.5], [3, 1, 3, 0.5], [3, 1, 2, 0.5]],
+                       "cylinders": [[0, 1, 0.5], [1, 2, 0.5], [2, 3, 0.5]]}})";
+        write_table_file(path, h, payload);
+        try {
+            primitive_from_metadata(read_table_header(path), path);
+        } catch (const InputError& err) {
+            return std::string(err.what());
+        }
+        return std::string("(no error)");
+    };
+    EXPECT_EQ(load("[1, 1, 1, 0.5]"), "(no error)");
+    const std::string e = load("[0, 1, 1, 0.5]");
+    EXPECT_NE(e.find(path + " (metadata): primitive 'hook' reaches outside its lattice box"),
+              std::string::npos)
+        << e;
+}
+
 // A killed table build leaves its temporary behind; the next run that opens the cache removes
 // it once it is old enough that no live writer can own it, and leaves fresh ones alone.
 TEST(TableCacheTest, StaleTemporariesAreRemoved) {

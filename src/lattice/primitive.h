@@ -27,4 +27,9 @@ struct Primitive {
     std::optional<LatticeSpec> lattice;
 };
 
+// The primitive (with its lattice) must lie in its box: a table cannot see what sticks out,
+// and a grid point inside a solid has no surface to answer with. InputError naming `place`
+// (a prefix: "scene.json: primitives.hair: ") otherwise.
+void check_inside_box(const Primitive& p, const std::string& place);
+
 }  // namespace lat

@@ -28,6 +28,9 @@ Primitive primitive_from_metadata(const TableHeader& h, const std::string& path)
     Primitive p = parse_primitive(def, meta["primitive"].get<std::string>(), &parser);
     p.lattice = LatticeSpec{
         h.sigma, {h.cells[0] / h.sigma_inv, h.cells[1] / h.sigma_inv, h.cells[2] / h.sigma_inv}};
+    // As a scene's primitive is (TablePlan): rasterizing one that sticks out (certify) would
+    // start rays inside its solid.
+    check_inside_box(p, where + ": ");
     return p;
 }
 

@@ -13,25 +13,6 @@
 namespace lat {
 namespace {
 
-// The primitive must lie in its box: the table cannot see what sticks out.
-void check_inside_box(const TablePlan& plan) {
-    const Primitive& p = *plan.primitive;
-    const Bounds3 b = p.shape->bounds();
-    const double X = p.lattice->cells[0] * p.lattice->sigma,
-                 Y = p.lattice->cells[1] * p.lattice->sigma,
-                 Z = p.lattice->cells[2] * p.lattice->sigma;
-    const double tol = 1e-9 * std::max({X, Y, Z});
-    if (b.finite() && b.lo.x >= -tol && b.lo.y >= -tol && b.lo.z >= -tol && b.hi.x <= X + tol &&
-        b.hi.y <= Y + tol && b.hi.z <= Z + tol)
-        return;
-    char buf[256];
-    std::snprintf(buf, sizeof buf,
-                  "primitive '%s' reaches outside its lattice box [0, %g] x [0, %g] x [0, %g] "
-                  "(its bounds are [%g, %g] x [%g, %g] x [%g, %g])",
-                  p.name.c_str(), X, Y, Z, b.lo.x, b.hi.x, b.lo.y, b.hi.y, b.lo.z, b.hi.z);
-    throw InputError(plan.place + buf);
-}
-
 std::string lattice_size(const TableHeader& h) {
     return std::to_string(h.cells[0]) + " x " + std::to_string(h.cells[1]) + " x " +
            std::to_string(h.cells[2]) + " cells (sigma^-1 = " + std::to_string(h.sigma_inv) + ")";
@@ -84,7 +65,7 @@ auto naming_the_primitive(const TablePlan& plan, Step&& step) {
 }  // namespace
 
 void check_buildable(const TablePlan& plan) {
-    check_inside_box(plan);
+    check_inside_box(*plan.primitive, plan.place);
     const double pairs = static_cast<double>(pair_count(plan.header));
     const double per_hit = plan.encoding->bytes_per_hit + sizeof(RawHit);
     const double avail = static_cast<double>(available_memory_bytes());
