@@ -1,6 +1,7 @@
 #include "lattice/primitive.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cstdio>
 
 #include "util/error.h"
@@ -8,6 +9,7 @@
 namespace lat {
 
 void check_inside_box(const Primitive& p, const std::string& place) {
+    assert(p.lattice);
     const Bounds3 b = p.shape->bounds();
     const double X = p.lattice->cells[0] * p.lattice->sigma,
                  Y = p.lattice->cells[1] * p.lattice->sigma,

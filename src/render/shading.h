@@ -118,8 +118,8 @@ Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, Sh
     const Scene& s = rs.scene();
     const Material& m = s.materials[hit.material];
     const Vec3 v = normalize(-ray.d);
-    Vec3 n = hit.n;
-    if (dot(n, v) < 0) n = -n;  // face the viewer
+    const auto facing = [&](Vec3 x) { return dot(x, v) < 0 ? -x : x; };  // the viewer's side
+    const Vec3 n = facing(hit.n);
 
     Vec3 c = m.ka * m.color * s.ambient;
     const auto term = [&](const PointLight& light, Vec3 l) {
@@ -127,8 +127,7 @@ Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, Sh
             return phong_term(m, m.color, n, l, v, light.intensity, hit.normal_length);
         Vec3 sum;
         for (std::uint8_t k = 0; k < hit.normals.count; ++k) {
-            const Vec3 nk = hit.normals.n[k];
-            sum += phong_term(m, m.color, dot(nk, v) < 0 ? -nk : nk, l, v, light.intensity);
+            sum += phong_term(m, m.color, facing(hit.normals.n[k]), l, v, light.intensity);
         }
         return sum / double(hit.normals.count);
     };
