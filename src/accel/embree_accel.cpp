@@ -62,6 +62,8 @@ struct Placed {
     // instead (test_self_last). Culling is conservative, so the test unculled answers as the
     // callbacks' would.
     bool direct = false;
+    // A direct object cheap enough to test before a shadow ray's traversal (LastBlocker).
+    bool cheap_blocker = false;
 
     Ray local_ray(const Ray& r) const { return {inverse.point(r.o), inverse.vector(r.d)}; }
     // Before the object is tested: the directions across the ray in its space handed on.
@@ -103,8 +105,13 @@ struct QueryContext {
     double tmin, tmax;
     AccelHit* hit;
     bool found = false;
-    // Occlusion: the object the ray leaves (the accelerator's number).
+    // Occlusion: the object the ray leaves (the accelerator's number); one tested before the
+    // traversal (LastBlocker), which its callbacks skip; the direct object that blocked the ray.
     std::uint32_t self = EmbreeAccel::kNoObject;
+    EmbreeAccel::LastBlocker tested_first, blocker;
+    bool is_tested_first(std::uint32_t obj, std::uint32_t part) const {
+        return obj == tested_first.object && part == tested_first.part;
+    }
     // intersect_layers: where crossings of partial coverage go (they do not end the ray), how
     // far to look, and for shadow rays what they let through (LayerComposite, which does not
     // depend on the order they are met in).
@@ -516,6 +523,26 @@ struct EmbreeAccel::Impl {
             ctx.found = blocks_transmittance<Kind::kDirect>(&ctx, t, *o.shape, local, tmin);
         else
             ctx.found = o.shape->occluded(local, tmin, ctx.tmax);
+        if (ctx.found && o.cheap_blocker) ctx.blocker = {ctx.self, EmbreeAccel::kWhole};
+    }
+
+    // Before a shadow ray's traversal: whether what blocked the last ray of its run blocks this
+    // one too. Not the ray's own direct object, which test_self_last tests after the traversal;
+    // what is tested here the traversal's callbacks skip.
+    bool blocked_by_last(QueryContext& ctx, const EmbreeAccel::LastBlocker& last) const {
+        if (last.object >= objects.size()) return false;
+        const Placed& o = objects[last.object];
+        const bool whole = last.part == EmbreeAccel::kWhole;
+        assert(!whole || o.cheap_blocker);
+        if (whole && last.object == ctx.self) return false;
+        const Ray local = object_ray(o, ctx.ray);
+        ctx.across_obj = last.object;
+        const double tmin = occlusion_tmin(&ctx, last.object, local);
+        if (whole ? o.shape->occluded(local, tmin, ctx.tmax)
+                  : o.shape->occluded_primitive(last.part, local, tmin, ctx.tmax))
+            return true;
+        ctx.tested_first = last;
+        return false;
     }
 
     template <Kind K>
@@ -526,6 +553,9 @@ struct EmbreeAccel::Impl {
         const Target t = self->template target<K>(args->primID, args->context->instID[0]);
         if constexpr (K == Kind::kDirect)
             if (t.object == ctx->self || !self->may_visit(ctx, args->primID)) return;
+        if (ctx->is_tested_first(t.object, K == Kind::kDirect ? EmbreeAccel::kWhole
+                                                              : static_cast<std::uint32_t>(t.part)))
+            return;
         const Shape& shape = *self->objects[t.object].shape;
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
@@ -541,6 +571,9 @@ struct EmbreeAccel::Impl {
             hit = shape.occluded_primitive(t.part, local, tmin, ctx->tmax);
         if (hit) {
             ctx->found = true;
+            if (K != Kind::kDirect || self->objects[t.object].cheap_blocker)
+                ctx->blocker = {t.object, K == Kind::kDirect ? EmbreeAccel::kWhole
+                                                             : static_cast<std::uint32_t>(t.part)};
             reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
         }
     }
@@ -596,6 +629,7 @@ struct EmbreeAccel::Impl {
                 if (b.empty()) continue;
                 direct.push_back(direct_prim(i, c, parts > 1, o));
                 o.direct = true;
+                o.cheap_blocker = o.shape->intersect_cost() <= EmbreeAccel::kCheapBlockerCost;
                 direct_bounds.push_back(b);
             }
         }
@@ -746,12 +780,19 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     return ctx.found;
 }
 
-bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t self) const {
+bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t self,
+                           LastBlocker* last) const {
     const bool traceable = embree_can_trace(r, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, nullptr);
     ctx.self = m.our_number(self);
+    // A run of rays that pass, or that something else blocks, keeps nothing: a blocker tested
+    // first in vain costs a test that the traversal may not have made.
+    if (last) {
+        if (m.blocked_by_last(ctx, *last)) return true;
+        *last = {};
+    }
     for (const std::uint32_t i : m.unbounded) {
         const Placed& o = m.objects[i];
         const Ray local = object_ray(o, r);
@@ -762,6 +803,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
         trace_any(m.scene, ctx, r, tmin, tmax);
         m.test_self_last(ctx);
     }
+    if (last) *last = ctx.blocker;
     return ctx.found;
 }
 

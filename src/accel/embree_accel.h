@@ -69,7 +69,20 @@ public:
     // Whether anything is crossed with tmin < t < tmax. A ray leaving a surface of object
     // `self` also skips that object's crossings within its surface_tolerance().
     static constexpr std::uint32_t kNoObject = 0xFFFFFFFFu;
-    bool occluded(const Ray& r, double tmin, double tmax, std::uint32_t self = kNoObject) const;
+    // What blocked the last shadow ray of a run (one light's, pixel after pixel), which
+    // occluded() tests first when the caller keeps one: neighbouring pixels' shadow rays are
+    // mostly blocked by the same thing. Only what is cheap to test is kept: a part of a
+    // several-part object (a strand's sphere or cylinder, a triangle), or an object placed
+    // whole whose test costs at most kCheapBlockerCost simple tests (a lattice's table, a
+    // sphere). The answer is the same with or without it.
+    struct LastBlocker {
+        std::uint32_t object = kNoObject;  // the accelerator's own number
+        std::uint32_t part = kWhole;       // its part, or kWhole
+    };
+    static constexpr std::uint32_t kWhole = 0xFFFFFFFFu;
+    static constexpr double kCheapBlockerCost = 1;
+    bool occluded(const Ray& r, double tmin, double tmax, std::uint32_t self = kNoObject,
+                  LastBlocker* last = nullptr) const;
     // One traversal for rays that see through partial crossings (Crossing::coverage < 1, from
     // prefiltered lattices): `hit`, as intersect() finds it, is the closest opaque crossing, and
     // `partial` every partial crossing before it (up to where `stop` says), in ray order. `self`

@@ -33,13 +33,13 @@ double sheet_width(const SurfaceHit& h, double width) {
 // Radiance at a layer; `width`: its footprint (world units), which picks the lattices' levels
 // of detail for its shadow rays, narrowing to the point light.
 Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, double width,
-                 ShadeCounters& counters) {
+                 ShadeState& state) {
     const auto visible = [&](std::size_t, const Ray& r, double tmin, double tmax, double dist) {
         const double w = shadow_width(ray, hit, r, width);
         set_ray_footprint({w, -w / dist, true});
         return transmittance(rs, r, tmin, tmax, hit.object);
     };
-    return shade_with(rs, ray, hit, counters, visible);
+    return shade_with(rs, ray, hit, state, visible);
 }
 
 }  // namespace
@@ -57,7 +57,7 @@ double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tm
     return trans <= kMinTransmittance ? 0 : trans;
 }
 
-Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCounters& counters) {
+Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeState& state) {
     thread_local std::vector<SurfaceHit> partial;
     set_ray_footprint({0, spread});
     const ScopedAcrossRay across(normalize(ray.d));
@@ -76,10 +76,10 @@ Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCou
         const bool last = h.sub_rays == 0 && seen.draws() == kMaxLayers;
         if (last) alpha = 1;
         if (alpha > 0)
-            c += shade_layer(rs, ray, h, sheet_width(h, spread * h.t), counters) * (left * alpha);
+            c += shade_layer(rs, ray, h, sheet_width(h, spread * h.t), state) * (left * alpha);
         if (last || seen.left() <= kMinTransmittance) return c;
     }
-    return c + (found ? shade_layer(rs, ray, opaque, spread * opaque.t, counters)
+    return c + (found ? shade_layer(rs, ray, opaque, spread * opaque.t, state)
                       : rs.scene().background) * seen.left();
 }
 

@@ -27,7 +27,7 @@ inline constexpr double kMaxShadowWidening = 4;
 
 // Radiance along a camera ray; `spread`: the width of its footprint per unit of distance (the
 // pixel's angle), which picks the lattices' levels of detail (lattice/filtered_shape.h).
-Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeCounters& counters);
+Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeState& state);
 
 // The share of light that gets through from tmin to tmax along r (unit direction) leaving a
 // surface of object `self`, whose crossings within its surface tolerance are skipped.

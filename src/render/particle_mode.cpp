@@ -157,7 +157,7 @@ double light_visibility(const RenderScene& base, const std::vector<ShadowMap>& m
 // between tangent and half vector (the cone of reflections about the strand), flat over the
 // particle as a particle system shades.
 Vec3 shade_particle(const Scene& s, const RenderScene& base, const std::vector<ShadowMap>& maps,
-                    const Particle& p, ShadeCounters& counters) {
+                    const Particle& p, ShadeState& state) {
     const Material& m = s.materials[p.material];
     const Vec3 mid = (p.a + p.b) * 0.5;
     const Vec3 axis = p.b - p.a;
@@ -182,17 +182,17 @@ Vec3 shade_particle(const Scene& s, const RenderScene& base, const std::vector<S
         return light_visibility(base, maps, i, r, tmin, tmax, EmbreeAccel::kNoObject);
     };
     const auto lit = [&](const Term& k, double seen) { c += seen * k.intensity * k.reflected; };
-    for_each_light(base, mid, counters, term, visible, lit);
+    for_each_light(base, mid, state, term, visible, lit);
     return c;
 }
 
 // Phong, as exact mode shades; the particles' shadows from their maps.
 Vec3 shade_base(const RenderScene& base, const std::vector<ShadowMap>& maps, const Ray& ray,
-                const SurfaceHit& hit, ShadeCounters& counters) {
+                const SurfaceHit& hit, ShadeState& state) {
     const auto visible = [&](std::size_t i, const Ray& r, double tmin, double tmax, double) {
         return light_visibility(base, maps, i, r, tmin, tmax, hit.object);
     };
-    return shade_with(base, ray, hit, counters, visible);
+    return shade_with(base, ray, hit, state, visible);
 }
 
 }  // namespace
@@ -250,10 +250,10 @@ RenderOutput render_particles(const Scene& scene, const ParticleSet& set, const 
     std::vector<Vec3> colour(ps.size());
     std::atomic<std::uint64_t> shadow{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ps.size(), 1024), [&](const auto& r) {
-        ShadeCounters counters;
+        ShadeState state;
         for (std::size_t i = r.begin(); i != r.end(); ++i)
-            colour[i] = shade_particle(scene, base, maps, ps[i], counters);
-        shadow.fetch_add(counters.shadow_rays, std::memory_order_relaxed);
+            colour[i] = shade_particle(scene, base, maps, ps[i], state);
+        shadow.fetch_add(state.shadow_rays, std::memory_order_relaxed);
     });
 
     // Splats, binned to tiles in particle order (the order that breaks depth ties).
@@ -292,7 +292,7 @@ RenderOutput render_particles(const Scene& scene, const ParticleSet& set, const 
             const int sw = tw * nx;  // samples per tile row
             depth.assign(static_cast<std::size_t>(sw) * th * ny, std::numeric_limits<double>::infinity());
             rgb.assign(depth.size(), scene.background);
-            ShadeCounters counters;
+            ShadeState state;
             // The base, ray traced at every sample.
             for (int sy = 0; sy < th * ny; ++sy)
                 for (int sx = 0; sx < sw; ++sx) {
@@ -302,7 +302,7 @@ RenderOutput render_particles(const Scene& scene, const ParticleSet& set, const 
                     const std::size_t k = static_cast<std::size_t>(sy) * sw + sx;
                     if (base.intersect(ray, 0.0, kInfinity, hit)) {
                         depth[k] = hit.t * dot(ray.d, view.w);
-                        rgb[k] = shade_base(base, maps, ray, hit, counters);
+                        rgb[k] = shade_base(base, maps, ray, hit, state);
                     }
                 }
             primary.fetch_add(static_cast<std::uint64_t>(sw) * th * ny, std::memory_order_relaxed);
@@ -341,7 +341,7 @@ RenderOutput render_particles(const Scene& scene, const ParticleSet& set, const 
                         out.display.rgb[px + ch] = to_byte(clamped[ch] / spp);
                     }
                 }
-            shadow.fetch_add(counters.shadow_rays, std::memory_order_relaxed);
+            shadow.fetch_add(state.shadow_rays, std::memory_order_relaxed);
             bar.add(1);
         }
     });

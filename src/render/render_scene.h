@@ -57,8 +57,9 @@ public:
     }
     // `self`: the object whose surface the ray leaves (see EmbreeAccel::occluded).
     bool occluded(const Ray& r, double tmin, double tmax,
-                  std::uint32_t self = EmbreeAccel::kNoObject) const {
-        return accel_->occluded(r, tmin, tmax, self);
+                  std::uint32_t self = EmbreeAccel::kNoObject,
+                  EmbreeAccel::LastBlocker* last = nullptr) const {
+        return accel_->occluded(r, tmin, tmax, self, last);
     }
 
     const Scene& scene() const { return scene_; }

@@ -76,7 +76,7 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
     const Scene& s = tc.rs.scene();
     const int w = tc.w, h = tc.h, spp = tc.spp;
     const int x0 = (tile % tc.tiles_x) * kTile, y0 = (tile / tc.tiles_x) * kTile;
-    ShadeCounters counters;
+    ShadeState state;
     // A tile runs on one thread from start to end: its visits are this thread's growth.
     const std::uint64_t visits0 = lattice_visits_this_thread();
     std::uint64_t rays = 0;
@@ -98,9 +98,9 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
                 SurfaceHit hit;
                 Vec3 c = s.background;
                 if (tc.opt.layered)
-                    c = trace_layers(tc.rs, ray, tc.spread, counters);
+                    c = trace_layers(tc.rs, ray, tc.spread, state);
                 else if (tc.rs.intersect(ray, 0.0, kInfinity, hit))
-                    c = tc.opt.shader ? tc.opt.shader(ray, hit, counters) : shade(tc.rs, ray, hit, counters);
+                    c = tc.opt.shader ? tc.opt.shader(ray, hit, state) : shade(tc.rs, ray, hit, state);
                 sum += c;
                 sum_clamped += Vec3{std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0),
                                     std::clamp(c.z, 0.0, 1.0)};
@@ -113,7 +113,7 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
         }
     }
     counts.primary.fetch_add(rays, std::memory_order_relaxed);
-    counts.shadow.fetch_add(counters.shadow_rays, std::memory_order_relaxed);
+    counts.shadow.fetch_add(state.shadow_rays, std::memory_order_relaxed);
     counts.visits.fetch_add(lattice_visits_this_thread() - visits0, std::memory_order_relaxed);
 }
 

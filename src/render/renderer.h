@@ -16,7 +16,7 @@ namespace lat {
 
 // Radiance seen along a ray at a hit, in place of shade() (render/shading.h): how a mode that
 // changes surfaces, not geometry, shades them (e.g. the texture mode's baked maps).
-using SurfaceShader = std::function<Vec3(const Ray&, const SurfaceHit&, ShadeCounters&)>;
+using SurfaceShader = std::function<Vec3(const Ray&, const SurfaceHit&, ShadeState&)>;
 
 struct RenderOptions {
     int spp = 1;  // stratified samples per pixel; 1 is the pixel centre

@@ -6,8 +6,8 @@ namespace lat {
 
 double shadow_epsilon(Vec3 p) { return 1e-7 * (1.0 + max_component(abs(p))); }
 
-Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters) {
-    return shade_with(rs, ray, hit, counters, hard_shadows(rs, hit.object));
+Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeState& state) {
+    return shade_with(rs, ray, hit, state, hard_shadows(rs, hit.object, state));
 }
 
 }  // namespace lat

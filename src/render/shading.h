@@ -1,6 +1,7 @@
 #pragma once
 // Phong shading with shadows, exactly as the reference format states it (docs/scene-format.md).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -8,8 +9,16 @@
 
 namespace lat {
 
-struct ShadeCounters {
+// What the shading of a run of samples (a tile's, one thread's) keeps from sample to sample:
+// the shadow rays cast, and per light what blocked its last shadow ray (EmbreeAccel::
+// LastBlocker), tested first by the next (lights past kKeptBlockers keep none).
+struct ShadeState {
     std::uint64_t shadow_rays = 0;
+    static constexpr std::size_t kKeptBlockers = 8;
+    std::array<EmbreeAccel::LastBlocker, kKeptBlockers> last_blocker;
+    EmbreeAccel::LastBlocker* kept_blocker(std::size_t light) {
+        return light < kKeptBlockers ? &last_blocker[light] : nullptr;
+    }
 };
 
 // One light's Phong term (diffuse + specular, before shadowing) at a surface of colour `color`
@@ -61,7 +70,7 @@ inline Vec3 phong_term(const Material& m, Vec3 color, Vec3 n, Vec3 l, Vec3 v, Ve
 }
 
 // Radiance (linear, unclamped) seen along `ray` at `hit`.
-Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters);
+Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeState& state);
 
 // Start of shadow rays: far enough from the surface to skip its own crossing, which double
 // precision places within ~1e-12 relative of the true one, and small against any feature.
@@ -79,7 +88,7 @@ double shadow_epsilon(Vec3 p);
 // layered shading, the texture mode's baked surfaces and particle mode (whose visibility reads
 // a shadow map per light) go through it.
 template <class Term, class Visible, class Lit>
-void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Term&& term,
+void for_each_light(const RenderScene& rs, Vec3 p, ShadeState& state, Term&& term,
                     Visible&& visible, Lit&& lit) {
     const Scene& s = rs.scene();
     const double eps = shadow_epsilon(p);
@@ -93,7 +102,7 @@ void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Term
         if (unshadowed == decltype(unshadowed){}) continue;
         double seen = 1;
         if (s.shadows) {
-            ++counters.shadow_rays;
+            ++state.shadow_rays;
             seen = visible(i, Ray{p, l}, eps, dist * (1 - 1e-12), dist);
             if (seen <= 0) continue;
         }
@@ -103,9 +112,9 @@ void for_each_light(const RenderScene& rs, Vec3 p, ShadeCounters& counters, Term
 
 // visible for for_each_light and shade_with where nothing is partly covered: the light
 // arrives whole (1) unless the shadow ray, leaving object self, meets something (0).
-inline auto hard_shadows(const RenderScene& rs, std::uint32_t self) {
-    return [&rs, self](std::size_t, const Ray& r, double tmin, double tmax, double) {
-        return rs.occluded(r, tmin, tmax, self) ? 0.0 : 1.0;
+inline auto hard_shadows(const RenderScene& rs, std::uint32_t self, ShadeState& state) {
+    return [&rs, self, &state](std::size_t light, const Ray& r, double tmin, double tmax, double) {
+        return rs.occluded(r, tmin, tmax, self, state.kept_blocker(light)) ? 0.0 : 1.0;
     };
 }
 
@@ -113,7 +122,7 @@ inline auto hard_shadows(const RenderScene& rs, std::uint32_t self) {
 // the light that arrives: 0 or 1 for shade(), a transmittance through partial hits for layered
 // rays (render/layers.h), a shadow map's for particle mode's base.
 template <class Visible>
-Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters,
+Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeState& state,
                 Visible&& visible) {
     const Scene& s = rs.scene();
     const Material& m = s.materials[hit.material];
@@ -134,7 +143,7 @@ Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, Sh
     const auto lit = [&](Vec3 added, double seen) {
         c += seen == 1 ? added : added * seen;
     };
-    for_each_light(rs, hit.p, counters, term, visible, lit);
+    for_each_light(rs, hit.p, state, term, visible, lit);
     return c;
 }
 

@@ -189,8 +189,8 @@ RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const R
     const Material& fur = scene.materials[maps.fur_material];
 
     RenderOptions o = opt;
-    o.shader = [&](const Ray& ray, const SurfaceHit& hit, ShadeCounters& counters) {
-        if (hit.object != base_index) return shade(rs, ray, hit, counters);
+    o.shader = [&](const Ray& ray, const SurfaceHit& hit, ShadeState& state) {
+        if (hit.object != base_index) return shade(rs, ray, hit, state);
         const Material& m = scene.materials[hit.material];
         const TextureMaps::Sample t =
             maps.lookup(base.xf.inverse_point(hit.p), hit.part, to_object_normal(base, hit.n));
@@ -199,7 +199,7 @@ RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const R
         Vec3 nf = normalize(base.xf.normal(t.normal));
         if (dot(nf, v) < 0) nf = -nf;
         Vec3 bare = m.ka * m.color * scene.ambient, furred = fur.ka * t.colour * scene.ambient;
-        const auto visible = hard_shadows(rs, hit.object);
+        const auto visible = hard_shadows(rs, hit.object, state);
         // Both surfaces' terms: a light that adds to neither casts no shadow ray.
         struct Terms {
             Vec3 bare, furred;
@@ -213,7 +213,7 @@ RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const R
             bare += added.bare;
             furred += added.furred;
         };
-        for_each_light(rs, hit.p, counters, terms, visible, lit);
+        for_each_light(rs, hit.p, state, terms, visible, lit);
         return (1 - t.coverage) * bare + t.coverage * furred;
     };
     return render_image(rs, o);
