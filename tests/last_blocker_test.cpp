@@ -75,6 +75,37 @@ TEST(LastBlocker, WhatBlockedTheLastRayIsTestedFirstAndOnce) {
     EXPECT_EQ(front.tests, 0);
 }
 
+// Rays up through a row of spheres, each blocked by its own: the kept blocker is tested first
+// in vain while trusted, then no longer, until it blocks a ray again.
+TEST(LastBlocker, ABlockerTestedInVainIsNoLongerTestedFirst) {
+    std::vector<std::unique_ptr<CountedSphere>> row;
+    std::vector<AccelObject> objects;
+    for (int i = 0; i < 6; ++i) {
+        row.push_back(std::make_unique<CountedSphere>(Vec3{2.0 * i, 0, 5}, 0.5));
+        objects.push_back({row.back().get(), &kIdentity});
+    }
+    const EmbreeAccel accel(objects);
+    EmbreeAccel::LastBlocker last;
+    const auto up_through = [&](int i) {
+        for (auto& s : row) s->tests = 0;
+        return accel.occluded({{2.0 * i, 0, 0}, {0, 0, 1}}, 0, 20, EmbreeAccel::kNoObject, &last);
+    };
+    ASSERT_TRUE(up_through(0));
+    for (int i = 1; i <= EmbreeAccel::kMaxTrust; ++i) {
+        ASSERT_TRUE(up_through(i));
+        EXPECT_EQ(row[static_cast<std::size_t>(i - 1)]->tests, 1) << i;  // tested first, in vain
+    }
+    EXPECT_EQ(last.trust, 0);
+    const std::size_t kept = EmbreeAccel::kMaxTrust;
+    ASSERT_TRUE(up_through(kept + 1));
+    EXPECT_EQ(row[kept]->tests, 0);  // no longer tested first
+    // Blocking the next ray without being tested first, it is trusted again.
+    ASSERT_TRUE(up_through(kept + 1));
+    EXPECT_EQ(last.trust, EmbreeAccel::kMaxTrust);
+    ASSERT_TRUE(up_through(kept + 1));
+    EXPECT_EQ(row[kept + 1]->tests, 1);
+}
+
 // Shadow rays in runs, as a tile's pixels cast them toward two lights, through spheres, wavy
 // chains (placed turned and moved) and a floor: the same answers with and without the blocker
 // kept, with chains placed flat and as Embree instances; fewer sphere tests with it.

@@ -132,6 +132,43 @@ TEST(Layers, ShadowRaysSumTransmittanceAndStopWhenBlocked) {
                                               {.blocked_below = expected * 1.01}));
 }
 
+// Shadow rays in a run that keeps what blocked the last of them (EmbreeAccel::LastBlocker):
+// the same answer and the same partial crossings as each alone, whether the kept sheet blocks
+// the next ray, lets it through partly, or lies out of its reach.
+TEST(Layers, ARunOfShadowRaysKeepingItsBlockerAnswersAsEachAlone) {
+    const Stack clear(6), blocked(6, 4);
+    const auto crossings = [](const std::vector<AccelHit>& hits) {
+        std::vector<std::pair<double, std::uint32_t>> out;
+        for (const AccelHit& h : hits) out.emplace_back(h.t, h.object);
+        return out;
+    };
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> xy(-1.3, 1.3), z0(0, 6.5);
+    std::uniform_int_distribution<std::uint32_t> self(0, 7);  // past 5: none
+    for (const Stack* s : {&clear, &blocked})
+        for (const double below : {0.05, 0.3}) {
+            EmbreeAccel::LastBlocker last;
+            int stopped = 0;
+            for (int i = 0; i < 400; ++i) {
+                const Ray r{{xy(rng), xy(rng), z0(rng)}, {0, 0, 1}};
+                const std::uint32_t from = self(rng);
+                AccelHit hit_alone, hit_run;
+                std::vector<AccelHit> alone, run;
+                const bool a = s->accel->intersect_layers(r, 0, kInfinity, from, hit_alone, alone,
+                                                          {.blocked_below = below});
+                const bool b = s->accel->intersect_layers(r, 0, kInfinity, from, hit_run, run,
+                                                          {.blocked_below = below}, &last);
+                ASSERT_EQ(a, b) << i;
+                stopped += a;
+                if (!a) {
+                    EXPECT_EQ(crossings(alone), crossings(run)) << i;
+                }
+            }
+            EXPECT_GT(stopped, 20);
+            EXPECT_LT(stopped, 380);
+        }
+}
+
 // A shadow ray tests the object it leaves (`self`) after the traversal, if nothing else
 // blocked it: the crossings it finds are the same whichever object it leaves (these sheets
 // have no surface tolerance, and lie ahead of the ray's start), and an opaque sheet blocks a

@@ -526,23 +526,44 @@ struct EmbreeAccel::Impl {
         if (ctx.found && o.cheap_blocker) ctx.blocker = {ctx.self, EmbreeAccel::kWhole};
     }
 
-    // Before a shadow ray's traversal: whether what blocked the last ray of its run blocks this
-    // one too. Not the ray's own direct object, which test_self_last tests after the traversal;
-    // what is tested here the traversal's callbacks skip.
-    bool blocked_by_last(QueryContext& ctx, const EmbreeAccel::LastBlocker& last) const {
-        if (last.object >= objects.size()) return false;
-        const Placed& o = objects[last.object];
-        const bool whole = last.part == EmbreeAccel::kWhole;
+    // Before a shadow ray's traversal: whether the run's blocker, kept and trusted, blocks this
+    // ray too (EmbreeAccel::LastBlocker). Not the ray's own direct object, which test_self_last
+    // tests after the traversal; what is tested here the traversal's callbacks skip.
+    bool blocked_by_kept(QueryContext& ctx, EmbreeAccel::LastBlocker* last) const {
+        if (!last || last->trust == 0 || last->object >= objects.size()) return false;
+        const Placed& o = objects[last->object];
+        const bool whole = last->part == EmbreeAccel::kWhole;
         assert(!whole || o.cheap_blocker);
-        if (whole && last.object == ctx.self) return false;
+        if (whole && last->object == ctx.self) return false;
         const Ray local = object_ray(o, ctx.ray);
-        ctx.across_obj = last.object;
-        const double tmin = occlusion_tmin(&ctx, last.object, local);
-        if (whole ? o.shape->occluded(local, tmin, ctx.tmax)
-                  : o.shape->occluded_primitive(last.part, local, tmin, ctx.tmax))
-            return true;
-        ctx.tested_first = last;
-        return false;
+        ctx.across_obj = last->object;
+        const double tmin = occlusion_tmin(&ctx, last->object, local);
+        bool blocked;
+        if (ctx.stop.shadow()) {  // a transmittance: a partial crossing it meets is kept
+            const Target t{last->object, whole ? 0 : last->part};
+            blocked = whole ? blocks_transmittance<Kind::kDirect>(&ctx, t, *o.shape, local, tmin)
+                            : blocks_transmittance<Kind::kFlat>(&ctx, t, *o.shape, local, tmin);
+        } else {
+            blocked = whole ? o.shape->occluded(local, tmin, ctx.tmax)
+                            : o.shape->occluded_primitive(last->part, local, tmin, ctx.tmax);
+        }
+        if (blocked) {
+            last->trust = EmbreeAccel::kMaxTrust;
+        } else {
+            ctx.tested_first = *last;
+            --last->trust;
+        }
+        return blocked;
+    }
+    // After the traversal: what blocked the ray (nothing, if it got through or what blocked it
+    // is not kept) is the run's blocker from now on; if it was the kept one, not tested first
+    // (it would have blocked the ray), it is trusted again.
+    static void keep_blocker(const QueryContext& ctx, EmbreeAccel::LastBlocker* last) {
+        if (!last) return;
+        if (ctx.blocker.object != EmbreeAccel::kNoObject && last->same(ctx.blocker))
+            last->trust = EmbreeAccel::kMaxTrust;
+        last->object = ctx.blocker.object;
+        last->part = ctx.blocker.part;
     }
 
     template <Kind K>
@@ -741,7 +762,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 
 bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                                    AccelHit& hit, std::vector<AccelHit>& partial,
-                                   const LayerStop& stop) const {
+                                   const LayerStop& stop, LastBlocker* last) const {
     partial.clear();
     const bool traceable = embree_can_trace(r, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
@@ -751,8 +772,13 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     ctx.partial = &partial;
     ctx.stop = stop;
     if (traceable && stop.shadow()) {
-        trace_any(m.scene, ctx, r, tmin, tmax);
-        m.test_self_last(ctx);
+        if (m.blocked_by_kept(ctx, last)) {
+            ctx.found = true;
+        } else {
+            trace_any(m.scene, ctx, r, tmin, tmax);
+            m.test_self_last(ctx);
+            m.keep_blocker(ctx, last);
+        }
     } else if (traceable)
         trace_closest(m.scene, ctx, r, tmin, tmax);
     const bool blocked = ctx.found && stop.shadow();
@@ -787,12 +813,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, nullptr);
     ctx.self = m.our_number(self);
-    // A run of rays that pass, or that something else blocks, keeps nothing: a blocker tested
-    // first in vain costs a test that the traversal may not have made.
-    if (last) {
-        if (m.blocked_by_last(ctx, *last)) return true;
-        *last = {};
-    }
+    if (m.blocked_by_kept(ctx, last)) return true;
     for (const std::uint32_t i : m.unbounded) {
         const Placed& o = m.objects[i];
         const Ray local = object_ray(o, r);
@@ -803,7 +824,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
         trace_any(m.scene, ctx, r, tmin, tmax);
         m.test_self_last(ctx);
     }
-    if (last) *last = ctx.blocker;
+    m.keep_blocker(ctx, last);
     return ctx.found;
 }
 

@@ -30,8 +30,9 @@ inline constexpr double kMaxShadowWidening = 4;
 Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeState& state);
 
 // The share of light that gets through from tmin to tmax along r (unit direction) leaving a
-// surface of object `self`, whose crossings within its surface tolerance are skipped.
+// surface of object `self`, whose crossings within its surface tolerance are skipped. last: what
+// blocked the last ray of its run, if kept (EmbreeAccel::LastBlocker).
 double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tmax,
-                     std::uint32_t self);
+                     std::uint32_t self, EmbreeAccel::LastBlocker* last = nullptr);
 
 }  // namespace lat

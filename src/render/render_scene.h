@@ -51,9 +51,10 @@ public:
     // less than stop.blocked_below through), else its partial crossings, not made into surface
     // hits (their points and normals are not wanted).
     bool partial_crossings(const Ray& r, double tmin, double tmax, std::uint32_t self,
-                           std::vector<AccelHit>& partial, const LayerStop& stop) const {
+                           std::vector<AccelHit>& partial, const LayerStop& stop,
+                           EmbreeAccel::LastBlocker* last = nullptr) const {
         AccelHit opaque;
-        return accel_->intersect_layers(r, tmin, tmax, self, opaque, partial, stop);
+        return accel_->intersect_layers(r, tmin, tmax, self, opaque, partial, stop, last);
     }
     // `self`: the object whose surface the ray leaves (see EmbreeAccel::occluded).
     bool occluded(const Ray& r, double tmin, double tmax,
