@@ -75,6 +75,23 @@ TEST(LastBlocker, WhatBlockedTheLastRayIsTestedFirstAndOnce) {
     EXPECT_EQ(front.tests, 0);
 }
 
+// A ray Embree cannot trace (its origin lies past 1.8e18) meets unbounded objects alone, with
+// or without a kept blocker that its line crosses.
+TEST(LastBlocker, ARayEmbreeCannotTraceMeetsUnboundedObjectsAlone) {
+    CountedSphere huge({0, 0, 0}, 1e18);
+    const std::vector<AccelObject> objects{{&huge, &kIdentity}};
+    const EmbreeAccel accel(objects);
+    EmbreeAccel::LastBlocker last;
+    const Ray near{{0, 0, -1.5e18}, {0, 0, 1}};
+    ASSERT_TRUE(accel.occluded(near, 0, 1e19, EmbreeAccel::kNoObject, &last));
+    ASSERT_NE(last.object, EmbreeAccel::kNoObject);
+    const Ray far{{0, 0, -4e18}, {0, 0, 1}};
+    const bool alone = accel.occluded(far, 2e18, 1e19);
+    huge.tests = 0;
+    EXPECT_EQ(accel.occluded(far, 2e18, 1e19, EmbreeAccel::kNoObject, &last), alone);
+    EXPECT_EQ(huge.tests, 0);
+}
+
 // Rays up through a row of spheres, each blocked by its own: the kept blocker is tested first
 // in vain while trusted, then no longer, until it blocks a ray again.
 TEST(LastBlocker, ABlockerTestedInVainIsNoLongerTestedFirst) {
@@ -120,7 +137,8 @@ struct Crowd {
         std::uniform_real_distribution<double> u(-4, 4), rad(0.2, 0.7), angle(0, 6.28);
         xf.reserve(60);  // AccelObject keeps pointers into xf
         for (int i = 0; i < 30; ++i) {
-            spheres.push_back(std::make_unique<CountedSphere>(Vec3{u(rng), u(rng), u(rng) + 5}, rad(rng)));
+            const Vec3 c{u(rng), u(rng), u(rng) + 5};
+            spheres.push_back(std::make_unique<CountedSphere>(c, rad(rng)));
             objects.push_back({spheres.back().get(), &kIdentity});
         }
         for (int i = 0; i < 20; ++i) {

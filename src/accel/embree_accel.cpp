@@ -105,13 +105,11 @@ struct QueryContext {
     double tmin, tmax;
     AccelHit* hit;
     bool found = false;
-    // Occlusion: the object the ray leaves (the accelerator's number); one tested before the
-    // traversal (LastBlocker), which its callbacks skip; the direct object that blocked the ray.
+    // Occlusion: the object the ray leaves (the accelerator's number); what was tested before
+    // the traversal (LastBlocker), which its callbacks skip; what blocked the ray, if it is to
+    // be kept (Impl::blocker_of).
     std::uint32_t self = EmbreeAccel::kNoObject;
     EmbreeAccel::LastBlocker tested_first, blocker;
-    bool is_tested_first(std::uint32_t obj, std::uint32_t part) const {
-        return obj == tested_first.object && part == tested_first.part;
-    }
     // intersect_layers: where crossings of partial coverage go (they do not end the ray), how
     // far to look, and for shadow rays what they let through (LayerComposite, which does not
     // depend on the order they are met in).
@@ -523,7 +521,23 @@ struct EmbreeAccel::Impl {
             ctx.found = blocks_transmittance<Kind::kDirect>(&ctx, t, *o.shape, local, tmin);
         else
             ctx.found = o.shape->occluded(local, tmin, ctx.tmax);
-        if (ctx.found && o.cheap_blocker) ctx.blocker = {ctx.self, EmbreeAccel::kWhole};
+        if (ctx.found) ctx.blocker = blocker_of<Kind::kDirect>(t);
+    }
+
+    // What a shadow ray's run keeps of what blocked it (EmbreeAccel::LastBlocker): a part of a
+    // several-part object, or a direct object cheap to test; else nothing.
+    template <Kind K>
+    EmbreeAccel::LastBlocker blocker_of(Target t) const {
+        if constexpr (K == Kind::kDirect) {
+            if (!objects[t.object].cheap_blocker) return {};
+            return {t.object, EmbreeAccel::kWhole};
+        }
+        return {t.object, static_cast<std::uint32_t>(t.part)};
+    }
+    template <Kind K>
+    static EmbreeAccel::LastBlocker tested_as(Target t) {
+        if constexpr (K == Kind::kDirect) return {t.object, EmbreeAccel::kWhole};
+        return {t.object, static_cast<std::uint32_t>(t.part)};
     }
 
     // Before a shadow ray's traversal: whether the run's blocker, kept and trusted, blocks this
@@ -533,10 +547,9 @@ struct EmbreeAccel::Impl {
         if (!last || last->trust == 0 || last->object >= objects.size()) return false;
         const Placed& o = objects[last->object];
         const bool whole = last->part == EmbreeAccel::kWhole;
-        assert(!whole || o.cheap_blocker);
+        assert(whole ? o.cheap_blocker : last->part < o.shape->primitive_count());
         if (whole && last->object == ctx.self) return false;
         const Ray local = object_ray(o, ctx.ray);
-        ctx.across_obj = last->object;
         const double tmin = occlusion_tmin(&ctx, last->object, local);
         bool blocked;
         if (ctx.stop.shadow()) {  // a transmittance: a partial crossing it meets is kept
@@ -574,9 +587,7 @@ struct EmbreeAccel::Impl {
         const Target t = self->template target<K>(args->primID, args->context->instID[0]);
         if constexpr (K == Kind::kDirect)
             if (t.object == ctx->self || !self->may_visit(ctx, args->primID)) return;
-        if (ctx->is_tested_first(t.object, K == Kind::kDirect ? EmbreeAccel::kWhole
-                                                              : static_cast<std::uint32_t>(t.part)))
-            return;
+        if (ctx->tested_first.same(tested_as<K>(t))) return;
         const Shape& shape = *self->objects[t.object].shape;
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
@@ -592,9 +603,7 @@ struct EmbreeAccel::Impl {
             hit = shape.occluded_primitive(t.part, local, tmin, ctx->tmax);
         if (hit) {
             ctx->found = true;
-            if (K != Kind::kDirect || self->objects[t.object].cheap_blocker)
-                ctx->blocker = {t.object, K == Kind::kDirect ? EmbreeAccel::kWhole
-                                                             : static_cast<std::uint32_t>(t.part)};
+            ctx->blocker = self->template blocker_of<K>(t);
             reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;
         }
     }
@@ -813,11 +822,16 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, nullptr);
     ctx.self = m.our_number(self);
-    if (m.blocked_by_kept(ctx, last)) return true;
+    // Only rays Embree can trace test their run's blocker first: the others meet unbounded
+    // objects alone.
+    if (traceable && m.blocked_by_kept(ctx, last)) return true;
     for (const std::uint32_t i : m.unbounded) {
         const Placed& o = m.objects[i];
         const Ray local = object_ray(o, r);
-        if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) return true;
+        if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) {
+            m.keep_blocker(ctx, last);  // nothing kept: unbounded objects are tested anyway
+            return true;
+        }
     }
 
     if (traceable) {

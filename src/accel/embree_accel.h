@@ -66,8 +66,6 @@ public:
 
     // Closest crossing with tmin < t < tmax, over all objects.
     bool intersect(const Ray& r, double tmin, double tmax, AccelHit& hit) const;
-    // Whether anything is crossed with tmin < t < tmax. A ray leaving a surface of object
-    // `self` also skips that object's crossings within its surface_tolerance().
     static constexpr std::uint32_t kNoObject = 0xFFFFFFFFu;
     // What blocked the last shadow ray of a run (one light's, pixel after pixel), which
     // occluded() and intersect_layers() (a shadow ray's transmittance) test first when the
@@ -77,17 +75,21 @@ public:
     // kCheapBlockerCost simple tests (a lattice's table, a sphere). The answer is the same with
     // or without it. Where shadows are too fine for runs (grass: 6 % of such tests blocked),
     // its trust falls to 0 and it is no longer tested first, until it blocks a ray again.
+    // It belongs to one accelerator (the renderer keeps one per light in each tile's
+    // ShadeState).
     struct LastBlocker {
         std::uint32_t object = kNoObject;  // the accelerator's own number
         std::uint32_t part = kWhole;       // its part, or kWhole
-        // Tested first while above 0: one up when it blocks the next ray (or would have), one
-        // down when tested in vain, within [0, kMaxTrust].
+        // Tested first while above 0: full again (kMaxTrust) when it blocks a ray, tested first
+        // or not; one less each time it is tested in vain.
         std::uint8_t trust = kMaxTrust;
         bool same(const LastBlocker& b) const { return object == b.object && part == b.part; }
     };
     static constexpr std::uint32_t kWhole = 0xFFFFFFFFu;
     static constexpr double kCheapBlockerCost = 1;
     static constexpr std::uint8_t kMaxTrust = 3;
+    // Whether anything is crossed with tmin < t < tmax. A ray leaving a surface of object
+    // `self` also skips that object's crossings within its surface_tolerance().
     bool occluded(const Ray& r, double tmin, double tmax, std::uint32_t self = kNoObject,
                   LastBlocker* last = nullptr) const;
     // One traversal for rays that see through partial crossings (Crossing::coverage < 1, from

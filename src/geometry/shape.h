@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <span>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "math/bounds.h"
@@ -133,6 +134,9 @@ struct SubRayNormals {
     };
     std::array<Slot, 4> n;
 };
+// Copied whole as bytes, unset slots too; a Slot default-constructed is left unset.
+static_assert(std::is_trivially_copyable_v<SubRayNormals>);
+static_assert(std::is_trivially_default_constructible_v<SubRayNormals::Slot>);
 // One of a camera ray's sheets (Shape::sheets).
 struct SheetCrossing {
     Crossing crossing;

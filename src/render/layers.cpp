@@ -34,7 +34,8 @@ double sheet_width(const SurfaceHit& h, double width) {
 // of detail for its shadow rays, narrowing to the point light.
 Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, double width,
                  ShadeState& state) {
-    const auto visible = [&](std::size_t light, const Ray& r, double tmin, double tmax, double dist) {
+    const auto visible = [&](std::size_t light, const Ray& r, double tmin, double tmax,
+                             double dist) {
         const double w = shadow_width(ray, hit, r, width);
         set_ray_footprint({w, -w / dist, true});
         return transmittance(rs, r, tmin, tmax, hit.object, state.kept_blocker(light));
@@ -49,7 +50,8 @@ double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tm
     thread_local std::vector<AccelHit> partial;
     // Sub-rays along the same world directions in every lattice (geometry/sub_rays.h).
     const ScopedAcrossRay across(normalize(r.d));
-    if (rs.partial_crossings(r, tmin, tmax, self, partial, {.blocked_below = kMinTransmittance}, last))
+    const LayerStop stop{.blocked_below = kMinTransmittance};
+    if (rs.partial_crossings(r, tmin, tmax, self, partial, stop, last))
         return 0;
     LayerComposite through;
     for (const AccelHit& h : partial) through.add(h.crossing);

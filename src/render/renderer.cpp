@@ -100,7 +100,8 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
                 if (tc.opt.layered)
                     c = trace_layers(tc.rs, ray, tc.spread, state);
                 else if (tc.rs.intersect(ray, 0.0, kInfinity, hit))
-                    c = tc.opt.shader ? tc.opt.shader(ray, hit, state) : shade(tc.rs, ray, hit, state);
+                    c = tc.opt.shader ? tc.opt.shader(ray, hit, state)
+                                      : shade(tc.rs, ray, hit, state);
                 sum += c;
                 sum_clamped += Vec3{std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0),
                                     std::clamp(c.z, 0.0, 1.0)};
