@@ -61,6 +61,8 @@ public:
     double surface_tolerance() const override { return s_->surface_tolerance(); }
     bool inside(lat::Vec3 p) const override { return s_->inside(p); }
     std::size_t primitive_count() const override { return s_->primitive_count(); }
+    // What the accelerator weighs (shadow rays' kept blockers) as the shape's own.
+    double intersect_cost() const override { return s_->intersect_cost(); }
     lat::Bounds3 primitive_bounds(std::size_t i) const override { return s_->primitive_bounds(i); }
     lat::Bounds3 primitive_bounds(std::size_t i, const lat::Transform& xf) const override {
         return s_->primitive_bounds(i, xf);
