@@ -528,12 +528,10 @@ struct EmbreeAccel::Impl {
     // several-part object, or a direct object cheap to test; else nothing.
     template <Kind K>
     EmbreeAccel::LastBlocker blocker_of(Target t) const {
-        if constexpr (K == Kind::kDirect) {
-            if (!objects[t.object].cheap_blocker) return {};
-            return {t.object, EmbreeAccel::kWhole};
-        }
-        return {t.object, static_cast<std::uint32_t>(t.part)};
+        if (K == Kind::kDirect && !objects[t.object].cheap_blocker) return {};
+        return tested_as<K>(t);
     }
+    // A target as a LastBlocker names it: a direct object whole, else its part.
     template <Kind K>
     static EmbreeAccel::LastBlocker tested_as(Target t) {
         if constexpr (K == Kind::kDirect) return {t.object, EmbreeAccel::kWhole};
