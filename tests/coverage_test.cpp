@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <random>
 
@@ -531,18 +532,23 @@ std::string near_and_far(bool row, bool far_bead) {
     return text;
 }
 
-// How many levels scene_lattices builds for a scene's one primitive, with levels of detail on,
-// within a pair budget.
-std::size_t levels_built(const std::string& scene, double max_pairs) {
-    test::TempDir dir;
+// The lattices scene_lattices gives a scene's one primitive, with levels of detail on, within
+// a pair and a work budget, with its cache in dir.
+SceneLattices levels_for(const test::TempDir& dir, const std::string& scene, double max_pairs,
+                         double max_work = kMaxLodWork) {
     const std::string path = (dir.path() / "near-and-far.json").string();
     std::ofstream(path) << scene;
     const Scene s = load_scene(path);
     const TableCache cache(dir.path().string(), true);
     TableSpec spec;
     spec.encoding = "coverage";
-    return scene_lattices(s, cache, spec, false, {LatticeFilter::kSmooth, true, 0.01, max_pairs})
-        .paths.size();
+    return scene_lattices(s, cache, spec, false,
+                          {LatticeFilter::kSmooth, true, 0.01, max_pairs, max_work});
+}
+// How many levels it reads (from a fresh cache).
+std::size_t levels_built(const std::string& scene, double max_pairs, double max_work = kMaxLodWork) {
+    test::TempDir dir;
+    return levels_for(dir, scene, max_pairs, max_work).paths.size();
 }
 
 // Levels of detail stop at the pair budget (LatticeFiltering::max_pairs): the finest level
@@ -565,6 +571,56 @@ TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
         EXPECT_EQ(levels(p1 - 1), 1u);
         EXPECT_EQ(levels(p0 / 2), 1u);
     }
+}
+
+// And at the work budget (LatticeFiltering::max_work: pairs times the primitive's cost, the
+// time of a build), saying so: the level wanted, the one left out, the one read instead.
+TEST(Coverage, LevelsOfDetailStopAtTheWorkBudgetAndSaySo) {
+    const double p1 = static_cast<double>(BoundaryGrid::pair_count({4, 2, 4}));
+    const double p2 = static_cast<double>(BoundaryGrid::pair_count({8, 4, 8}));
+    test::TempDir probe;
+    const std::string scene = near_and_far(true, true);
+    levels_for(probe, scene, kMaxLodPairs);
+    const double cost = load_scene((probe.path() / "near-and-far.json").string())
+                            .primitives[0].shape->intersect_cost();
+    ASSERT_GT(cost, kMaxExactCost);  // its levels are tables
+    const auto levels = [&](double max_work) { return levels_built(scene, kMaxLodPairs, max_work); };
+    EXPECT_EQ(levels(p2 * cost), 3u);
+    EXPECT_EQ(levels(p2 * cost * 0.99), 2u);
+    EXPECT_EQ(levels(p1 * cost), 2u);
+    EXPECT_EQ(levels(p1 * cost * 0.99), 1u);
+    EXPECT_EQ(levels(0), 1u);  // level 0 whatever its cost
+
+    test::TempDir dir;
+    const SceneLattices all = levels_for(dir, scene, kMaxLodPairs, p2 * cost);
+    EXPECT_TRUE(all.notes.empty());
+    test::TempDir dir2;
+    const SceneLattices two = levels_for(dir2, scene, kMaxLodPairs, p1 * cost);
+    ASSERT_EQ(two.notes.size(), 1u);
+    const std::string& note = two.notes[0];
+    EXPECT_NE(note.find("primitives.bead"), std::string::npos) << note;
+    EXPECT_NE(note.find("to sigma^-1 = 4 wanted"), std::string::npos) << note;
+    EXPECT_NE(note.find("sigma^-1 = 4 would take"), std::string::npos) << note;
+    EXPECT_NE(note.find("read sigma^-1 = 2"), std::string::npos) << note;
+}
+
+// The work budget bounds what a render builds, not what it reads: levels in the cache are read
+// whatever it is, and the levels between them too only when they are cached or within it.
+TEST(Coverage, LevelsOfDetailInTheCacheAreReadWhateverTheWorkBudget) {
+    test::TempDir dir;
+    const std::string scene = near_and_far(true, true);
+    EXPECT_EQ(levels_for(dir, scene, kMaxLodPairs).paths.size(), 3u);  // builds all three
+    const SceneLattices cached = levels_for(dir, scene, kMaxLodPairs, 0);
+    EXPECT_EQ(cached.paths.size(), 3u);
+    EXPECT_EQ(cached.built, 0);
+    EXPECT_TRUE(cached.notes.empty());
+    // Level 1 gone from the cache: level 2 alone is read (level 1 is not affordable), and
+    // nothing is built.
+    std::filesystem::remove(cached.paths[1]);
+    const SceneLattices gap = levels_for(dir, scene, kMaxLodPairs, 0);
+    ASSERT_EQ(gap.paths.size(), 1u);
+    EXPECT_EQ(gap.paths[0], cached.paths[2]);
+    EXPECT_EQ(gap.built, 0);
 }
 
 // The footprints on a primitive's copies: from the nearest point of the nearest box to the

@@ -49,6 +49,7 @@ struct RenderArgs {
     int shadow_map_size = ParticleOptions{}.shadow_map_size;
     std::string filter = "smooth";
     std::string lod = "on";
+    double lod_budget = kLodBudgetMinutes;  // of one core
     bool quiet = false;
 
     bool lattice_mode() const { return kModes.at(mode) == RenderMode::kLattice; }
@@ -81,6 +82,7 @@ void print_summary(const RenderArgs& a, const Scene& scene, const ModeResult& r,
                      human_bytes(static_cast<double>(lattices.table_bytes)).c_str(),
                      std::to_string(lattices.table_entries).c_str(), lattices.built,
                      lattices.build_seconds);
+    for (const std::string& note : lattices.notes) std::fprintf(stderr, "lattice: note: %s\n", note.c_str());
     if (st.ranks.size() > 1)
         std::fprintf(stderr, "lattice: render spread over %zu MPI ranks (tiles per rank:%s)\n",
                      st.ranks.size(), [&] {
@@ -119,6 +121,8 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeRes
         j["encoding"] = a.spec.encoding;
         j["filter"] = a.filter;
         j["lod"] = a.lod;
+        j["lod_budget_minutes"] = a.lod_budget;
+        j["lattice_notes"] = lattices.notes;
         j["tables_ms"] = r.prepare_ms;
         j["tables_built"] = lattices.built;
         j["table_bytes"] = lattices.table_bytes;
@@ -189,6 +193,7 @@ int run_render(const RenderArgs& a) {
     settings.spec = a.spec;
     settings.filtering.filter = kFilters.at(a.filter);
     settings.filtering.lod = kOnOff.at(a.lod);
+    settings.filtering.max_work = a.lod_budget * 60 * kPairTestsPerCpuSecond;
     settings.accel.instancing = kInstancing.at(a.instancing);
     settings.texture = a.texture;
     settings.shadow_map_size = a.shadow_map_size;
@@ -252,6 +257,13 @@ Command add_render_command(CLI::App& parent) {
                           "K, 2K, 4K as the pixels' footprints need (on); or only K, tables "
                           "alone (off)")
         ->check(CLI::IsMember(kOnOff));
+    c.app->add_option("--lod-budget", args->lod_budget,
+                      "lattice mode, --lod on: a costlier primitive's levels of detail beyond K are "
+                      "built only if each takes at most about this many minutes of one core "
+                      "(estimated from its pairs and the primitive's cost); rays that want a level "
+                      "left out read the finest built, and the summary says so")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     c.app->add_option("--instancing", args->instancing,
                       "Multi-part objects as Embree instances (always), flattened into one "
                       "hierarchy (never), or flattened unless that would be huge (auto)")

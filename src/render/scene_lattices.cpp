@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "csg/csg_shape.h"
 #include "lattice/boundary_grid.h"
@@ -42,6 +43,78 @@ std::pair<int, int> lod_range(const Scene& scene, int prim, const TableContext& 
     return {j0, j1};
 }
 
+// Level j of a primitive's levels of detail: sigma^-1 = K 2^j.
+TablePlan level_plan(const Scene& scene, const Primitive& p, const TableSpec& spec, int j) {
+    TableSpec level = spec;
+    level.sigma_inv = spec.sigma_inv << j;
+    return plan_table(p, level, scene.file);
+}
+
+// What a primitive's levels of detail cost: pairs and the time to build them.
+struct LevelCosts {
+    const Scene& scene;
+    const Primitive& p;
+    const TableSpec& spec;
+    double cost = p.shape ? std::max(1.0, p.shape->intersect_cost()) : 1.0;  // per sub-ray
+
+    long long sigma_inv(int j) const { return static_cast<long long>(spec.sigma_inv) << j; }
+    std::string name(int j) const { return "sigma^-1 = " + std::to_string(sigma_inv(j)); }
+    double pairs(int j) const {
+        return static_cast<double>(
+            BoundaryGrid::pair_count(level_plan(scene, p, spec, j).context.cells));
+    }
+    double work(int j) const { return pairs(j) * cost; }  // LatticeFiltering::max_work
+};
+
+// Why level `next` is left out (past the largest refinement, over the pair budget, or over the
+// work budget), and what the rays that want it or finer read instead.
+std::string levels_note(const LevelCosts& c, int wanted, int next, bool fits,
+                        const LatticeFiltering& filtering) {
+    const auto whole = [](double v) { return std::to_string(std::llround(std::ceil(v))); };
+    std::string why;
+    if (!fits && c.sigma_inv(next) > kMaxSigmaInv)
+        why = c.name(next) + " is past the largest, " + std::to_string(kMaxSigmaInv);
+    else if (!fits)
+        why = c.name(next) + " has " + whole(c.pairs(next) / 1e6) +
+              " M pairs, over the budget of " + whole(filtering.max_pairs / 1e6) + " M";
+    else
+        why = c.name(next) + " would take about " +
+              whole(c.work(next) / kPairTestsPerCpuSecond / 60) +
+              " minutes of one core to build, over --lod-budget (" +
+              whole(filtering.max_work / kPairTestsPerCpuSecond / 60) +
+              "); a larger budget builds it once, for every later render";
+    return c.p.where + ": levels of detail to " + c.name(wanted) + " wanted; " + why +
+           "; rays that want finer read " + c.name(next - 1);
+}
+
+// The levels j to read, of those the footprints want: within the largest refinement and the
+// pair budget (memory), and the finest affordable (time): within the work budget, or cached
+// already (the budget bounds what a render builds, not what it reads). Level 0, the lattice
+// asked for, is read whatever its size. A note says what was left out, why, and how to get it.
+struct LevelChoice {
+    std::pair<int, int> range;
+    std::string note;  // empty when every level wanted is read
+};
+LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pair<int, int> wanted,
+                          const LatticeFiltering& filtering) {
+    const auto fits = [&](int j) {
+        return c.sigma_inv(j) <= kMaxSigmaInv && c.pairs(j) <= filtering.max_pairs;
+    };
+    const auto affordable = [&](int j) {
+        return j == 0 || c.work(j) <= filtering.max_work ||
+               std::filesystem::exists(cache.path_for(level_plan(c.scene, c.p, c.spec, j)));
+    };
+    int fitting = 0;
+    while (fitting < wanted.second && fits(fitting + 1)) ++fitting;
+    int finest = fitting;
+    while (!affordable(finest)) --finest;
+    int first = std::min(wanted.first, finest);
+    for (int j = finest; j > first; --j)
+        if (!affordable(j - 1)) first = j;
+    if (finest == wanted.second) return {{first, finest}, ""};
+    return {{first, finest}, levels_note(c, wanted.second, finest + 1, finest < fitting, filtering)};
+}
+
 // A primitive's filtered lattice: its levels from the cache, coarse to fine. csg_leaf: some CSG
 // tree holds an instance of it.
 void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, const TableSpec& spec,
@@ -72,28 +145,15 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     } else if (lod) {
         range = lod_range(scene, prim, base, filtering.spread);
     }
-    // Levels beyond the largest refinement or the pair budget are left out: the finest level
-    // within both then serves the rays that want finer. Level 0
-    // (the lattice asked for) is built whatever its size.
-    const auto level_plan = [&](int j) {
-        TableSpec level = spec;
-        level.sigma_inv = spec.sigma_inv << j;
-        return plan_table(p, level, scene.file);
-    };
-    const auto allowed = [&](int j) {
-        return (static_cast<long long>(spec.sigma_inv) << j) <= kMaxSigmaInv &&
-               BoundaryGrid::pair_count(level_plan(j).context.cells) <=
-                   static_cast<long double>(filtering.max_pairs);
-    };
-    int finest = 0;
-    while (finest < range.second && allowed(finest + 1)) ++finest;
-    range = {std::min(range.first, finest), std::min(range.second, finest)};
+    const LevelChoice choice = choose_levels({scene, p, spec}, cache, range, filtering);
+    if (!choice.note.empty()) out.notes.push_back(choice.note);
+    range = choice.range;
     std::vector<FilterLevel> levels;
     double error = 0;
     const bool reads_tables = exact_width == 0 || csg_leaf;
     if (!reads_tables) levels.push_back({nullptr, base});
     for (int j = range.first; reads_tables && j <= range.second; ++j) {
-        const TablePlan plan = level_plan(j);
+        const TablePlan plan = level_plan(scene, p, spec, j);
         const TableCache::Entry e = cache.get(plan, progress);
         levels.push_back({e.table, plan.context});
         error = plan.error_bound();

@@ -21,6 +21,9 @@ struct SceneLattices {
     int built = 0;
     double build_seconds = 0;
     std::vector<std::string> paths;
+    // What the user should know about the lattices chosen: levels of detail left out for a
+    // budget, and what serves their rays instead.
+    std::vector<std::string> notes;
 };
 
 // How lattices are filtered (issue 10): the filter, and whether levels of detail are built. With
@@ -34,11 +37,22 @@ struct SceneLattices {
 // of 16 x 16 x 8 cells (`lattice-rings`, before its torus was answered by its crossings) stopped
 // at 2K (17 M pairs; 4K, 268 M pairs, was still building after 7 minutes in 5 GB).
 inline constexpr double kMaxLodPairs = 134217728.0;
+// They are also built only up to kMaxLodWork pair tests: pairs times the primitive's
+// intersect_cost, the work of a coverage build, whose sub-rays each pay about the whole cost
+// for a primitive without parts to cull (a CSG object or a quartic: the only ones whose levels
+// are tables, answered_by_primitive). A build does about kPairTestsPerCpuSecond (`ball-csg7`,
+// 73 simple tests: 12.1 and 150 CPU seconds at sigma^-1 = 1 and 2, 2.5 GHz Xeon, 2026-11-27),
+// so the budget is a quarter of an hour of one core (`render --lod-budget`): that primitive gets
+// 2K, not 4K (36 minutes; the first render at the default waited 20 minutes on 2 cores).
+inline constexpr double kPairTestsPerCpuSecond = 1.2e6;
+inline constexpr double kLodBudgetMinutes = 15;
+inline constexpr double kMaxLodWork = kLodBudgetMinutes * 60 * kPairTestsPerCpuSecond;
 struct LatticeFiltering {
     LatticeFilter filter = LatticeFilter::kNone;
     bool lod = false;
     double spread = 0;
     double max_pairs = kMaxLodPairs;
+    double max_work = kMaxLodWork;
 };
 // Three levels, K to 4K: the next (8K) of the paper's hair would take 28 GB to build.
 inline constexpr int kMaxLodLevels = 3;
