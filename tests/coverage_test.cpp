@@ -573,9 +573,10 @@ TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
     }
 }
 
-// And at the work budget (LatticeFiltering::max_work: pairs times the primitive's cost, the
-// time of a build), saying so: the level wanted, the one left out, the one read instead.
-TEST(Coverage, LevelsOfDetailStopAtTheWorkBudgetAndSaySo) {
+// Past the work budget (LatticeFiltering::max_work: pairs times the primitive's cost, the time
+// of a build) a costly primitive answers by its own crossings, as a cheap one does (no tables;
+// each instance's sub-rays bounded), and says so: the level wanted, the one left out, and why.
+TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
     const double p1 = static_cast<double>(BoundaryGrid::pair_count({4, 2, 4}));
     const double p2 = static_cast<double>(BoundaryGrid::pair_count({8, 4, 8}));
     test::TempDir probe;
@@ -584,24 +585,24 @@ TEST(Coverage, LevelsOfDetailStopAtTheWorkBudgetAndSaySo) {
     const double cost = load_scene((probe.path() / "near-and-far.json").string())
                             .primitives[0].shape->intersect_cost();
     ASSERT_GT(cost, kMaxExactCost);  // its levels are tables
-    const auto levels = [&](double max_work) { return levels_built(scene, kMaxLodPairs, max_work); };
-    EXPECT_EQ(levels(p2 * cost), 3u);
-    EXPECT_EQ(levels(p2 * cost * 0.99), 2u);
-    EXPECT_EQ(levels(p1 * cost), 2u);
-    EXPECT_EQ(levels(p1 * cost * 0.99), 1u);
-    EXPECT_EQ(levels(0), 1u);  // level 0 whatever its cost
-
-    test::TempDir dir;
-    const SceneLattices all = levels_for(dir, scene, kMaxLodPairs, p2 * cost);
-    EXPECT_TRUE(all.notes.empty());
-    test::TempDir dir2;
-    const SceneLattices two = levels_for(dir2, scene, kMaxLodPairs, p1 * cost);
-    ASSERT_EQ(two.notes.size(), 1u);
-    const std::string& note = two.notes[0];
-    EXPECT_NE(note.find("primitives.bead"), std::string::npos) << note;
-    EXPECT_NE(note.find("to sigma^-1 = 4 wanted"), std::string::npos) << note;
-    EXPECT_NE(note.find("sigma^-1 = 4 would take"), std::string::npos) << note;
-    EXPECT_NE(note.find("read sigma^-1 = 2"), std::string::npos) << note;
+    for (const double budget : {p2 * cost, p2 * cost * 0.99, p1 * cost * 0.99, 0.0}) {
+        test::TempDir dir;
+        const SceneLattices l = levels_for(dir, scene, kMaxLodPairs, budget);
+        const bool within = budget >= p2 * cost;
+        EXPECT_EQ(l.paths.size(), within ? 3u : 0u) << budget;
+        EXPECT_EQ(l.built, within ? 3 : 0) << budget;
+        for (const double widest : l.widest_footprints)
+            EXPECT_EQ(std::isfinite(widest), !within) << budget;
+        ASSERT_EQ(l.notes.size(), within ? 0u : 1u) << budget;
+        if (within) continue;
+        const std::string& note = l.notes[0];
+        EXPECT_NE(note.find("primitives.bead"), std::string::npos) << note;
+        EXPECT_NE(note.find("to sigma^-1 = 4 wanted"), std::string::npos) << note;
+        const std::string left_out = budget >= p1 * cost ? "sigma^-1 = 4" : "sigma^-1 = 2";
+        EXPECT_NE(note.find(left_out + " would take"), std::string::npos) << note;
+        EXPECT_NE(note.find("--lod-budget"), std::string::npos) << note;
+        EXPECT_NE(note.find("own crossings"), std::string::npos) << note;
+    }
 }
 
 // The work budget bounds what a render builds, not what it reads: levels in the cache are read
@@ -621,6 +622,12 @@ TEST(Coverage, LevelsOfDetailInTheCacheAreReadWhateverTheWorkBudget) {
     ASSERT_EQ(gap.paths.size(), 1u);
     EXPECT_EQ(gap.paths[0], cached.paths[2]);
     EXPECT_EQ(gap.built, 0);
+    EXPECT_TRUE(gap.notes.empty());
+    // Level 2 gone too: past the budget, the primitive answers by its crossings.
+    std::filesystem::remove(cached.paths[2]);
+    const SceneLattices none = levels_for(dir, scene, kMaxLodPairs, 0);
+    EXPECT_TRUE(none.paths.empty());
+    EXPECT_EQ(none.notes.size(), 1u);
 }
 
 // The footprints on a primitive's copies: from the nearest point of the nearest box to the

@@ -69,7 +69,7 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     // The point-sampled finest level reaches as far as make_lattice_shape's lattices do.
     : filter_(filter),
       primitive_(levels.back().ctx.primitive),
-      exact_(exact_width > 0 && primitive_ && answered_by_primitive(*primitive_)),
+      exact_(exact_width > 0 && primitive_),
       exact_width_(exact_width),
       sub_ray_reach_(farthest_sub_ray(exact_width)) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
@@ -117,6 +117,7 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     chain_ = exact_ ? dynamic_cast<const ChainShape*>(primitive_) : nullptr;
     if (chain_ && chain_->primitive_count() >= kMinBoxedParts)
         part_boxes_ = std::make_unique<const PartBoxes>(*chain_, box(), true);
+    paired_shadows_ = exact_ && !chain_ && primitive_->intersect_cost() > kMaxExactCost;
 }
 
 void FilteredLatticeShape::spans(const Ray& r, SpanList& out) const {
@@ -438,10 +439,28 @@ unsigned FilteredLatticeShape::sub_ray_crossings(std::span<const std::uint32_t> 
 unsigned FilteredLatticeShape::blocked_sub_rays(std::span<const std::uint32_t> parts,
                                                 const RayQuad& q, unsigned live) const {
     if (chain_) return chain_->blocked_lanes(parts, q, live);
+    if (paired_shadows_) return blocked_pairs(q, live);
     unsigned blocked = 0;
     for (int k = 0; k < kSubRays; ++k)
         if (live >> k & 1 && primitive_->occluded(q.ray(k), q.tmin[k], q.tmax[k]))
             blocked |= 1u << k;
+    return blocked;
+}
+
+// The lanes of a shadow ray's 2 x 2 sub-rays (k = i 2 + j) in two pairs, the rows {0, 1} and
+// {3, 2}: one test a pair, of its first live lane (0 and 3, on a diagonal), answers for both.
+// Every lattice pairs the lanes alike, so a pair blocked in one stays blocked in the next
+// (LayerComposite). The shadows of a costly primitive's sub-rays took two thirds of `ball-csg7`'s
+// render (6 tori and a sphere, cost 73); with pairs: ... (docs/filtering.md).
+unsigned FilteredLatticeShape::blocked_pairs(const RayQuad& q, unsigned live) const {
+    static constexpr std::array<std::array<int, 2>, 2> kPairs{{{0, 1}, {3, 2}}};
+    unsigned blocked = 0;
+    for (const auto& pair : kPairs) {
+        const unsigned lanes = (1u << pair[0] | 1u << pair[1]) & live;
+        if (lanes == 0) continue;
+        const int k = lanes >> pair[0] & 1 ? pair[0] : pair[1];
+        if (primitive_->occluded(q.ray(k), q.tmin[k], q.tmax[k])) blocked |= lanes;
+    }
     return blocked;
 }
 

@@ -116,10 +116,13 @@ inline constexpr double kSheetDepth = 1;
 // How far from a ray its farthest sub-ray lies, for a footprint this wide.
 double farthest_sub_ray(double width);
 // Primitives other than chains whose exact intersection costs more than this many simple tests
-// (Shape::intersect_cost) are answered by their tables. The ball of CSG tori (6 tori and a
-// sphere, cost 73): tables 34.49 dB in 262 ms, with the half blend of sub-rays 36.55 dB in
-// 628 ms, sub-rays alone 37.48 dB in 1055 ms; exact 1 spp 32.80 dB in 240 ms, 4 spp 38.73 dB in
-// 876 ms (the tables are ahead of exact at equal time).
+// (Shape::intersect_cost) are answered by their tables, when the levels their footprints want
+// are within the build budget (render/scene_lattices.h, kMaxLodWork; else by their crossings).
+// The ball of CSG tori (6 tori and a sphere, cost 73; 2026-11-26): tables 34.49 dB in 262 ms,
+// with the half blend of sub-rays 36.55 dB in 628 ms, sub-rays alone 37.48 dB in 1055 ms; exact
+// 1 spp 32.80 dB in 240 ms, 4 spp 38.73 dB in 876 ms (the tables are ahead of exact at equal
+// time). Its sub-rays, since sheets by depth (2026-11-27, 1 thread): 41.52 dB in 3013 ms against
+// exact 4 spp's 38.73 dB in 2596 ms.
 inline constexpr double kMaxExactCost = 64;
 // Whether a filtered lattice with levels of detail answers its rays from the primitive itself:
 // a chain (spheres and cylinders: hairs, tufts) always, whatever its parts, since its sub-rays
@@ -143,7 +146,8 @@ public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage (or is null:
     // FilterLevel); the primitive (ctx.primitive) must outlive the shape. table_error:
     // Encoding::error_bound of the finest level. exact_width: above 0, rays take the primitive's
-    // own crossings (levels of detail on; one level) if it is answered_by_primitive; their
+    // own crossings (levels of detail on; one level), as scene_lattices decides (a primitive
+    // answered_by_primitive, or one whose levels wanted are past the build budget); their
     // footprints are narrowed to at most exact_width (primitive units), which bounds how far from a
     // ray its sub-rays go and so how far culling must reach; each instance narrower still by its
     // own bound (cull_bounds, AcrossRay::widest). A ray without a footprint gets the crossing of
@@ -243,6 +247,9 @@ private:
     // A chain's parts' boxes: a sub-ray is intersected with the parts whose box it meets only.
     std::unique_ptr<const PartBoxes> part_boxes_;
     const ChainShape* chain_ = nullptr;  // primitive_, when it is a chain
+    // Shadow rays through a primitive costlier than kMaxExactCost (not a chain) test two of
+    // their sub-rays, each standing for its neighbour (shadow_pairs), not four.
+    bool paired_shadows_ = false;
     std::optional<HitTableShape> point_;  // the finest level, point-sampled (if it has a table)
 
     const LatticeFrame& cull_frame() const { return levels_[cull_level_].frame; }
@@ -293,6 +300,7 @@ private:
                                QuadCrossings& hits) const;
     unsigned blocked_sub_rays(std::span<const std::uint32_t> parts, const RayQuad& q,
                               unsigned live) const;
+    unsigned blocked_pairs(const RayQuad& q, unsigned live) const;
 };
 
 }  // namespace lat

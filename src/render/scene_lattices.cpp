@@ -67,9 +67,9 @@ struct LevelCosts {
 };
 
 // Why level `next` is left out (past the largest refinement, over the pair budget, or over the
-// work budget), and what the rays that want it or finer read instead.
+// work budget), and what serves the rays that want it or finer instead (`instead`).
 std::string levels_note(const LevelCosts& c, int wanted, int next, bool fits,
-                        const LatticeFiltering& filtering) {
+                        const LatticeFiltering& filtering, const std::string& instead) {
     const auto whole = [](double v) { return std::to_string(std::llround(std::ceil(v))); };
     std::string why;
     if (!fits && c.sigma_inv(next) > kMaxSigmaInv)
@@ -82,18 +82,19 @@ std::string levels_note(const LevelCosts& c, int wanted, int next, bool fits,
               whole(c.work(next) / kPairTestsPerCpuSecond / 60) +
               " minutes of one core to build, over --lod-budget (" +
               whole(filtering.max_work / kPairTestsPerCpuSecond / 60) +
-              "); a larger budget builds it once, for every later render";
-    return c.p.where + ": levels of detail to " + c.name(wanted) + " wanted; " + why +
-           "; rays that want finer read " + c.name(next - 1);
+              "; a larger budget builds it once, for every later render)";
+    return c.p.where + ": levels of detail to " + c.name(wanted) + " wanted; " + why + "; " +
+           instead;
 }
 
 // The levels j to read, of those the footprints want: within the largest refinement and the
 // pair budget (memory), and the finest affordable (time): within the work budget, or cached
 // already (the budget bounds what a render builds, not what it reads). Level 0, the lattice
-// asked for, is read whatever its size. A note says what was left out, why, and how to get it.
+// asked for, is read whatever its size.
 struct LevelChoice {
     std::pair<int, int> range;
-    std::string note;  // empty when every level wanted is read
+    int left_out = -1;         // the coarsest level wanted and not read; -1: none
+    bool over_budget = false;  // left out for the work budget (else for its size)
 };
 LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pair<int, int> wanted,
                           const LatticeFiltering& filtering) {
@@ -111,8 +112,22 @@ LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pai
     int first = std::min(wanted.first, finest);
     for (int j = finest; j > first; --j)
         if (!affordable(j - 1)) first = j;
-    if (finest == wanted.second) return {{first, finest}, ""};
-    return {{first, finest}, levels_note(c, wanted.second, finest + 1, finest < fitting, filtering)};
+    if (finest == wanted.second) return {{first, finest}};
+    return {{first, finest}, finest + 1, finest < fitting};
+}
+
+// For a primitive answered by its crossings: each instance's bound on its sub-rays' footprint
+// (out.widest_footprints), and the widest of them, the shape's.
+double sub_ray_bounds(const Scene& scene, int prim, const TableContext& base, double spread,
+                      SceneLattices& out) {
+    double widest = 0;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+        if (scene.objects[i].primitive != prim) continue;
+        out.widest_footprints[i] =
+            kSubRayWidening * instance_footprints(scene, scene.objects[i], base, spread).second;
+        widest = std::max(widest, out.widest_footprints[i]);
+    }
+    return widest;
 }
 
 // A primitive's filtered lattice: its levels from the cache, coarse to fine. csg_leaf: some CSG
@@ -129,25 +144,32 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
     // (AccelObject::widest_footprint): the farthest instance's is 1.4 times the nearest's on
     // Plates 4 and 5, 1.9 times on the furry bunny, 3.7 on grass. The shape's own bound is the
     // widest over its instances; above 0 exactly when the shape answers by its crossings.
+    // A costlier primitive whose levels wanted are past the work budget answers by its crossings
+    // too: tables coarser than its footprints blur it, and cost more than finer ones, their
+    // sheets being wider and less opaque. `ball-csg7` (512^2, 1 spp, 1 thread, against exact at
+    // 64 spp; it wants 4K, 37 minutes of one core): tables at 2K 30.38 dB in 1059 ms, at K
+    // 27.15 dB in 1603 ms; its crossings 41.52 dB in 3013 ms; exact 32.80 dB in 679 ms, at 4 spp
+    // 38.73 dB in 2596 ms.
     const TableContext base = plan_table(p, spec, scene.file).context;
     const bool lod = filtering.lod && filtering.spread > 0;
+    bool by_crossings = lod && base.primitive && answered_by_primitive(*base.primitive);
     std::pair<int, int> range{0, 0};
-    double exact_width = 0;
-    if (lod && base.primitive && answered_by_primitive(*base.primitive)) {
-        for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-            if (scene.objects[i].primitive != prim) continue;
-            const double widest =
-                kSubRayWidening *
-                instance_footprints(scene, scene.objects[i], base, filtering.spread).second;
-            out.widest_footprints[i] = widest;
-            exact_width = std::max(exact_width, widest);
-        }
-    } else if (lod) {
-        range = lod_range(scene, prim, base, filtering.spread);
+    if (lod && !by_crossings) {
+        const LevelCosts costs{scene, p, spec};
+        const std::pair<int, int> wanted = lod_range(scene, prim, base, filtering.spread);
+        const LevelChoice choice = choose_levels(costs, cache, wanted, filtering);
+        by_crossings = choice.over_budget && base.primitive;
+        if (!by_crossings) range = choice.range;
+        if (choice.left_out >= 0)
+            out.notes.push_back(levels_note(
+                costs, wanted.second, choice.left_out, choice.over_budget, filtering,
+                by_crossings ? "its rays take its own crossings instead (" +
+                                   std::to_string(kExactSubRays * kExactSubRays) +
+                                   " sub-rays a ray, no tables)"
+                             : "rays that want finer read " + costs.name(choice.left_out - 1)));
     }
-    const LevelChoice choice = choose_levels({scene, p, spec}, cache, range, filtering);
-    if (!choice.note.empty()) out.notes.push_back(choice.note);
-    range = choice.range;
+    const double exact_width =
+        by_crossings ? sub_ray_bounds(scene, prim, base, filtering.spread, out) : 0;
     std::vector<FilterLevel> levels;
     double error = 0;
     const bool reads_tables = exact_width == 0 || csg_leaf;
