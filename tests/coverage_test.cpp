@@ -498,7 +498,7 @@ TEST(Coverage, TurnedCopiesOfABeadRenderAsOne) {
 // Two copies of a primitive, one near the camera and one far: levels of detail want 1K, 2K and
 // 4K. The primitive is a bead, or a row of six small tori (a CSG union of cost 72, quartics
 // counting 12), which costs more to intersect than kMaxExactCost and so is answered by its
-// tables and their levels.
+// tables and their levels (within the build budget; past it, by its crossings).
 constexpr const char* kNearAndFar = R"({
   "format": "lattice-reference/1",
   "camera": {"eye": [1, -3, 1], "look_at": [1, 0.5, 1], "up": [0, 0, 1], "fov_y_deg": 30,
@@ -579,11 +579,11 @@ TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
 TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
     const double p1 = static_cast<double>(BoundaryGrid::pair_count({4, 2, 4}));
     const double p2 = static_cast<double>(BoundaryGrid::pair_count({8, 4, 8}));
-    test::TempDir probe;
     const std::string scene = near_and_far(true, true);
-    levels_for(probe, scene, kMaxLodPairs);
-    const double cost = load_scene((probe.path() / "near-and-far.json").string())
-                            .primitives[0].shape->intersect_cost();
+    test::TempDir probe;
+    const std::string path = (probe.path() / "near-and-far.json").string();
+    std::ofstream(path) << scene;
+    const double cost = load_scene(path).primitives[0].shape->intersect_cost();
     ASSERT_GT(cost, kMaxExactCost);  // its levels are tables
     for (const double budget : {p2 * cost, p2 * cost * 0.99, p1 * cost * 0.99, 0.0}) {
         test::TempDir dir;
@@ -595,14 +595,36 @@ TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
             EXPECT_EQ(std::isfinite(widest), !within) << budget;
         ASSERT_EQ(l.notes.size(), within ? 0u : 1u) << budget;
         if (within) continue;
+        // The finest level wanted, what it would take, and the budget that builds it.
         const std::string& note = l.notes[0];
-        EXPECT_NE(note.find("primitives.bead"), std::string::npos) << note;
-        EXPECT_NE(note.find("to sigma^-1 = 4 wanted"), std::string::npos) << note;
-        const std::string left_out = budget >= p1 * cost ? "sigma^-1 = 4" : "sigma^-1 = 2";
-        EXPECT_NE(note.find(left_out + " would take"), std::string::npos) << note;
-        EXPECT_NE(note.find("--lod-budget"), std::string::npos) << note;
-        EXPECT_NE(note.find("own crossings"), std::string::npos) << note;
+        const auto minutes = static_cast<long long>(std::ceil(lod_minutes(p2 * cost)));
+        for (const std::string& part :
+             {std::string("near-and-far.json: primitives.bead: "),
+              std::string("from sigma^-1 = 1 to sigma^-1 = 4 wanted"),
+              std::string("sigma^-1 = 4 would take about"),
+              "--lod-budget " + std::to_string(minutes) + " builds it",
+              std::string("its rays take its own crossings instead")})
+            EXPECT_NE(note.find(part), std::string::npos) << part << " in " << note;
     }
+    // Only the near copy: level 2 alone wanted, past the budget, so crossings, not level 1.
+    test::TempDir near;
+    const SceneLattices l = levels_for(near, near_and_far(true, false), kMaxLodPairs, p1 * cost);
+    EXPECT_TRUE(l.paths.empty());
+    ASSERT_EQ(l.notes.size(), 1u);
+    EXPECT_NE(l.notes[0].find("level of detail sigma^-1 = 4 wanted"), std::string::npos)
+        << l.notes[0];
+}
+
+// Levels left out for their size (the pair budget) are said too, with what their rays read.
+TEST(Coverage, LevelsLeftOutForTheirSizeAreSaid) {
+    test::TempDir dir;
+    const double p1 = static_cast<double>(BoundaryGrid::pair_count({4, 2, 4}));
+    const SceneLattices l = levels_for(dir, near_and_far(true, true), p1);
+    EXPECT_EQ(l.paths.size(), 2u);
+    ASSERT_EQ(l.notes.size(), 1u);
+    for (const std::string part : {"sigma^-1 = 4 has", "M pairs, over the budget of",
+                                   "rays that want finer read sigma^-1 = 2"})
+        EXPECT_NE(l.notes[0].find(part), std::string::npos) << part << " in " << l.notes[0];
 }
 
 // The work budget bounds what a render builds, not what it reads: levels in the cache are read
@@ -622,7 +644,11 @@ TEST(Coverage, LevelsOfDetailInTheCacheAreReadWhateverTheWorkBudget) {
     ASSERT_EQ(gap.paths.size(), 1u);
     EXPECT_EQ(gap.paths[0], cached.paths[2]);
     EXPECT_EQ(gap.built, 0);
-    EXPECT_TRUE(gap.notes.empty());
+    ASSERT_EQ(gap.notes.size(), 1u);
+    EXPECT_NE(gap.notes[0].find("sigma^-1 = 2 is over --lod-budget and not in the cache; rays "
+                                "that want coarser read sigma^-1 = 4"),
+              std::string::npos)
+        << gap.notes[0];
     // Level 2 gone too: past the budget, the primitive answers by its crossings.
     std::filesystem::remove(cached.paths[2]);
     const SceneLattices none = levels_for(dir, scene, kMaxLodPairs, 0);

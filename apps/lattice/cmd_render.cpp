@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <cstdio>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
@@ -193,7 +194,7 @@ int run_render(const RenderArgs& a) {
     settings.spec = a.spec;
     settings.filtering.filter = kFilters.at(a.filter);
     settings.filtering.lod = kOnOff.at(a.lod);
-    settings.filtering.max_work = a.lod_budget * 60 * kPairTestsPerCpuSecond;
+    settings.filtering.max_work = lod_work(a.lod_budget);
     settings.accel.instancing = kInstancing.at(a.instancing);
     settings.texture = a.texture;
     settings.shadow_map_size = a.shadow_map_size;
@@ -254,15 +255,22 @@ Command add_render_command(CLI::App& parent) {
                           " simple tests) answered by the crossings of " +
                           std::to_string(kExactSubRays) + " x " + std::to_string(kExactSubRays) +
                           " sub-rays across each ray's footprint, a costlier one by levels of detail, sigma^-1 = "
-                          "K, 2K, 4K as the pixels' footprints need (on); or only K, tables "
-                          "alone (off)")
+                          "K, 2K, 4K as the pixels' footprints need, or by its crossings where they "
+                          "are past --lod-budget (on); or only K, tables alone (off)")
         ->check(CLI::IsMember(kOnOff));
     c.app->add_option("--lod-budget", args->lod_budget,
                       "lattice mode, --lod on: a costlier primitive's levels of detail beyond K are "
                       "built only if each takes at most about this many minutes of one core "
-                      "(estimated from its pairs and the primitive's cost); rays that want a level "
-                      "left out read the finest built, and the summary says so")
-        ->check(CLI::NonNegativeNumber)
+                      "(estimated from its pairs and the primitive's cost); past it the primitive "
+                      "is answered by its crossings, and the summary says so. A level in the "
+                      "cache is read whatever the budget")
+        ->check([](const std::string& text) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            return end != text.c_str() && *end == '\0' && std::isfinite(v) && v >= 0 && v <= 1e7
+                       ? ""
+                       : "a number of minutes from 0 to 1e7";
+        })
         ->capture_default_str();
     c.app->add_option("--instancing", args->instancing,
                       "Multi-part objects as Embree instances (always), flattened into one "

@@ -72,8 +72,9 @@ double lod_blend(double f, double band);
 // normals (the pixel's box filter on this primitive), for shadow rays
 // their share as the coverage (a ray without a footprint: its own line's). Its table then
 // serves CSG (spans, `inside`) only, and is built only when a CSG tree holds a copy, no finer
-// level ever (scene_lattices). A costly primitive is answered by its tables and their levels
-// alone.
+// level ever (scene_lattices). A costly primitive is answered by its tables and their levels,
+// unless the levels its footprints want are past the build budget (render/scene_lattices.h):
+// then by its crossings too, its shadow rays testing their sub-rays in pairs (blocked_pairs).
 //   Why: where intersecting the primitive is cheap, its sub-rays give a better image than the
 // tables in less time, at every footprint tried. 1 spp, 2 threads, ms and PSNR against exact
 // ground truth (256 spp; 64 for the bunny and grass), on Plates 2 / 3 / 4 / 5, the furry bunny,
@@ -248,7 +249,7 @@ private:
     std::unique_ptr<const PartBoxes> part_boxes_;
     const ChainShape* chain_ = nullptr;  // primitive_, when it is a chain
     // Shadow rays through a primitive costlier than kMaxExactCost (not a chain) test two of
-    // their sub-rays, each standing for its neighbour (shadow_pairs), not four.
+    // their sub-rays, each standing for its neighbour (blocked_pairs), not four.
     bool paired_shadows_ = false;
     std::optional<HitTableShape> point_;  // the finest level, point-sampled (if it has a table)
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
+#include <cstdio>
 
 #include "csg/csg_shape.h"
 #include "lattice/boundary_grid.h"
@@ -66,35 +66,14 @@ struct LevelCosts {
     double work(int j) const { return pairs(j) * cost; }  // LatticeFiltering::max_work
 };
 
-// Why level `next` is left out (past the largest refinement, over the pair budget, or over the
-// work budget), and what serves the rays that want it or finer instead (`instead`).
-std::string levels_note(const LevelCosts& c, int wanted, int next, bool fits,
-                        const LatticeFiltering& filtering, const std::string& instead) {
-    const auto whole = [](double v) { return std::to_string(std::llround(std::ceil(v))); };
-    std::string why;
-    if (!fits && c.sigma_inv(next) > kMaxSigmaInv)
-        why = c.name(next) + " is past the largest, " + std::to_string(kMaxSigmaInv);
-    else if (!fits)
-        why = c.name(next) + " has " + whole(c.pairs(next) / 1e6) +
-              " M pairs, over the budget of " + whole(filtering.max_pairs / 1e6) + " M";
-    else
-        why = c.name(next) + " would take about " +
-              whole(c.work(next) / kPairTestsPerCpuSecond / 60) +
-              " minutes of one core to build, over --lod-budget (" +
-              whole(filtering.max_work / kPairTestsPerCpuSecond / 60) +
-              "; a larger budget builds it once, for every later render)";
-    return c.p.where + ": levels of detail to " + c.name(wanted) + " wanted; " + why + "; " +
-           instead;
-}
-
 // The levels j to read, of those the footprints want: within the largest refinement and the
 // pair budget (memory), and the finest affordable (time): within the work budget, or cached
 // already (the budget bounds what a render builds, not what it reads). Level 0, the lattice
 // asked for, is read whatever its size.
 struct LevelChoice {
     std::pair<int, int> range;
-    int left_out = -1;         // the coarsest level wanted and not read; -1: none
-    bool over_budget = false;  // left out for the work budget (else for its size)
+    int fitting = 0;           // the finest level wanted within the size limits
+    bool over_budget = false;  // range.second < fitting: a finer level past the work budget
 };
 LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pair<int, int> wanted,
                           const LatticeFiltering& filtering) {
@@ -103,7 +82,7 @@ LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pai
     };
     const auto affordable = [&](int j) {
         return j == 0 || c.work(j) <= filtering.max_work ||
-               std::filesystem::exists(cache.path_for(level_plan(c.scene, c.p, c.spec, j)));
+               cache.cached(level_plan(c.scene, c.p, c.spec, j));
     };
     int fitting = 0;
     while (fitting < wanted.second && fits(fitting + 1)) ++fitting;
@@ -112,8 +91,47 @@ LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pai
     int first = std::min(wanted.first, finest);
     for (int j = finest; j > first; --j)
         if (!affordable(j - 1)) first = j;
-    if (finest == wanted.second) return {{first, finest}};
-    return {{first, finest}, finest + 1, finest < fitting};
+    return {{first, finest}, fitting, finest < fitting};
+}
+
+// What the user should know of a choice that leaves out levels wanted: which, why, and what
+// serves their rays instead (by_crossings: the primitive's crossings). Empty when none is.
+std::string levels_note(const LevelCosts& c, std::pair<int, int> wanted, const LevelChoice& ch,
+                        const LatticeFiltering& filtering, bool by_crossings) {
+    const auto number = [](double v) {
+        char text[32];
+        std::snprintf(text, sizeof text, v < 10 ? "%.2g" : "%.0f", v);
+        return std::string(text);
+    };
+    const auto [first, finest] = ch.range;
+    std::string why, instead = "rays that want finer read " + c.name(finest);
+    if (ch.over_budget) {
+        const double minutes = lod_minutes(c.work(ch.fitting));
+        why = c.name(ch.fitting) + " would take about " + number(minutes) +
+              " minutes of one core to build, over --lod-budget " +
+              number(lod_minutes(filtering.max_work)) + " (--lod-budget " +
+              std::to_string(static_cast<long long>(std::ceil(minutes))) +
+              " builds it once, for every later render)";
+    } else if (finest < wanted.second && c.sigma_inv(finest + 1) > kMaxSigmaInv) {
+        why = c.name(finest + 1) + " is past the largest, " + std::to_string(kMaxSigmaInv);
+    } else if (finest < wanted.second) {
+        why = c.name(finest + 1) + " has " + number(c.pairs(finest + 1) / 1e6) +
+              " M pairs, over the budget of " + number(filtering.max_pairs / 1e6) + " M";
+    } else if (first > wanted.first) {
+        why = c.name(first - 1) + " is over --lod-budget and not in the cache";
+        instead = "rays that want coarser read " + c.name(first);
+    } else {
+        return "";
+    }
+    if (by_crossings)
+        instead = "its rays take its own crossings instead (" + std::to_string(kSubRays) +
+                  " sub-rays a ray)";
+    const std::string asked = wanted.first == wanted.second
+                                  ? "level of detail " + c.name(wanted.first)
+                                  : "levels of detail from " + c.name(wanted.first) + " to " +
+                                        c.name(wanted.second);
+    return located_message(c.scene.file, c.p.where,
+                           asked + " wanted; " + why + "; " + instead);
 }
 
 // For a primitive answered by its crossings: each instance's bound on its sub-rays' footprint
@@ -160,13 +178,8 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, con
         const LevelChoice choice = choose_levels(costs, cache, wanted, filtering);
         by_crossings = choice.over_budget && base.primitive;
         if (!by_crossings) range = choice.range;
-        if (choice.left_out >= 0)
-            out.notes.push_back(levels_note(
-                costs, wanted.second, choice.left_out, choice.over_budget, filtering,
-                by_crossings ? "its rays take its own crossings instead (" +
-                                   std::to_string(kExactSubRays * kExactSubRays) +
-                                   " sub-rays a ray, no tables)"
-                             : "rays that want finer read " + costs.name(choice.left_out - 1)));
+        const std::string note = levels_note(costs, wanted, choice, filtering, by_crossings);
+        if (!note.empty()) out.notes.push_back(note);
     }
     const double exact_width =
         by_crossings ? sub_ray_bounds(scene, prim, base, filtering.spread, out) : 0;

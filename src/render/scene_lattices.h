@@ -29,24 +29,30 @@ struct SceneLattices {
 // How lattices are filtered (issue 10): the filter, and whether levels of detail are built. With
 // lod, each primitive gets the levels sigma^-1 = K 2^j whose cells match the footprints of the
 // camera's pixels (spread: a pixel's angle) somewhere on its instances, at most kMaxLodLevels;
-// a primitive answered_by_primitive gets the lattice asked for alone, and only if a CSG tree
-// holds a copy (no ray reads it elsewhere).
+// a primitive answered_by_primitive, or one whose levels wanted are past the work budget (below),
+// is answered by its crossings and gets the lattice asked for alone, only if a CSG tree holds a
+// copy (no ray reads it elsewhere).
 // Levels of detail beyond sigma^-1 = K are built only up to kMaxLodPairs ordered pairs of
 // boundary points: rays that want finer get the finest level within it, not a table that takes
 // half an hour to build. 2^27 holds the hair of Plates 4 and 5 at 4K (111 M pairs); a CSG ring
 // of 16 x 16 x 8 cells (`lattice-rings`, before its torus was answered by its crossings) stopped
 // at 2K (17 M pairs; 4K, 268 M pairs, was still building after 7 minutes in 5 GB).
 inline constexpr double kMaxLodPairs = 134217728.0;
-// They are also built only up to kMaxLodWork pair tests: pairs times the primitive's
-// intersect_cost, the work of a coverage build, whose sub-rays each pay about the whole cost
-// for a primitive without parts to cull (a CSG object or a quartic: the only ones whose levels
-// are tables, answered_by_primitive). A build does about kPairTestsPerCpuSecond (`ball-csg7`,
-// 73 simple tests: 12.1 and 150 CPU seconds at sigma^-1 = 1 and 2, 2.5 GHz Xeon, 2026-11-27),
-// so the budget is a quarter of an hour of one core (`render --lod-budget`): that primitive gets
-// 2K, not 4K (36 minutes; the first render at the default waited 20 minutes on 2 cores).
+// They are also built only up to a work budget (LatticeFiltering::max_work) of pair tests: pairs
+// times the primitive's intersect_cost, the work of a coverage build, whose sub-rays each pay
+// about the whole cost for a primitive without parts to cull (a CSG tree or a mesh costlier than
+// kMaxExactCost: the only ones whose levels are tables, not answered_by_primitive). A build
+// does about kPairTestsPerCpuSecond (`ball-csg7`, 73 simple tests: 12.1, 150 and 1900 CPU
+// seconds at sigma^-1 = 1, 2 and 4; 2.5 GHz Xeon, 2026-11-27), so the default budget is a
+// quarter of an hour of one core (`render --lod-budget`): that primitive's 4K level (about 36
+// minutes estimated; the first render at the default waited 20 minutes on 2 cores) is left out,
+// and it answers by its crossings. A level in the cache is read whatever the budget.
 inline constexpr double kPairTestsPerCpuSecond = 1.2e6;
 inline constexpr double kLodBudgetMinutes = 15;
-inline constexpr double kMaxLodWork = kLodBudgetMinutes * 60 * kPairTestsPerCpuSecond;
+// The work budget of so many minutes of one core, and back.
+constexpr double lod_work(double minutes) { return minutes * 60 * kPairTestsPerCpuSecond; }
+constexpr double lod_minutes(double work) { return work / (60 * kPairTestsPerCpuSecond); }
+inline constexpr double kMaxLodWork = lod_work(kLodBudgetMinutes);
 struct LatticeFiltering {
     LatticeFilter filter = LatticeFilter::kNone;
     bool lod = false;

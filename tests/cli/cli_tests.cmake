@@ -56,6 +56,11 @@ add_test(NAME cli.unknown_extension
 add_test(NAME cli.usage_error
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--spp;0;${BAD}/good.json;-o;${CLI_OUT}/u.png"
           -DEXIT=2 "-DPATTERN=--spp" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+foreach(budget nan -1 inf 12x)
+  add_test(NAME cli.lod_budget_refused_${budget}
+    COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;lattice;--lod-budget;${budget};${BAD}/good.json;-o;${CLI_OUT}/lb.png"
+            -DEXIT=2 "-DPATTERN=--lod-budget" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+endforeach()
 add_test(NAME cli.good_scene_renders
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;-q;${BAD}/good.json;-o;${CLI_OUT}/good.png"
           -DEXIT=0 -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)

@@ -85,12 +85,17 @@ std::string TableCache::path_for(const TablePlan& plan) const {
     return dir_ + "/" + safe.substr(0, 64) + tail;
 }
 
+bool TableCache::cached(const TablePlan& plan) const {
+    const std::string path = path_for(plan);
+    struct stat st {};
+    const auto present = [&] { return ::stat(path.c_str(), &st) == 0; };
+    return across_ranks_ ? dist::root_says(present) : present();
+}
+
 TableCache::Entry TableCache::get(const TablePlan& plan, bool progress) const {
     Entry e;
     e.path = path_for(plan);
-    struct stat st {};
-    const auto missing = [&] { return ::stat(e.path.c_str(), &st) != 0; };
-    if (across_ranks_ ? dist::root_says(missing) : missing()) {
+    if (!cached(plan)) {
         const auto t0 = std::chrono::steady_clock::now();
         build_table_file(plan, e.path, progress, across_ranks_);
         e.build_seconds =

@@ -33,6 +33,9 @@ public:
         bool built = false;
         double build_seconds = 0;
     };
+    // Whether the plan's table is in the cache (collective across ranks: rank 0's answer, the
+    // one get acts on).
+    bool cached(const TablePlan& plan) const;
     // Loads the cached table, or builds and caches it.
     Entry get(const TablePlan& plan, bool progress) const;
 
