@@ -19,7 +19,7 @@ import subprocess
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES = ["plate2-thistle", "plate3-hair-closeup", "plate4-fuzzy-sphere-1000",
-          "plate5-fuzzy-sphere-5000"]
+          "plate5-fuzzy-sphere-5000", "furry-bunny", "grass"]
 # Issue 9's check class, which the issue's "scenes you have not seen" may resemble: 400
 # instances on a ball of a CSG of quartics (costlier than kMaxExactCost, its level wanted past
 # the build budget) and of a tuft of 216 segments; written by complexity_scenes.py.
