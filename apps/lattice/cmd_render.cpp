@@ -264,6 +264,7 @@ Command add_render_command(CLI::App& parent) {
                       "(estimated from its pairs and the primitive's cost); past it the primitive "
                       "is answered by its crossings, and the summary says so. A level in the "
                       "cache is read whatever the budget")
+        // Not CLI::Range: its comparisons let "nan" through.
         ->check([](const std::string& text) -> std::string {
             char* end = nullptr;
             const double v = std::strtod(text.c_str(), &end);
