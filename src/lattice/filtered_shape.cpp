@@ -365,17 +365,6 @@ void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, d
 void FilteredLatticeShape::exact_sub_rays(double width, bool normal, const Ray& r, double tmin,
                                           double tmax, SubRayHits& h) const {
     constexpr int n = kExactSubRays;
-    // Along the world's directions across the ray where the renderer set them, so that the
-    // k-th sub-ray is the same in every lattice (geometry/sub_rays.h).
-    // (Perpendicular to the ray and each other within 1e-3, which farthest_sub_ray allows for:
-    // made exactly so, the basis cost Plate 2 a sixth of its time.)
-    const AcrossRay& across = across_ray_in_object();
-    Vec3 u, v;
-    if (across.set) {
-        u = normalize(across.u), v = normalize(across.v);
-    } else {
-        orthonormal_basis(r.d / length(r.d), u, v);
-    }
     // A union's sub-rays meet only parts near r: found once, with boxes grown by the farthest
     // sub-ray's distance from r, at least its offset along any axis. Plates 4 and 5 render 6 %
     // faster than with every part intersected by every sub-ray; images identical. (Boxes grown
@@ -387,8 +376,27 @@ void FilteredLatticeShape::exact_sub_rays(double width, bool normal, const Ray& 
         if (near.size() < all) near.resize(all);
         const std::span<std::uint32_t> out(near.data(), all);
         parts = {near.data(), part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, out)};
+        // Near no part, no sub-ray meets the primitive: found first, before the sub-rays are
+        // made. Of the visits of shadow rays, grass and ball-tuft216 find no part near in 44 %
+        // and 59 %, the furry bunny and Plate 4 in 27 % and 16 % (their instances' culling
+        // capsules are coarser than the parts' boxes).
+        if (parts.empty()) {
+            h.met = 0;
+            return;
+        }
     } else if (chain_)
         parts = chain_->all_parts();
+    // Along the world's directions across the ray where the renderer set them, so that the
+    // k-th sub-ray is the same in every lattice (geometry/sub_rays.h).
+    // (Perpendicular to the ray and each other within 1e-3, which farthest_sub_ray allows for:
+    // made exactly so, the basis cost Plate 2 a sixth of its time.)
+    const AcrossRay& across = across_ray_in_object();
+    Vec3 u, v;
+    if (across.set) {
+        u = normalize(across.u), v = normalize(across.v);
+    } else {
+        orthonormal_basis(r.d / length(r.d), u, v);
+    }
     // The sub-rays, lane k = i n + j (bit k of Sheet::sub_rays), each clipped to the box.
     static_assert(n * n == 4, "a RayQuad holds a ray's sub-rays");
     RayQuad q;

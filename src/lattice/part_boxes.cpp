@@ -130,25 +130,6 @@ unsigned PartBoxes::Ray4::meets_listed(const std::uint32_t* parts, std::size_t n
     return meets4(lo, hi, r) & ((1u << n) - 1);
 }
 
-// Lane j: meets_float's test of box j, operation for operation: the slabs' entries and exits
-// combined in its order (max(max(x, y), max(z, -inf)), which matters for a NaN).
-unsigned PartBoxes::Ray4::meets4(const __m128 lo[3], const __m128 hi[3], const Range& r) const {
-    __m128 entry[3], exit[3];
-    for (std::size_t a = 0; a < 3; ++a) {
-        const __m128 o = _mm_set1_ps(o_[a]), inv = _mm_set1_ps(inv_[a]);
-        const __m128 t0 = _mm_mul_ps(_mm_sub_ps(lo[a], o), inv);
-        const __m128 t1 = _mm_mul_ps(_mm_sub_ps(hi[a], o), inv);
-        entry[a] = _mm_min_ps(t0, t1);
-        exit[a] = _mm_max_ps(t0, t1);
-    }
-    const __m128 tn = _mm_max_ps(_mm_max_ps(entry[0], entry[1]),
-                                 _mm_max_ps(entry[2], _mm_set1_ps(-INFINITY)));
-    const __m128 tf = _mm_min_ps(_mm_min_ps(exit[0], exit[1]),
-                                 _mm_min_ps(exit[2], _mm_set1_ps(INFINITY)));
-    const __m128 lo_t = _mm_max_ps(tn, _mm_set1_ps(r.lo)), hi_t = _mm_min_ps(tf, _mm_set1_ps(r.hi));
-    return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(lo_t, hi_t)));
-}
-
 // In float, lo - g rounds by at most 2^-24 (D + g) (coordinates relative to the box centre are
 // below D): growing by 1e-5 more covers the part in g, the boxes' padding (1e-4 D) the rest.
 PartBoxes::Ray4::Grow PartBoxes::Ray4::grow(double g) {
@@ -176,6 +157,7 @@ PartBoxes::Ray4::Ray4(const PartBoxes& boxes, const Ray& r) : boxes_(boxes), ray
         inv_[k] = static_cast<float>(inv);
     }
     o_[3] = 0, inv_[3] = 1;  // the neutral lane: its slab is (-inf, inf)
+    for (std::size_t k = 0; k < 3; ++k) ob_[k] = _mm_set1_ps(o_[k]), invb_[k] = _mm_set1_ps(inv_[k]);
 }
 
 PartBoxes::Ray4::Range PartBoxes::Ray4::range(double tmin, double tmax) const {

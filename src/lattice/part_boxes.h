@@ -117,10 +117,29 @@ public:
         bool use_float_ = true;
         double shift_ = 0;  // the float test's t is the ray's t minus this
         alignas(16) float o_[4], inv_[4];
+        __m128 ob_[3], invb_[3];  // o_[a] and inv_[a] in every lane
         bool meets_double(const Bounds3& b, const Range& r) const;
         // Four boxes at once, given axis by axis (lane j: box j): bit j, whether the ray meets
-        // box j within r.
-        unsigned meets4(const __m128 lo[3], const __m128 hi[3], const Range& r) const;
+        // box j within r. Lane j is meets_float's test of box j, operation for operation: the
+        // slabs' entries and exits combined in its order (max(max(x, y), max(z, -inf)), which
+        // matters for a NaN). Inline, with the ray broadcast once (ob_, invb_): a tuft's tree
+        // tests about ten nodes a ray, and the call and the broadcasts were a third of each.
+        unsigned meets4(const __m128 lo[3], const __m128 hi[3], const Range& r) const {
+            __m128 entry[3], exit[3];
+            for (std::size_t a = 0; a < 3; ++a) {
+                const __m128 t0 = _mm_mul_ps(_mm_sub_ps(lo[a], ob_[a]), invb_[a]);
+                const __m128 t1 = _mm_mul_ps(_mm_sub_ps(hi[a], ob_[a]), invb_[a]);
+                entry[a] = _mm_min_ps(t0, t1);
+                exit[a] = _mm_max_ps(t0, t1);
+            }
+            const __m128 tn = _mm_max_ps(_mm_max_ps(entry[0], entry[1]),
+                                         _mm_max_ps(entry[2], _mm_set1_ps(-INFINITY)));
+            const __m128 tf = _mm_min_ps(_mm_min_ps(exit[0], exit[1]),
+                                         _mm_min_ps(exit[2], _mm_set1_ps(INFINITY)));
+            const __m128 lo_t = _mm_max_ps(tn, _mm_set1_ps(r.lo));
+            const __m128 hi_t = _mm_min_ps(tf, _mm_set1_ps(r.hi));
+            return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(lo_t, hi_t)));
+        }
         template <class Q>
         unsigned meets_grown_quad(const Q& b, const Range& r, const Grow& g) const {
             assert(use_float_);
