@@ -401,6 +401,7 @@ void FilteredLatticeShape::exact_sub_rays(double width, bool normal, const Ray& 
     static_assert(n * n == 4, "a RayQuad holds a ray's sub-rays");
     RayQuad q;
     q.d = r.d;
+    const Vec3 inv = reciprocals(r.d);  // the sub-rays' clip_ray, in four
     unsigned live = 0;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
@@ -410,7 +411,7 @@ void FilteredLatticeShape::exact_sub_rays(double width, bool normal, const Ray& 
             q.ox[k] = o.x, q.oy[k] = o.y, q.oz[k] = o.z;
             double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
             // A lane clipped away gets a range of 0: its tests run, masked off.
-            if (!clip_ray(box(), {o, r.d}, t0, t1)) t0 = t1 = 0;
+            if (!clip_line(box(), o, r.d, inv, t0, t1)) t0 = t1 = 0;
             q.tmin[k] = t0, q.tmax[k] = normal ? t1 : std::min(t1, tmax);
             if (q.tmin[k] < q.tmax[k]) live |= 1u << k;
         }

@@ -36,27 +36,33 @@ inline Bounds3 expand(Bounds3 b, double delta) {
     return {b.lo - Vec3{delta, delta, delta}, b.hi + Vec3{delta, delta, delta}};
 }
 
-// Slab test: the parameter range [t0, t1] of the ray inside the box, clipped to the given range.
-// Returns false if the range is empty. Works for unbounded boxes and zero direction components.
-inline bool clip_ray(const Bounds3& b, const Ray& r, double& t0, double& t1) {
-    for (int a = 0; a < 3; ++a) {
-        const double o = r.o[static_cast<std::size_t>(a)];
-        const double d = r.d[static_cast<std::size_t>(a)];
-        const double lo = b.lo[static_cast<std::size_t>(a)];
-        const double hi = b.hi[static_cast<std::size_t>(a)];
-        if (d == 0.0) {
-            if (o < lo || o > hi) return false;
+// Slab test: the parameter range [t0, t1] of the line o + t d inside the box, clipped to the
+// given range, with inv[a] = 1 / d[a] given (rays of one direction share them; read only where
+// d[a] != 0). Returns false if the range is empty. Works for unbounded boxes and zero direction
+// components.
+inline bool clip_line(const Bounds3& b, const Vec3& o, const Vec3& d, const Vec3& inv, double& t0,
+                      double& t1) {
+    for (std::size_t a = 0; a < 3; ++a) {
+        if (d[a] == 0.0) {
+            if (o[a] < b.lo[a] || o[a] > b.hi[a]) return false;
             continue;
         }
-        const double inv = 1.0 / d;
-        double tn = (lo - o) * inv;
-        double tf = (hi - o) * inv;
+        double tn = (b.lo[a] - o[a]) * inv[a];
+        double tf = (b.hi[a] - o[a]) * inv[a];
         if (tn > tf) std::swap(tn, tf);
         if (tn > t0) t0 = tn;  // NaN-safe ordering: comparisons with NaN leave t0/t1 alone
         if (tf < t1) t1 = tf;
         if (t0 > t1) return false;
     }
     return true;
+}
+// The reciprocals clip_line wants (0 where d is 0, never read there).
+inline Vec3 reciprocals(const Vec3& d) {
+    const auto inv = [](double x) { return x != 0.0 ? 1.0 / x : 0.0; };
+    return {inv(d.x), inv(d.y), inv(d.z)};
+}
+inline bool clip_ray(const Bounds3& b, const Ray& r, double& t0, double& t1) {
+    return clip_line(b, r.o, r.d, reciprocals(r.d), t0, t1);
 }
 
 }  // namespace lat
