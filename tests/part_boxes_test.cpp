@@ -230,7 +230,7 @@ TEST(PartBoxes, NearPartsThroughTheTreeAreTheFlatScans) {
     EXPECT_GT(through_tree, 8000u);
 }
 
-// A primitive with a part of unbounded box still builds its tree (the median split sorts such a
+// A primitive with a part of unbounded box still builds its tree (the split sorts such a
 // part as if centred at 0) and near_parts answers as the flat scan: the part is near every ray.
 TEST(PartBoxes, AnUnboundedPartLeavesTheTreeAnsweringAsTheFlatScan) {
     std::mt19937 rng(19);

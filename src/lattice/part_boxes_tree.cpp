@@ -26,7 +26,9 @@ float PartBoxes::centre(std::uint32_t p, std::size_t a) const {
 // Splits order[first, last) in two, sorted along the axis and at the place that give the least
 // surface area heuristic: the areas of the halves' boxes, each times its parts (ties by index;
 // boxes without a centre sort first). A tuft's segments lie across each other near its root,
-// where median cuts of their centres made children whose boxes overlapped.
+// where median cuts of their centres made children whose boxes overlapped. Each half keeps at
+// least a quarter of the parts, so that a node's child holds at most 9/16 of its parts and the
+// tree stays shallow (tree_near_parts' stack) whatever the boxes.
 std::size_t PartBoxes::halve(std::vector<std::uint32_t>& order, std::size_t first,
                              std::size_t last) const {
     const std::size_t n = last - first;
@@ -55,6 +57,7 @@ std::size_t PartBoxes::halve(std::vector<std::uint32_t>& order, std::size_t firs
         lo = {INFINITY, INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY, -INFINITY};
         for (std::size_t k = 1; k < n; ++k) {
             grow(lo, hi, order[first + k - 1]);
+            if (k < n / 4 || n - k < n / 4) continue;
             const double cost = area(lo, hi) * double(k) + right[k];
             if (cost < best) best = cost, best_axis = axis, best_cut = first + k;
         }
@@ -103,7 +106,7 @@ PartBoxes::Made PartBoxes::make_node(std::vector<std::uint32_t>& order, std::siz
     return made;
 }
 
-// Top down, four children a node, split at medians of the parts' centres.
+// Top down, four children a node (halve, twice).
 void PartBoxes::build_tree() {
     std::vector<std::uint32_t> order(f_.size());
     std::iota(order.begin(), order.end(), 0u);
@@ -119,9 +122,9 @@ bool PartBoxes::Ray4::tame(const Grow& g) const {
 
 std::size_t PartBoxes::tree_near_parts(const Ray4& slabs, const Ray4::Range& range,
                                        const Ray4::Grow& g, std::span<std::uint32_t> out) const {
-    // Each child holds about a quarter of its parent's parts (median splits): some 16 levels
-    // for 2^32 parts, with at most 3 lanes a level left on the stack.
-    std::array<std::uint32_t, 128> stack;
+    // A child holds at most 9/16 of its parent's parts (halve): under 40 levels for 2^32
+    // parts, with at most 3 lanes a level left on the stack.
+    std::array<std::uint32_t, 160> stack;
     std::size_t top = 0, n = 0;
     stack[top++] = static_cast<std::uint32_t>(nodes_.size() - 1);
     while (top > 0) {
