@@ -195,6 +195,7 @@ TEST(PartBoxes, NearPartsThroughTheTreeAreTheFlatScans) {
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> u(0, 1);
     std::size_t through_tree = 0;
+    std::size_t few = 0, many = 0;  // tree searches finding up to 16 parts (insertion), or more
     for (const int parts : {int(PartBoxes::kTreeFrom) + 1, 100, 1000, 5000}) {
         const Boxes prim = random_boxes(rng, parts, parts > 500 ? 0.1 : 0.4, 1.0);
         const PartBoxes boxes(prim, prim.bounds(), true);
@@ -222,12 +223,51 @@ TEST(PartBoxes, NearPartsThroughTheTreeAreTheFlatScans) {
             ASSERT_EQ(std::vector<std::uint32_t>(near.begin(), near.begin() + count), flat)
                 << parts << " parts, ray " << n;
             kept += count;
-            through_tree += slabs.in_float() && slabs.tame(grow) ? 1 : 0;
+            if (slabs.in_float() && slabs.tame(grow)) {
+                ++through_tree;
+                ++(count <= 16 ? few : many);
+            }
         }
         EXPECT_GT(kept, 100u);                           // parts are met
         EXPECT_LT(kept, 3000u * prim.parts.size() / 2);  // and left out
     }
     EXPECT_GT(through_tree, 8000u);
+    EXPECT_GT(few, 1000u);
+    EXPECT_GT(many, 100u);
+}
+
+// Boxes that give the split nothing to choose between (5,000 copies of one box, or boxes nested
+// one in the next) still make a tree that answers as the flat scan (and stays shallow enough
+// for its search's stack, which a debug build asserts).
+TEST(PartBoxes, DegenerateBoxesMakeATreeThatAnswersAsTheFlatScan) {
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (const bool nested : {false, true}) {
+        Boxes prim;
+        const Vec3 c{3.5, 3.5, 10};
+        for (int i = 0; i < 5000; ++i) {
+            const double h = nested ? 0.001 * (i + 1) : 0.5;
+            prim.parts.push_back({c - Vec3{h, h, h}, c + Vec3{h, h, h}});
+        }
+        const PartBoxes boxes(prim, prim.bounds(), true);
+        std::vector<std::uint32_t> near(prim.parts.size());
+        for (int n = 0; n < 200; ++n) {
+            const Vec3 p = c + Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * 6.0;
+            const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+            const Ray r{p - d * 30.0, d};
+            const std::size_t count = boxes.near_parts(r, 0.05, 0.0, near);
+            const PartBoxes::Ray4 slabs(boxes, r);
+            std::vector<std::uint32_t> flat;
+            for (std::uint32_t i = 0; i < prim.parts.size(); ++i)
+                if (slabs.meets_grown4(i / 4, slabs.range(0.0, kInfinity),
+                                       PartBoxes::Ray4::grow(0.05)) >>
+                        (i % 4) &
+                    1u)
+                    flat.push_back(i);
+            ASSERT_EQ(std::vector<std::uint32_t>(near.begin(), near.begin() + count), flat)
+                << (nested ? "nested" : "copies") << ", ray " << n;
+        }
+    }
 }
 
 // A primitive with a part of unbounded box still builds its tree (the split sorts such a

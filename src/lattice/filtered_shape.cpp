@@ -409,7 +409,7 @@ void FilteredLatticeShape::exact_sub_rays(double width, bool normal, const Ray& 
             const double a = ((i + 0.5) / n - 0.5) * width, b = ((j + 0.5) / n - 0.5) * width;
             const Vec3 o = r.o + u * a + v * b;
             q.ox[k] = o.x, q.oy[k] = o.y, q.oz[k] = o.z;
-            double t0 = tmin, t1 = kInfinity;  // clip_ray only narrows [t0, t1]
+            double t0 = tmin, t1 = kInfinity;  // clip_line only narrows [t0, t1]
             // A lane clipped away gets a range of 0: its tests run, masked off.
             if (!clip_line(box(), o, r.d, inv, t0, t1)) t0 = t1 = 0;
             q.tmin[k] = t0, q.tmax[k] = normal ? t1 : std::min(t1, tmax);

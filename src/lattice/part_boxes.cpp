@@ -157,7 +157,8 @@ PartBoxes::Ray4::Ray4(const PartBoxes& boxes, const Ray& r) : boxes_(boxes), ray
         inv_[k] = static_cast<float>(inv);
     }
     o_[3] = 0, inv_[3] = 1;  // the neutral lane: its slab is (-inf, inf)
-    for (std::size_t k = 0; k < 3; ++k) ob_[k] = _mm_set1_ps(o_[k]), invb_[k] = _mm_set1_ps(inv_[k]);
+    for (std::size_t k = 0; k < 3; ++k)
+        ob_[k] = _mm_set1_ps(o_[k]), invb_[k] = _mm_set1_ps(inv_[k]);
 }
 
 PartBoxes::Ray4::Range PartBoxes::Ray4::range(double tmin, double tmax) const {

@@ -24,31 +24,37 @@ float PartBoxes::centre(std::uint32_t p, std::size_t a) const {
 }
 
 // Splits order[first, last) in two, sorted along the axis and at the place that give the least
-// surface area heuristic: the areas of the halves' boxes, each times its parts (ties by index;
-// boxes without a centre sort first). A tuft's segments lie across each other near its root,
-// where median cuts of their centres made children whose boxes overlapped. Each half keeps at
-// least a quarter of the parts, so that a node's child holds at most 9/16 of its parts and the
-// tree stays shallow (tree_near_parts' stack) whatever the boxes.
+// surface area heuristic: the areas of the halves' boxes, each times its parts (sorted by
+// centre, ties by index; a box without a centre sorts as if centred at 0; an unbounded box
+// costs as if huge, and equal costs go to the cut nearer the middle). A tuft's segments lie
+// across each other near its root, where median cuts of their centres made children whose
+// boxes overlapped. Each half keeps at least a quarter of the parts (rounded down), so that the
+// tree stays shallow whatever the boxes: under 40 levels for 2^32 parts (tree_near_parts).
 std::size_t PartBoxes::halve(std::vector<std::uint32_t>& order, std::size_t first,
                              std::size_t last) const {
     const std::size_t n = last - first;
     const auto at = [&](std::size_t i) { return order.begin() + static_cast<std::ptrdiff_t>(i); };
+    const auto by_centre = [&](std::size_t axis) {
+        return [this, axis](std::uint32_t x, std::uint32_t y) {
+            const float cx = centre(x, axis), cy = centre(y, axis);
+            return cx < cy || (cx == cy && x < y);
+        };
+    };
     const auto area = [](const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
         const double x = double(hi[0]) - double(lo[0]), y = double(hi[1]) - double(lo[1]),
                      z = double(hi[2]) - double(lo[2]);
-        return std::isfinite(x + y + z) ? x * y + y * z + z * x : 0.0;
+        return std::isfinite(x + y + z) ? x * y + y * z + z * x : 1e300;
     };
     const auto grow = [&](std::array<float, 3>& lo, std::array<float, 3>& hi, std::uint32_t p) {
         for (std::size_t a = 0; a < 3; ++a)
             lo[a] = std::min(lo[a], f_[p].lo[a]), hi[a] = std::max(hi[a], f_[p].hi[a]);
     };
+    const auto off_middle = [&](std::size_t k) { return k > n / 2 ? k - n / 2 : n / 2 - k; };
     std::vector<double> right(n + 1);
     double best = INFINITY;
-    std::size_t best_axis = 0, best_cut = first + n / 2;
+    std::size_t best_axis = 0, best_k = n / 2;
     for (std::size_t axis = 0; axis < 3; ++axis) {
-        std::sort(at(first), at(last), [&](std::uint32_t x, std::uint32_t y) {
-            return centre(x, axis) < centre(y, axis) || (centre(x, axis) == centre(y, axis) && x < y);
-        });
+        std::sort(at(first), at(last), by_centre(axis));
         std::array<float, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
         for (std::size_t k = n; k-- > 0;) {
             grow(lo, hi, order[first + k]);
@@ -59,14 +65,12 @@ std::size_t PartBoxes::halve(std::vector<std::uint32_t>& order, std::size_t firs
             grow(lo, hi, order[first + k - 1]);
             if (k < n / 4 || n - k < n / 4) continue;
             const double cost = area(lo, hi) * double(k) + right[k];
-            if (cost < best) best = cost, best_axis = axis, best_cut = first + k;
+            if (cost < best || (cost == best && off_middle(k) < off_middle(best_k)))
+                best = cost, best_axis = axis, best_k = k;
         }
     }
-    std::sort(at(first), at(last), [&](std::uint32_t x, std::uint32_t y) {
-        return centre(x, best_axis) < centre(y, best_axis) ||
-               (centre(x, best_axis) == centre(y, best_axis) && x < y);
-    });
-    return best_cut;
+    if (best_axis != 2) std::sort(at(first), at(last), by_centre(best_axis));  // 2: as it is
+    return first + best_k;
 }
 
 // The node over order[first, last): a leaf of its parts when they are four or fewer, else a
@@ -122,8 +126,8 @@ bool PartBoxes::Ray4::tame(const Grow& g) const {
 
 std::size_t PartBoxes::tree_near_parts(const Ray4& slabs, const Ray4::Range& range,
                                        const Ray4::Grow& g, std::span<std::uint32_t> out) const {
-    // A child holds at most 9/16 of its parent's parts (halve): under 40 levels for 2^32
-    // parts, with at most 3 lanes a level left on the stack.
+    // A child holds at most about 9/16 of its parent's parts (halve): under 40 levels for
+    // 2^32 parts, with at most 3 lanes a level left on the stack.
     std::array<std::uint32_t, 160> stack;
     std::size_t top = 0, n = 0;
     stack[top++] = static_cast<std::uint32_t>(nodes_.size() - 1);
