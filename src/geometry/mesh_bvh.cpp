@@ -61,11 +61,12 @@ void MeshBvh::traverse(const Ray& r, double tmin, const double* tmax,
     std::uint32_t stack[64];
     int top = 0;
     stack[top++] = 0;
+    const Vec3 inv = reciprocals(r.d);  // clip_ray's, once for every node
     while (top > 0) {
         const Node& node = nodes_[stack[--top]];
         double t0 = tmin, t1 = *tmax;
         const double pad = 1e-9 * (1 + max_component(max(abs(node.box.lo), abs(node.box.hi))));
-        if (!clip_ray(expand(node.box, pad), r, t0, t1))
+        if (!clip_line(expand(node.box, pad), r.o, r.d, inv, t0, t1))
             continue;
         if (node.count > 0) {
             for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
