@@ -15,22 +15,10 @@
 #include <type_traits>
 
 #include "geometry/sub_rays.h"
+#include "math/float_round.h"
 
 namespace lat {
 namespace {
-
-// std::nextafter(f, INFINITY), without libm's call (every shadow ray takes one).
-float next_up(float f) {
-    if (!(f < INFINITY)) return f;  // +infinity, NaN
-    if (f == 0) return std::numeric_limits<float>::denorm_min();
-    const auto bits = std::bit_cast<std::uint32_t>(f);
-    return std::bit_cast<float>(f > 0 ? bits + 1 : bits - 1);  // toward +infinity
-}
-
-float float_above(double t) {
-    const auto f = static_cast<float>(t);
-    return static_cast<double>(f) > t ? f : next_up(f);
-}
 
 // Whether a map keeps the directions across a ray across it and as long as its direction (a
 // similarity: turned and evenly scaled), within 1e-3 (scenes give rotations to 6 digits). A
@@ -177,12 +165,12 @@ static_assert(std::is_standard_layout_v<QueryContext> && offsetof(QueryContext, 
 RTCBounds to_rtc_bounds(const Bounds3& b) {
     const double pad = 1e-6 * (max_component(abs(b.lo)) + max_component(abs(b.hi))) + 1e-9;
     RTCBounds r;
-    r.lower_x = std::nextafter(static_cast<float>(b.lo.x - pad), -INFINITY);
-    r.lower_y = std::nextafter(static_cast<float>(b.lo.y - pad), -INFINITY);
-    r.lower_z = std::nextafter(static_cast<float>(b.lo.z - pad), -INFINITY);
-    r.upper_x = std::nextafter(static_cast<float>(b.hi.x + pad), INFINITY);
-    r.upper_y = std::nextafter(static_cast<float>(b.hi.y + pad), INFINITY);
-    r.upper_z = std::nextafter(static_cast<float>(b.hi.z + pad), INFINITY);
+    r.lower_x = next_down(static_cast<float>(b.lo.x - pad));
+    r.lower_y = next_down(static_cast<float>(b.lo.y - pad));
+    r.lower_z = next_down(static_cast<float>(b.lo.z - pad));
+    r.upper_x = next_up(static_cast<float>(b.hi.x + pad));
+    r.upper_y = next_up(static_cast<float>(b.hi.y + pad));
+    r.upper_z = next_up(static_cast<float>(b.hi.z + pad));
     r.align0 = r.align1 = 0;
     return r;
 }

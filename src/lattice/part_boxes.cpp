@@ -5,6 +5,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "math/float_round.h"
+
 namespace lat {
 namespace {
 
@@ -17,15 +19,6 @@ Bounds3 padded(const Bounds3& b) {
     return expand(b, 1e-6 * scale + 1e-12);
 }
 
-float down(double x) {
-    const auto f = static_cast<float>(x);
-    return static_cast<double>(f) <= x ? f : std::nextafter(f, -INFINITY);
-}
-float up(double x) {
-    const auto f = static_cast<float>(x);
-    return static_cast<double>(f) >= x ? f : std::nextafter(f, INFINITY);
-}
-
 }  // namespace
 
 PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box, bool tree)
@@ -36,9 +29,10 @@ PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box, bool tree)
         exact_.push_back(b);
         // Coordinates relative to the box centre, like the float ray's origin.
         const Bounds3 f = expand(b, kPad * d);
-        Box4 q{{down(f.lo.x - center_.x), down(f.lo.y - center_.y), down(f.lo.z - center_.z),
-                -INFINITY},
-               {up(f.hi.x - center_.x), up(f.hi.y - center_.y), up(f.hi.z - center_.z), INFINITY}};
+        Box4 q{{float_at_most(f.lo.x - center_.x), float_at_most(f.lo.y - center_.y),
+                float_at_most(f.lo.z - center_.z), -INFINITY},
+               {float_at_least(f.hi.x - center_.x), float_at_least(f.hi.y - center_.y),
+                float_at_least(f.hi.z - center_.z), INFINITY}};
         f_.push_back(q);
     }
     quads_.resize((f_.size() + 3) / 4);
@@ -133,7 +127,7 @@ unsigned PartBoxes::Ray4::meets_listed(const std::uint32_t* parts, std::size_t n
 // In float, lo - g rounds by at most 2^-24 (D + g) (coordinates relative to the box centre are
 // below D): growing by 1e-5 more covers the part in g, the boxes' padding (1e-4 D) the rest.
 PartBoxes::Ray4::Grow PartBoxes::Ray4::grow(double g) {
-    return {g, up(g * (1 + 1e-5))};
+    return {g, float_at_least(g * (1 + 1e-5))};
 }
 
 bool PartBoxes::Ray4::meets_grown(std::uint32_t i, const Range& r, const Grow& g) const {
@@ -165,7 +159,7 @@ PartBoxes::Ray4::Range PartBoxes::Ray4::range(double tmin, double tmax) const {
     // The range moved by the shift, widened by more than that subtraction's rounding.
     const double m = 4e-16 * (std::abs(shift_) + (std::isinf(tmin) ? 0 : std::abs(tmin)) +
                               (std::isinf(tmax) ? 0 : std::abs(tmax)));
-    return {tmin, tmax, down(tmin - shift_ - m), up(tmax - shift_ + m)};
+    return {tmin, tmax, float_at_most(tmin - shift_ - m), float_at_least(tmax - shift_ + m)};
 }
 
 bool PartBoxes::Ray4::meets_double(const Bounds3& b, const Range& r) const {
