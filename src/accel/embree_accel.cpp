@@ -14,10 +14,16 @@
 #include <string>
 #include <type_traits>
 
+#include "accel/embree_query.h"
+#include "accel/embree_rays.h"
+#include "accel/space_order.h"
 #include "geometry/sub_rays.h"
 #include "math/float_round.h"
 
 namespace lat {
+
+using namespace embree_detail;
+
 namespace {
 
 // Whether a map keeps the directions across a ray across it and as long as its direction (a
@@ -32,252 +38,12 @@ bool keeps_directions_across(const Transform& xf) {
            std::abs(dot(c[1], c[2])) <= tol;
 }
 
-// An object as the callbacks read it. The accelerator numbers its objects in the order of a
-// space-filling curve through their boxes, and keeps what a callback loads in this record:
-// the objects a ray meets are near each other, and their records then share cache lines
-// (scattered objects come in random order, and a callback stalled on loading the object's
-// shape and inverse map from the scene's records).
-struct Placed {
-    const Shape* shape;
-    const Transform* xf;  // object -> world
-    Affine inverse;       // xf's inverse map
-    double widest_footprint;
-    std::uint32_t original;  // its index among the objects given to the constructor
-    bool identity;           // xf is the identity
-    bool similar;            // keeps_directions_across(xf)
-    // Placed as direct primitives (one Embree primitive per cull part, whose callbacks test
-    // the whole shape), so that a shadow ray leaving it can test it after the traversal
-    // instead (test_self_last). Culling is conservative, so the test unculled answers as the
-    // callbacks' would.
-    bool direct = false;
-    // A direct object cheap enough to test before a shadow ray's traversal (LastBlocker).
-    bool cheap_blocker = false;
-
-    Ray local_ray(const Ray& r) const { return {inverse.point(r.o), inverse.vector(r.d)}; }
-    // Before the object is tested: the directions across the ray in its space handed on.
-    void hand_across() const {
-        set_across_ray_in_object(inverse, identity, similar, widest_footprint);
-    }
-};
-
-// The object-space ray for objects tested outside Embree, with the directions across it.
-Ray object_ray(const Placed& o, const Ray& r) {
-    o.hand_across();
-    return o.identity ? r : o.local_ray(r);
-}
-
-// Partial crossings in ray order, ties by object: the same for any traversal order.
-bool in_ray_order(const AccelHit& a, const AccelHit& b) {
-    return a.t != b.t ? a.t < b.t : a.object < b.object;
-}
-
-// Per-query state. Embree hands our callbacks the RTCIntersectContext; ours extends it with
-// the double-precision ray and the best hit so far (the documented way to pass query data).
-// Objects go by two numbers: the accelerator's (an index into Impl::objects: self, the cache
-// and the ring of tested objects) and the caller's (AccelHit::object: hit, partial).
-struct QueryContext {
-    // h: where the closest hit goes (for a shadow ray's transmittance, what blocked it); null
-    // for plain occlusion, which needs none.
-    QueryContext(const EmbreeAccel::Impl& m, const Ray& r, double t0, double t1, AccelHit* h)
-        : accel(&m), ray(r), tmin(t0), tmax(t1), hit(h) {
-        rtcInitIntersectContext(&rtc);
-    }
-    // The objects' copy of the directions across the ray ends with the query (sub_rays.h).
-    ~QueryContext() { clear_across_ray_in_object(); }
-    QueryContext(const QueryContext&) = delete;
-    QueryContext& operator=(const QueryContext&) = delete;
-
-    RTCIntersectContext rtc;
-    const EmbreeAccel::Impl* accel;
-    Ray ray;  // world space, double
-    double tmin, tmax;
-    AccelHit* hit;
-    bool found = false;
-    // Occlusion: the object the ray leaves (the accelerator's number); what was tested before
-    // the traversal (LastBlocker), which its callbacks skip; what blocked the ray, if it is to
-    // be kept (Impl::blocker_of).
-    std::uint32_t self = EmbreeAccel::kNoObject;
-    EmbreeAccel::LastBlocker tested_first, blocker;
-    // intersect_layers: where crossings of partial coverage go (they do not end the ray), how
-    // far to look, and for shadow rays what they let through (LayerComposite, which does not
-    // depend on the order they are met in).
-    std::vector<AccelHit>* partial = nullptr;
-    LayerStop stop;
-    LayerComposite transmitted;
-    // An object (the caller's number) answers a ray with its sheets at its first visit; met
-    // again (it fell out of the ring of tested objects), it is not counted twice.
-    bool met_already(std::uint32_t object) const {
-        for (const AccelHit& p : *partial)
-            if (p.object == object) return true;
-        return false;
-    }
-    // A shadow ray's partial crossing; whether the ray is now blocked. The stop has a margin
-    // (1e-9 relative) that the product of what the crossings let through, taken in any order,
-    // cannot close: transmittance() then finds at most blocked_below in ray order too.
-    bool add_shadow_partial(const AccelHit& h) {
-        assert(stop.shadow());
-        if (met_already(h.object)) return false;
-        partial->push_back(h);
-        transmitted.add(h.crossing);
-        return transmitted.left() < stop.blocked_below * (1 - 1e-9);
-    }
-    // A camera ray's partial crossing: the crossings are kept in ray order and cut where
-    // compositing will stop (LayerStop), and tmax and the traversal's tfar come down to the
-    // last one kept. (add_sheets keeps an object's sheets from being added twice.)
-    void add_camera_partial(const AccelHit& h, float& tfar) {
-        assert(!stop.shadow());
-        partial->insert(std::upper_bound(partial->begin(), partial->end(), h, in_ray_order), h);
-        if (stop.max_layers <= 0) return;
-        LayerComposite seen;
-        for (std::size_t i = 0; i < partial->size(); ++i) {
-            seen.add((*partial)[i].crossing);
-            if (seen.draws() == stop.max_layers || seen.left() <= stop.min_left) {
-                partial->resize(i + 1);
-                tmax = std::min(tmax, partial->back().t);
-                tfar = std::min(tfar, float_above(tmax));
-                break;
-            }
-        }
-    }
-    // The last object's object-space ray: consecutive parts of one object reuse it.
-    std::uint32_t cached_obj = ~0u;
-    Ray cached_local;
-    // The object whose directions across the ray were handed on last.
-    std::uint32_t across_obj = ~0u;
-    // Objects culled by several parts that this query has already tested: a second part of
-    // the same object can add nothing (its answer for a shorter range is no closer). A small
-    // ring; an object that falls out of it is merely tested again.
-    std::uint32_t tested[8];
-    unsigned n_tested = 0;
-    bool tested_already(std::uint32_t obj) const {
-        const unsigned n = std::min(n_tested, 8u);
-        for (unsigned i = 0; i < n; ++i)
-            if (tested[i] == obj) return true;
-        return false;
-    }
-    void mark_tested(std::uint32_t obj) { tested[n_tested++ % 8] = obj; }
-};
-// Callbacks cast Embree's context pointer back to ours.
-static_assert(std::is_standard_layout_v<QueryContext> && offsetof(QueryContext, rtc) == 0);
-
-// A float bound that surely contains the double one, so that Embree's float traversal never
-// prunes a primitive the double test would hit.
-RTCBounds to_rtc_bounds(const Bounds3& b) {
-    const double pad = 1e-6 * (max_component(abs(b.lo)) + max_component(abs(b.hi))) + 1e-9;
-    RTCBounds r;
-    r.lower_x = next_down(static_cast<float>(b.lo.x - pad));
-    r.lower_y = next_down(static_cast<float>(b.lo.y - pad));
-    r.lower_z = next_down(static_cast<float>(b.lo.z - pad));
-    r.upper_x = next_up(static_cast<float>(b.hi.x + pad));
-    r.upper_y = next_up(static_cast<float>(b.hi.y + pad));
-    r.upper_z = next_up(static_cast<float>(b.hi.z + pad));
-    r.align0 = r.align1 = 0;
-    return r;
-}
-
-// Embree asserts (and aborts) on a ray whose float origin or direction exceeds FLT_LARGE
-// (1.844e18) or is NaN, or whose range is NaN. Such a ray comes only from degenerate input (an
-// extreme transform or polynomial); it must never reach rtcIntersect1 or rtcOccluded1.
-bool embree_can_trace(const Ray& r, double tmin, double tmax) {
-    constexpr double kLarge = 1.8e18;  // just below Embree's FLT_LARGE
-    // Comparisons with NaN are false, so NaN fails too; `&` on 0s and 1s keeps it one branch
-    // per ray.
-    const auto small = [&](double v) { return static_cast<unsigned>(std::abs(v) < kLarge); };
-    return (small(r.o.x) & small(r.o.y) & small(r.o.z) & small(r.d.x) & small(r.d.y) &
-            small(r.d.z) & small(tmin) & static_cast<unsigned>(!std::isnan(tmax))) != 0;
-}
-
-// Embree drops primitives whose float bounds are not finite or exceed FLT_LARGE; objects that
-// large (or unbounded) are tested outside Embree instead, so that they are never lost.
-bool embree_can_hold(const Bounds3& b) {
-    constexpr double kLarge = 1.8e18;  // just below Embree's FLT_LARGE
-    return b.finite() && max_component(abs(b.lo)) < kLarge && max_component(abs(b.hi)) < kLarge;
-}
-
-// Rays with NaN or infinite parts hit nothing: no object can be tested against them.
-bool ray_is_finite(const Ray& r, double tmin, double tmax) {
-    return is_finite(r.o) && is_finite(r.d) && std::isfinite(tmin) && !std::isnan(tmax);
-}
-
-void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax);
-
-// The bits of v (below 2^10) spread to every third bit.
-std::uint32_t spread_bits(std::uint32_t v) {
-    v = (v | (v << 16)) & 0x030000FFu;
-    v = (v | (v << 8)) & 0x0300F00Fu;
-    v = (v | (v << 4)) & 0x030C30C3u;
-    return (v | (v << 2)) & 0x09249249u;
-}
-
-// A Morton code of p's place in the box `within` (10 bits an axis).
-std::uint32_t morton_code(Vec3 p, const Bounds3& within) {
-    const Vec3 ext = within.extent();
-    std::uint32_t code = 0;
-    for (std::size_t k = 0; k < 3; ++k) {
-        const double u = ext[k] > 0 ? (p[k] - within.lo[k]) / ext[k] : 0.0;
-        const auto q = static_cast<std::uint32_t>((u > 0 ? std::min(u, 1.0) : 0.0) * 1023.0);
-        code |= spread_bits(q) << k;
-    }
-    return code;
-}
-
-// The indices of the points along a Morton curve through their bounding box; points that are
-// not finite last.
-std::vector<std::uint32_t> space_order(std::span<const Vec3> points) {
-    Bounds3 all;
-    for (const Vec3& p : points)
-        if (is_finite(p)) all = merge(all, p);
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> keys(points.size());
-    for (std::uint32_t i = 0; i < points.size(); ++i)
-        keys[i] = {is_finite(points[i]) ? morton_code(points[i], all) : ~0u, i};
-    std::sort(keys.begin(), keys.end());
-    std::vector<std::uint32_t> order;
-    order.reserve(keys.size());
-    for (const auto& key : keys) order.push_back(key.second);
-    return order;
-}
-
-// Embree's closest-hit traversal; the callbacks record what they find in ctx.
-template <class Context>
-void trace_closest(RTCScene scene, Context& ctx, const Ray& r, double tmin, double tmax) {
-    alignas(16) RTCRayHit rh;
-    set_rtc_ray(rh.ray, r, tmin, tmax);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene, &ctx.rtc, &rh);
-}
-
-// Embree's any-hit traversal (children unsorted, cheaper per node); a callback ends it by
-// setting the ray's tfar to -infinity.
-template <class Context>
-void trace_any(RTCScene scene, Context& ctx, const Ray& r, double tmin, double tmax) {
-    alignas(16) RTCRay ray;
-    set_rtc_ray(ray, r, tmin, tmax);
-    rtcOccluded1(scene, &ctx.rtc, &ray);
-}
-
-void set_rtc_ray(RTCRay& ray, const Ray& r, double tmin, double tmax) {
-    ray.org_x = static_cast<float>(r.o.x);
-    ray.org_y = static_cast<float>(r.o.y);
-    ray.org_z = static_cast<float>(r.o.z);
-    ray.dir_x = static_cast<float>(r.d.x);
-    ray.dir_y = static_cast<float>(r.d.y);
-    ray.dir_z = static_cast<float>(r.d.z);
-    // Embree prunes in float: widen the range a little so that it never cuts a double hit.
-    ray.tnear = std::max(0.0f, static_cast<float>(tmin) * 0.5f);
-    ray.tfar = std::isfinite(tmax) ? float_above(tmax) : INFINITY;
-    ray.time = 0;
-    ray.mask = 0xFFFFFFFFu;
-    ray.id = 0;
-    ray.flags = 0;
-}
-
 }  // namespace
 
 struct EmbreeAccel::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
-    std::vector<Placed> objects;  // in the accelerator's order (Placed)
+    std::vector<Placed> objects;          // in the accelerator's order (Placed)
     std::vector<std::uint32_t> numbered;  // an object's index given -> its index in objects
     // A crossing of objects[obj], under the number the caller gave the object.
     AccelHit caller_hit(double t, std::uint32_t obj, const Crossing& c) const {
@@ -323,7 +89,7 @@ struct EmbreeAccel::Impl {
     static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
                                   const Placed& o);
     std::vector<DirectPrim> direct;
-    std::vector<Bounds3> direct_bounds;  // world space, per direct primitive
+    std::vector<Bounds3> direct_bounds;      // world space, per direct primitive
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
     std::vector<std::uint32_t> inst_object;  // top-level geomID -> object, for instances
     struct FlatPrim {
@@ -428,7 +194,7 @@ struct EmbreeAccel::Impl {
         if constexpr (K == Kind::kDirect)
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
         self->hand_across(ctx, t.object);
-        assert(ctx->hit);  // rtcIntersect1 runs only for intersect and intersect_layers
+        assert(ctx->hit);             // rtcIntersect1 runs only for intersect and intersect_layers
         assert(!ctx->stop.shadow());  // shadow rays: occluded_cb, blocks_transmittance
         const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
         const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
@@ -794,8 +560,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
         }
     }
     // Partial crossings met before a closer opaque one was found lie behind it.
-    if (ctx.found)
-        std::erase_if(partial, [&](const AccelHit& p) { return p.t >= hit.t; });
+    if (ctx.found) std::erase_if(partial, [&](const AccelHit& p) { return p.t >= hit.t; });
     // In ray order (ties by object): the same for any traversal order.
     std::sort(partial.begin(), partial.end(), in_ray_order);
     return ctx.found;

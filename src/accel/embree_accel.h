@@ -2,8 +2,8 @@
 // The acceleration structure: Embree 3 over the scene's objects. Every object is Embree user
 // geometry whose callbacks intersect in double precision with the exact (double) ray, so Embree
 // only prunes. Shapes made of several parts (sphere/cylinder chains) become one prototype scene
-// each, placed by Embree instances, or are flattened (see Instancing); unbounded objects (half-spaces, paraboloids) live in a list
-// tested directly, since a BVH cannot bound them.
+// each, placed by Embree instances, or are flattened (see Instancing); unbounded objects
+// (half-spaces, paraboloids) live in a list tested directly, since a BVH cannot bound them.
 #include <memory>
 #include <span>
 #include <vector>

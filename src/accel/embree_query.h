@@ -1,0 +1,146 @@
+#pragma once
+// What the accelerator's callbacks read (accel/embree_accel.cpp): an object as placed, and the
+// state of one query, which Embree hands them as its intersect context.
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+#include "accel/embree_accel.h"
+#include "accel/embree_rays.h"
+#include "geometry/sub_rays.h"
+
+namespace lat::embree_detail {
+
+// An object as the callbacks read it. The accelerator numbers its objects in the order of a
+// space-filling curve through their boxes, and keeps what a callback loads in this record:
+// the objects a ray meets are near each other, and their records then share cache lines
+// (scattered objects come in random order, and a callback stalled on loading the object's
+// shape and inverse map from the scene's records).
+struct Placed {
+    const Shape* shape;
+    const Transform* xf;  // object -> world
+    Affine inverse;       // xf's inverse map
+    double widest_footprint;
+    std::uint32_t original;  // its index among the objects given to the constructor
+    bool identity;           // xf is the identity
+    bool similar;            // keeps_directions_across(xf)
+    // Placed as direct primitives (one Embree primitive per cull part, whose callbacks test
+    // the whole shape), so that a shadow ray leaving it can test it after the traversal
+    // instead (test_self_last). Culling is conservative, so the test unculled answers as the
+    // callbacks' would.
+    bool direct = false;
+    // A direct object cheap enough to test before a shadow ray's traversal (LastBlocker).
+    bool cheap_blocker = false;
+
+    Ray local_ray(const Ray& r) const { return {inverse.point(r.o), inverse.vector(r.d)}; }
+    // Before the object is tested: the directions across the ray in its space handed on.
+    void hand_across() const {
+        set_across_ray_in_object(inverse, identity, similar, widest_footprint);
+    }
+};
+
+// The object-space ray for objects tested outside Embree, with the directions across it.
+inline Ray object_ray(const Placed& o, const Ray& r) {
+    o.hand_across();
+    return o.identity ? r : o.local_ray(r);
+}
+
+// Partial crossings in ray order, ties by object: the same for any traversal order.
+inline bool in_ray_order(const AccelHit& a, const AccelHit& b) {
+    return a.t != b.t ? a.t < b.t : a.object < b.object;
+}
+
+// Per-query state. Embree hands our callbacks the RTCIntersectContext; ours extends it with
+// the double-precision ray and the best hit so far (the documented way to pass query data).
+// Objects go by two numbers: the accelerator's (an index into Impl::objects: self, the cache
+// and the ring of tested objects) and the caller's (AccelHit::object: hit, partial).
+struct QueryContext {
+    // h: where the closest hit goes (for a shadow ray's transmittance, what blocked it); null
+    // for plain occlusion, which needs none.
+    QueryContext(const EmbreeAccel::Impl& m, const Ray& r, double t0, double t1, AccelHit* h)
+        : accel(&m), ray(r), tmin(t0), tmax(t1), hit(h) {
+        rtcInitIntersectContext(&rtc);
+    }
+    // The objects' copy of the directions across the ray ends with the query (sub_rays.h).
+    ~QueryContext() { clear_across_ray_in_object(); }
+    QueryContext(const QueryContext&) = delete;
+    QueryContext& operator=(const QueryContext&) = delete;
+
+    RTCIntersectContext rtc;
+    const EmbreeAccel::Impl* accel;
+    Ray ray;  // world space, double
+    double tmin, tmax;
+    AccelHit* hit;
+    bool found = false;
+    // Occlusion: the object the ray leaves (the accelerator's number); what was tested before
+    // the traversal (LastBlocker), which its callbacks skip; what blocked the ray, if it is to
+    // be kept (Impl::blocker_of).
+    std::uint32_t self = EmbreeAccel::kNoObject;
+    EmbreeAccel::LastBlocker tested_first, blocker;
+    // intersect_layers: where crossings of partial coverage go (they do not end the ray), how
+    // far to look, and for shadow rays what they let through (LayerComposite, which does not
+    // depend on the order they are met in).
+    std::vector<AccelHit>* partial = nullptr;
+    LayerStop stop;
+    LayerComposite transmitted;
+    // An object (the caller's number) answers a ray with its sheets at its first visit; met
+    // again (it fell out of the ring of tested objects), it is not counted twice.
+    bool met_already(std::uint32_t object) const {
+        for (const AccelHit& p : *partial)
+            if (p.object == object) return true;
+        return false;
+    }
+    // A shadow ray's partial crossing; whether the ray is now blocked. The stop has a margin
+    // (1e-9 relative) that the product of what the crossings let through, taken in any order,
+    // cannot close: transmittance() then finds at most blocked_below in ray order too.
+    bool add_shadow_partial(const AccelHit& h) {
+        assert(stop.shadow());
+        if (met_already(h.object)) return false;
+        partial->push_back(h);
+        transmitted.add(h.crossing);
+        return transmitted.left() < stop.blocked_below * (1 - 1e-9);
+    }
+    // A camera ray's partial crossing: the crossings are kept in ray order and cut where
+    // compositing will stop (LayerStop), and tmax and the traversal's tfar come down to the
+    // last one kept. (add_sheets keeps an object's sheets from being added twice.)
+    void add_camera_partial(const AccelHit& h, float& tfar) {
+        assert(!stop.shadow());
+        partial->insert(std::upper_bound(partial->begin(), partial->end(), h, in_ray_order), h);
+        if (stop.max_layers <= 0) return;
+        LayerComposite seen;
+        for (std::size_t i = 0; i < partial->size(); ++i) {
+            seen.add((*partial)[i].crossing);
+            if (seen.draws() == stop.max_layers || seen.left() <= stop.min_left) {
+                partial->resize(i + 1);
+                tmax = std::min(tmax, partial->back().t);
+                tfar = std::min(tfar, float_above(tmax));
+                break;
+            }
+        }
+    }
+    // The last object's object-space ray: consecutive parts of one object reuse it.
+    std::uint32_t cached_obj = ~0u;
+    Ray cached_local;
+    // The object whose directions across the ray were handed on last.
+    std::uint32_t across_obj = ~0u;
+    // Objects culled by several parts that this query has already tested: a second part of
+    // the same object can add nothing (its answer for a shorter range is no closer). A small
+    // ring; an object that falls out of it is merely tested again.
+    std::uint32_t tested[8];
+    unsigned n_tested = 0;
+    bool tested_already(std::uint32_t obj) const {
+        const unsigned n = std::min(n_tested, 8u);
+        for (unsigned i = 0; i < n; ++i)
+            if (tested[i] == obj) return true;
+        return false;
+    }
+    void mark_tested(std::uint32_t obj) { tested[n_tested++ % 8] = obj; }
+};
+// Callbacks cast Embree's context pointer back to ours.
+static_assert(std::is_standard_layout_v<QueryContext> && offsetof(QueryContext, rtc) == 0);
+
+}  // namespace lat::embree_detail
