@@ -4,15 +4,11 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cassert>
 #include <cmath>
-#include <cstddef>
-#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
-#include <type_traits>
 
 #include "accel/embree_query.h"
 #include "accel/embree_rays.h"

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "math/float_round.h"
+
 namespace lat {
 
 Bounds3 Capsule::placed_bounds(const Transform& xf) const {
@@ -24,8 +26,7 @@ FloatCapsule FloatCapsule::holding(const Capsule& c) {
                           std::abs(double(f.b[k]) - c.b[k])});
     }
     const double r = c.r + std::sqrt(3.0) * moved;
-    f.r = static_cast<float>(r);
-    if (double(f.r) < r) f.r = std::nextafter(f.r, INFINITY);
+    f.r = float_at_least(r);
     if (!std::isfinite(moved) || !std::isfinite(f.r)) f.r = -1;  // beyond float: none
     return f;
 }
