@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # make bench: runs every bench/*_bench program, writes bench/results/<name>.json (Google
 # Benchmark's JSON) and bench/results/summary.md (a readable table of all of them), then the
-# encodings, complexity and filtering benchmarks through the lattice command (and
-# docs/images/complexity.png).
+# encodings, complexity, independent-tracer and filtering benchmarks through the lattice command
+# (and docs/images/complexity.png).
 set -euo pipefail
 build=${1:-build}
 here=$(cd "$(dirname "$0")" && pwd)
@@ -18,6 +18,8 @@ echo "== encodings (through the lattice command)"
 python3 "$here/encodings.py" "$build/bin/lattice" "$out" > "$out/encodings.md"
 echo "== complexity (exact against lattice mode as the primitive grows; docs/complexity.md)"
 python3 "$here/complexity.py" "$build/bin/lattice" "$out" --work "$build/complexity" > "$out/complexity.md"
+echo "== exact mode against an independent Embree tracer (issue 9, deliverable 4; docs/complexity.md)"
+python3 "$here/embree_tracer.py" "$build/bin/lattice" "$build/bin/embree_tracer" "$out" --work "$build/embree_tracer" > "$out/embree_tracer.md"
 echo "== filtering (the default filter against exact mode at 1 and 4 spp; docs/filtering.md)"
 python3 "$here/filtering.py" "$build/bin/lattice" "$out" --work "$build/filtering" > "$out/filtering.md"
 echo "== scatter (fur on a mesh, 100,000 instances)"
@@ -32,7 +34,7 @@ fi
 # (pyenv, a virtualenv) comes first in PATH.
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 "$py" "$here/plot_complexity.py" "$out/complexity.json" "$here/../docs/images/complexity.png"
-{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/filtering.md" "$out/scatter.md" "$out/distributed.md"; } > "$out/summary.md"
+{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/filtering.md" "$out/scatter.md" "$out/distributed.md"; } > "$out/summary.md"
 echo
 cat "$out/summary.md"
 echo "results: $out"

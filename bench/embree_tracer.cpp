@@ -1,0 +1,547 @@
+// embree_tracer SCENE.json -o OUT.png [--threads N] [--geometry user|native] [--rounds R]
+// An independent Embree tracer for "lattice-reference/1" scenes (hairs of balls and cylinders,
+// spheres, half-spaces): the yardstick of issue 9's "exact mode at most the time of an
+// independent Embree tracer on the same machine" (bench/embree_tracer.py, docs/complexity.md).
+// It reads the scene with the reference tracer's parser (tests/reference) and shares no code
+// with src/ but the PNG writer: geometry, Embree set-up, traversal and shading are its own,
+// written as a user of Embree would write them.
+//   --geometry user:   balls and flat-ended cylinders as Embree user geometry, intersected in
+//                      double on the world ray mapped by each instance (the reference's rules,
+//                      in double instead of long double);
+//   --geometry native: Embree's own float primitives (RTC_GEOMETRY_TYPE_SPHERE_POINT, capped
+//                      cones RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE) and Embree's float distances.
+// Half-spaces are tested in double, outside Embree, in both. One ray a pixel through its centre,
+// Phong shading with hard shadows as the reference README defines them. Prints one JSON line:
+// build and render times (rendering only, median of --rounds).
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "io/image.h"
+#include "reference_tracer.h"
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct V {
+    double x = 0, y = 0, z = 0;
+};
+V operator+(V a, V b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+V operator-(V a, V b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V operator*(double s, V a) { return {s * a.x, s * a.y, s * a.z}; }
+double dot(V a, V b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+V cross(V a, V b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+V normalize(V a) { return (1 / std::sqrt(dot(a, a))) * a; }
+V from(const reftrace::Vec& v) { return {double(v.x), double(v.y), double(v.z)}; }
+
+using M3 = double[3][3];
+V mul(const M3& m, V v) {
+    return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+            m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
+}
+V mul_transposed(const M3& m, V v) {
+    return {m[0][0] * v.x + m[1][0] * v.y + m[2][0] * v.z, m[0][1] * v.x + m[1][1] * v.y + m[2][1] * v.z,
+            m[0][2] * v.x + m[1][2] * v.y + m[2][2] * v.z};
+}
+
+// Where a ray is inside a convex solid, and the outward normal where it enters.
+struct Span {
+    double t0 = kInf, t1 = -kInf;
+    V n;
+    bool empty() const { return !(t0 <= t1); }
+};
+
+// Solutions of a t^2 + 2 b t + c <= 0, a > 0, without cancellation.
+bool quadratic_span(double a, double b, double c, double& t0, double& t1) {
+    const double disc = b * b - a * c;
+    if (disc < 0) return false;
+    const double q = -(b + std::copysign(std::sqrt(disc), b));
+    if (q == 0) {
+        t0 = t1 = 0;
+        return true;
+    }
+    t0 = q / a, t1 = c / q;
+    if (t0 > t1) std::swap(t0, t1);
+    return true;
+}
+
+struct Ball {
+    V c;
+    double r;
+};
+struct Cylinder {
+    V a, axis;
+    double length, r;
+};
+
+Span ball_span(V o, V d, const Ball& b) {
+    Span s;
+    const V w = o - b.c;
+    if (quadratic_span(dot(d, d), dot(w, d), dot(w, w) - b.r * b.r, s.t0, s.t1)) s.n = o + s.t0 * d - b.c;
+    return s;
+}
+
+Span cylinder_span(V o, V d, const Cylinder& c) {
+    Span s;
+    const V w = o - c.a;
+    const double wa = dot(w, c.axis), da = dot(d, c.axis);
+    double s0 = -kInf, s1 = kInf;  // between the end planes
+    if (da == 0) {
+        if (wa < 0 || wa > c.length) return s;
+    } else {
+        s0 = -wa / da, s1 = (c.length - wa) / da;
+        if (s0 > s1) std::swap(s0, s1);
+    }
+    const V wp = w - wa * c.axis, dp = d - da * c.axis;  // across the axis
+    double l0 = -kInf, l1 = kInf;
+    const double a = dot(dp, dp);
+    if (a == 0) {
+        if (dot(wp, wp) > c.r * c.r) return s;
+    } else if (!quadratic_span(a, dot(wp, dp), dot(wp, wp) - c.r * c.r, l0, l1)) {
+        return s;
+    }
+    s.t0 = std::max(s0, l0), s.t1 = std::min(s1, l1);
+    if (!s.empty()) s.n = l0 >= s0 ? wp + l0 * dp : (da > 0 ? -1 * c.axis : c.axis);
+    return s;
+}
+
+// A primitive: its parts (balls first, then cylinders) and its Embree scene.
+struct Proto {
+    std::vector<Ball> balls;
+    std::vector<Cylinder> cylinders;
+    RTCScene scene = nullptr;
+    Span span(V o, V d, unsigned part) const {
+        return part < balls.size() ? ball_span(o, d, balls[part]) : cylinder_span(o, d, cylinders[part - balls.size()]);
+    }
+};
+
+struct Object {
+    int material = 0;
+    const Proto* proto = nullptr;  // an instance's; else a sphere (ball) or a half-space
+    Ball ball{};
+    V point, normal;                // half-space: dot(x - point, normal) <= 0
+    M3 minv{};                      // instance: local = minv (world - t)
+    V t;
+};
+
+struct World;
+
+// One query: Embree's context first (Embree hands it back to the callbacks), then the world ray
+// in double and what was found.
+struct Query {
+    RTCIntersectContext rtc;
+    const World* world;
+    V o, d;
+    double tmin, tmax;  // closest: (0, best so far); occlusion: the segment
+    int object = -1;
+    V n;  // the hit's outward normal, world
+};
+
+struct World {
+    reftrace::Scene ref;
+    std::vector<Proto> protos;
+    std::vector<Object> objects;
+    std::vector<unsigned> instance_object;  // top-level geometry ID of an instance -> object
+    std::vector<unsigned> sphere_object;    // primitive ID in the spheres' geometry -> object
+    std::vector<unsigned> planes;           // objects tested outside Embree
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    bool native = false;
+    ~World() {
+        for (Proto& p : protos)
+            if (p.scene) rtcReleaseScene(p.scene);
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+};
+
+float float_up(double t) { return std::nextafter(static_cast<float>(t), kInf); }
+
+// The object a primitive belongs to: an instance's, else one of the top-level spheres.
+unsigned object_hit(const World& w, unsigned inst, unsigned prim) {
+    return inst != RTC_INVALID_GEOMETRY_ID ? w.instance_object[inst] : w.sphere_object[prim];
+}
+
+// The callbacks of user geometry: an instance's parts (mapped by its transform, in double) or a
+// top-level sphere.
+
+Span user_span(const Query& q, const Object& obj, unsigned prim, V& n_world) {
+    if (!obj.proto) {
+        const Span s = ball_span(q.o, q.d, obj.ball);
+        n_world = s.n;
+        return s;
+    }
+    const V o = mul(obj.minv, q.o - obj.t), d = mul(obj.minv, q.d);
+    const Span s = obj.proto->span(o, d, prim);
+    n_world = mul_transposed(obj.minv, s.n);
+    return s;
+}
+
+void user_intersect(const RTCIntersectFunctionNArguments* a) {
+    if (!a->valid[0]) return;
+    auto* q = reinterpret_cast<Query*>(a->context);
+    const unsigned i = object_hit(*q->world, a->context->instID[0], a->primID);
+    V n;
+    const Span s = user_span(*q, q->world->objects[i], a->primID, n);
+    if (s.empty() || !(s.t0 > 0) || !(s.t0 < q->tmax)) return;
+    q->tmax = s.t0;
+    q->object = static_cast<int>(i);
+    q->n = n;
+    auto* rh = reinterpret_cast<RTCRayHit*>(a->rayhit);
+    rh->ray.tfar = float_up(s.t0);
+    rh->hit.geomID = a->geomID;
+}
+
+void user_occluded(const RTCOccludedFunctionNArguments* a) {
+    if (!a->valid[0]) return;
+    auto* q = reinterpret_cast<Query*>(a->context);
+    const unsigned i = object_hit(*q->world, a->context->instID[0], a->primID);
+    V n;
+    const Span s = user_span(*q, q->world->objects[i], a->primID, n);
+    if (!s.empty() && s.t1 > q->tmin && s.t0 < q->tmax) {
+        q->object = 0;
+        reinterpret_cast<RTCRay*>(a->ray)->tfar = -kInf;
+    }
+}
+
+// Bounds of a user primitive, padded so that the float transforms Embree traverses with never
+// cull what the double test would find.
+void pad_box(RTCBounds& b) {
+    const float pad = 1e-4f * (1 + std::max({std::fabs(b.lower_x), std::fabs(b.upper_x), std::fabs(b.lower_y),
+                                              std::fabs(b.upper_y), std::fabs(b.lower_z), std::fabs(b.upper_z)}));
+    b.lower_x -= pad, b.lower_y -= pad, b.lower_z -= pad;
+    b.upper_x += pad, b.upper_y += pad, b.upper_z += pad;
+}
+
+RTCBounds ball_bounds(const Ball& b) {
+    return {float(b.c.x - b.r), float(b.c.y - b.r), float(b.c.z - b.r), 0,
+            float(b.c.x + b.r), float(b.c.y + b.r), float(b.c.z + b.r), 0};
+}
+
+void proto_bounds(const RTCBoundsFunctionArguments* a) {
+    const auto* p = static_cast<const Proto*>(a->geometryUserPtr);
+    RTCBounds b;
+    if (a->primID < p->balls.size()) {
+        b = ball_bounds(p->balls[a->primID]);
+    } else {
+        const Cylinder& c = p->cylinders[a->primID - p->balls.size()];
+        const V e = c.a + c.length * c.axis;
+        b = {float(std::min(c.a.x, e.x) - c.r), float(std::min(c.a.y, e.y) - c.r), float(std::min(c.a.z, e.z) - c.r), 0,
+             float(std::max(c.a.x, e.x) + c.r), float(std::max(c.a.y, e.y) + c.r), float(std::max(c.a.z, e.z) + c.r), 0};
+    }
+    pad_box(b);
+    *a->bounds_o = b;
+}
+
+void sphere_bounds(const RTCBoundsFunctionArguments* a) {
+    const auto* w = static_cast<const World*>(a->geometryUserPtr);
+    RTCBounds b = ball_bounds(w->objects[w->sphere_object[a->primID]].ball);
+    pad_box(b);
+    *a->bounds_o = b;
+}
+
+RTCGeometry user_geometry(RTCDevice dev, unsigned count, void* ptr, RTCBoundsFunction bounds) {
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryUserPrimitiveCount(g, count);
+    rtcSetGeometryUserData(g, ptr);
+    rtcSetGeometryBoundsFunction(g, bounds, ptr);
+    rtcSetGeometryIntersectFunction(g, user_intersect);
+    rtcSetGeometryOccludedFunction(g, user_occluded);
+    return g;
+}
+
+// Embree's own primitives: balls as points with a radius, cylinders as capped cones.
+void attach_native(RTCDevice dev, RTCScene s, const Proto& p) {
+    if (!p.balls.empty()) {
+        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                                               4 * sizeof(float), p.balls.size()));
+        for (const Ball& b : p.balls) *v++ = float(b.c.x), *v++ = float(b.c.y), *v++ = float(b.c.z), *v++ = float(b.r);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(s, g, 0);
+        rtcReleaseGeometry(g);
+    }
+    if (!p.cylinders.empty()) {
+        const std::size_t n = p.cylinders.size();
+        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE);
+        auto* v = static_cast<float*>(
+            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 2 * n));
+        auto* idx = static_cast<unsigned*>(
+            rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned), n));
+        for (std::size_t k = 0; k < n; ++k) {
+            const Cylinder& c = p.cylinders[k];
+            for (const V e : {c.a, c.a + c.length * c.axis})
+                *v++ = float(e.x), *v++ = float(e.y), *v++ = float(e.z), *v++ = float(c.r);
+            idx[k] = static_cast<unsigned>(2 * k);
+        }
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(s, g, 1);
+        rtcReleaseGeometry(g);
+    }
+}
+
+void build_protos(World& w) {
+    for (const reftrace::Primitive& rp : w.ref.primitives) {
+        Proto p;
+        for (const auto& b : rp.balls) p.balls.push_back({from(b.c), double(b.r)});
+        for (const auto& c : rp.cylinders) p.cylinders.push_back({from(c.a), from(c.axis), double(c.length), double(c.r)});
+        w.protos.push_back(std::move(p));
+    }
+    for (Proto& p : w.protos) {  // stable addresses from here on
+        p.scene = rtcNewScene(w.device);
+        rtcSetSceneBuildQuality(p.scene, RTC_BUILD_QUALITY_HIGH);
+        if (w.native) {
+            attach_native(w.device, p.scene, p);
+        } else {
+            RTCGeometry g = user_geometry(w.device, unsigned(p.balls.size() + p.cylinders.size()), &p, proto_bounds);
+            rtcCommitGeometry(g);
+            rtcAttachGeometry(p.scene, g);
+            rtcReleaseGeometry(g);
+        }
+        rtcCommitScene(p.scene);
+    }
+}
+
+void attach_instance(World& w, unsigned i, const reftrace::Object& ro) {
+    Object& o = w.objects[i];
+    o.proto = &w.protos[std::size_t(ro.primitive)];
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) o.minv[r][c] = double(ro.minv[r][c]);
+    o.t = from(ro.t);
+    RTCGeometry g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(g, o.proto->scene);
+    const float xfm[12] = {float(ro.m[0][0]), float(ro.m[0][1]), float(ro.m[0][2]), float(ro.t.x),
+                           float(ro.m[1][0]), float(ro.m[1][1]), float(ro.m[1][2]), float(ro.t.y),
+                           float(ro.m[2][0]), float(ro.m[2][1]), float(ro.m[2][2]), float(ro.t.z)};
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xfm);
+    rtcCommitGeometry(g);
+    const unsigned id = rtcAttachGeometry(w.scene, g);
+    if (w.instance_object.size() <= id) w.instance_object.resize(id + 1);
+    w.instance_object[id] = i;
+    rtcReleaseGeometry(g);
+}
+
+// The spheres: one geometry, user or Embree points, a primitive each.
+void attach_spheres(World& w) {
+    const std::vector<unsigned>& spheres = w.sphere_object;
+    if (spheres.empty()) return;
+    RTCGeometry g;
+    if (w.native) {
+        g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                                               4 * sizeof(float), spheres.size()));
+        for (const unsigned i : spheres) {
+            const Ball& b = w.objects[i].ball;
+            *v++ = float(b.c.x), *v++ = float(b.c.y), *v++ = float(b.c.z), *v++ = float(b.r);
+        }
+    } else {
+        g = user_geometry(w.device, unsigned(spheres.size()), &w, sphere_bounds);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(w.scene, g);
+    rtcReleaseGeometry(g);
+}
+
+void build_world(World& w) {
+    w.objects.resize(w.ref.objects.size());
+    build_protos(w);
+    w.scene = rtcNewScene(w.device);
+    rtcSetSceneBuildQuality(w.scene, RTC_BUILD_QUALITY_HIGH);
+    for (unsigned i = 0; i < w.ref.objects.size(); ++i) {
+        const reftrace::Object& ro = w.ref.objects[i];
+        Object& o = w.objects[i];
+        o.material = ro.material;
+        if (ro.kind == reftrace::Kind::instance) {
+            attach_instance(w, i, ro);
+        } else if (ro.kind == reftrace::Kind::sphere) {
+            o.ball = {from(ro.ball.c), double(ro.ball.r)};
+            w.sphere_object.push_back(i);
+        } else {
+            o.point = from(ro.point), o.normal = from(ro.normal);
+            w.planes.push_back(i);
+        }
+    }
+    attach_spheres(w);
+    rtcCommitScene(w.scene);
+}
+
+// Native hits' distances are float: shadow rays leave the surface by this much (world units;
+// the reference's 1e-9 is for exact distances).
+constexpr double kNativeShadowOffset = 1e-3;
+
+struct Hit {
+    double t = kInf;
+    int object = -1;
+    V n;  // outward, world, any length
+};
+
+void init_ray(RTCRay& r, const Query& q, double tmin, double tmax) {
+    r.org_x = float(q.o.x), r.org_y = float(q.o.y), r.org_z = float(q.o.z);
+    r.dir_x = float(q.d.x), r.dir_y = float(q.d.y), r.dir_z = float(q.d.z);
+    r.tnear = std::max(0.0f, std::nextafter(float(tmin), 0.0f));
+    r.tfar = std::isfinite(tmax) ? float_up(tmax) : INFINITY;
+    r.time = 0, r.mask = ~0u, r.id = 0, r.flags = 0;
+}
+
+Query query(const World& w, V o, V d, double tmin, double tmax) {
+    Query q;
+    rtcInitIntersectContext(&q.rtc);
+    q.world = &w, q.o = o, q.d = d, q.tmin = tmin, q.tmax = tmax;
+    return q;
+}
+
+Hit closest(const World& w, V o, V d) {
+    Query q = query(w, o, d, 0, kInf);
+    RTCRayHit rh;
+    init_ray(rh.ray, q, 0, kInf);
+    rh.hit.geomID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(w.scene, &q.rtc, &rh);
+    Hit h;
+    if (!w.native && q.object >= 0) {
+        h = {q.tmax, q.object, q.n};
+    } else if (w.native && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+        h.t = rh.ray.tfar;
+        h.object = int(object_hit(w, rh.hit.instID[0], rh.hit.primID));
+        const V ng{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};  // in the instance's space
+        h.n = w.objects[std::size_t(h.object)].proto ? mul_transposed(w.objects[std::size_t(h.object)].minv, ng) : ng;
+    }
+    for (const unsigned i : w.planes) {
+        const Object& p = w.objects[i];
+        const double dn = dot(d, p.normal), t = -dot(o - p.point, p.normal) / dn;
+        if (dn < 0 && t > 0 && t < h.t) h = {t, int(i), p.normal};
+    }
+    return h;
+}
+
+// Is there solid on the segment o + t d, tmin < t < tmax? (d of unit length: Embree's float
+// curves over-report occlusion along a direction 600 units long.)
+bool blocked(const World& w, V o, V d, double tmin, double tmax) {
+    for (const unsigned i : w.planes) {
+        const Object& p = w.objects[i];
+        const double dn = dot(d, p.normal), wn = dot(o - p.point, p.normal);
+        if (dn == 0 ? wn <= 0 : dn < 0 ? -wn / dn < tmax : -wn / dn > tmin) return true;
+    }
+    Query q = query(w, o, d, tmin, tmax);
+    RTCRay r;
+    init_ray(r, q, tmin, tmax);
+    rtcOccluded1(w.scene, &q.rtc, &r);
+    return r.tfar < 0;
+}
+
+V camera_ray(const reftrace::Camera& cam, int i, int j) {
+    const V w = normalize(from(cam.look_at) - from(cam.eye));
+    const V u = normalize(cross(w, from(cam.up)));
+    const V v = cross(u, w);
+    const double h = std::tan(double(cam.fov_y_deg) * std::numbers::pi / 360);
+    const double a = double(cam.width) / cam.height;
+    const double x = (2 * (i + 0.5) / cam.width - 1) * a * h, y = (1 - 2 * (j + 0.5) / cam.height) * h;
+    return normalize(w + x * u + y * v);
+}
+
+// Phong with hard shadows, as the reference README defines it.
+V shade(const World& w, V o, V d) {
+    const reftrace::Scene& s = w.ref;
+    const Hit h = closest(w, o, d);
+    if (h.object < 0) return from(s.background);
+    const V p = o + h.t * d, view = -1 * d;
+    V n = normalize(h.n);
+    if (dot(n, view) < 0) n = -1 * n;
+    const reftrace::Material& m = s.materials[std::size_t(w.objects[std::size_t(h.object)].material)];
+    const V col = from(m.color), amb = from(s.ambient);
+    const double ka = double(m.ka), kd = double(m.kd), ks = double(m.ks), shine = double(m.shininess);
+    V c{ka * col.x * amb.x, ka * col.y * amb.y, ka * col.z * amb.z};
+    for (const reftrace::Light& light : s.lights) {
+        const V to = from(light.position) - p;
+        const double dist = std::sqrt(dot(to, to));
+        const V l = (1 / dist) * to;
+        const double offset = w.native ? kNativeShadowOffset : double(reftrace::kShadowEpsilon);
+        if (s.shadows && blocked(w, p, l, offset, dist)) continue;
+        const double nl = dot(n, l);
+        const double spec = ks * std::pow(std::max(0.0, dot(2 * nl * n - l, view)), shine);
+        const double diff = kd * std::max(0.0, nl);
+        const V in = from(light.intensity);
+        c = c + V{in.x * (diff * col.x + spec), in.y * (diff * col.y + spec), in.z * (diff * col.z + spec)};
+    }
+    return c;
+}
+
+std::uint8_t to_byte(double c) { return static_cast<std::uint8_t>(std::lround(255 * std::clamp(c, 0.0, 1.0))); }
+
+lat::Image8 render(const World& w) {
+    const reftrace::Camera& cam = w.ref.camera;
+    lat::Image8 img{cam.width, cam.height, std::vector<std::uint8_t>(3 * std::size_t(cam.width) * cam.height)};
+    const V eye = from(cam.eye);
+    tbb::parallel_for(tbb::blocked_range<int>(0, cam.height), [&](const tbb::blocked_range<int>& rows) {
+        for (int j = rows.begin(); j != rows.end(); ++j)
+            for (int i = 0; i < cam.width; ++i) {
+                const V c = shade(w, eye, camera_ray(cam, i, j));
+                std::uint8_t* px = &img.rgb[3 * (std::size_t(j) * cam.width + i)];
+                px[0] = to_byte(c.x), px[1] = to_byte(c.y), px[2] = to_byte(c.z);
+            }
+    });
+    return img;
+}
+
+double ms_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"An independent Embree tracer for lattice-reference/1 scenes (timing yardstick)"};
+    std::string scene_path, out_path, geometry = "user";
+    int threads = 0, rounds = 1;
+    app.add_option("scene", scene_path, "Scene file (lattice-reference/1)")->required();
+    app.add_option("-o,--output", out_path, "Output PNG")->required();
+    app.add_option("--threads", threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 4096));
+    app.add_option("--geometry", geometry, "user: double-precision user geometry; native: Embree's float primitives")
+        ->check(CLI::IsMember({"user", "native"}));
+    app.add_option("--rounds", rounds, "Renders timed (the median is reported)")->check(CLI::Range(1, 1000));
+    CLI11_PARSE(app, argc, argv);
+    try {
+        const int n = threads > 0 ? threads : int(tbb::this_task_arena::max_concurrency());
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(n));
+        World w;
+        w.ref = reftrace::load_scene(scene_path);
+        w.native = geometry == "native";
+        const std::string config = "threads=" + std::to_string(n);
+        w.device = rtcNewDevice(config.c_str());
+        if (!w.device) throw std::runtime_error("Embree: cannot create a device");
+        const auto t0 = std::chrono::steady_clock::now();
+        build_world(w);
+        if (rtcGetDeviceError(w.device) != RTC_ERROR_NONE) throw std::runtime_error("Embree: build failed");
+        const double build_ms = ms_since(t0);
+        std::vector<double> times;
+        lat::Image8 img;
+        for (int r = 0; r < rounds; ++r) {
+            const auto t = std::chrono::steady_clock::now();
+            img = render(w);
+            times.push_back(ms_since(t));
+        }
+        lat::write_png(out_path, img);
+        std::vector<double> sorted = times;
+        std::sort(sorted.begin(), sorted.end());
+        std::printf("{\"scene\": \"%s\", \"geometry\": \"%s\", \"threads\": %d, \"build_ms\": %.3f, \"render_ms\": %.3f, \"rounds_ms\": [",
+                    scene_path.c_str(), geometry.c_str(), n, build_ms, sorted[sorted.size() / 2]);
+        for (std::size_t k = 0; k < times.size(); ++k) std::printf("%s%.3f", k ? ", " : "", times[k]);
+        std::printf("]}\n");
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "embree_tracer: %s\n", e.what());
+        return 2;
+    }
+    return 0;
+}
