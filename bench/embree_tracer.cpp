@@ -139,15 +139,18 @@ struct Object {
 
 struct World;
 
-// One query: Embree's context first (Embree hands it back to the callbacks), then the world ray
-// in double and what was found.
+// Rays traced together (--packets): rtcIntersect8 / rtcOccluded8; a single ray is lane 0.
+constexpr int kLanes = 8;
+
+// One query of up to kLanes rays: Embree's context first (Embree hands it back to the
+// callbacks), then each lane's world ray in double and what it found.
 struct Query {
     RTCIntersectContext rtc;
     const World* world;
-    V o, d;
-    double tmin, tmax;  // closest: (0, best so far); occlusion: the segment
-    int object = -1;
-    V n;  // the hit's outward normal, world
+    V o[kLanes], d[kLanes];
+    double tmin[kLanes], tmax[kLanes];  // closest: (0, best so far); occlusion: the segment
+    int object[kLanes];
+    V n[kLanes];  // the hit's outward normal, world
 };
 
 struct World {
@@ -178,42 +181,42 @@ unsigned object_hit(const World& w, unsigned inst, unsigned prim) {
 // The callbacks of user geometry: an instance's parts (mapped by its transform, in double) or a
 // top-level sphere.
 
-Span user_span(const Query& q, const Object& obj, unsigned prim, V& n_world) {
+Span user_span(const Query& q, int k, const Object& obj, unsigned prim, V& n_world) {
     if (!obj.proto) {
-        const Span s = ball_span(q.o, q.d, obj.ball);
+        const Span s = ball_span(q.o[k], q.d[k], obj.ball);
         n_world = s.n;
         return s;
     }
-    const V o = mul(obj.minv, q.o - obj.t), d = mul(obj.minv, q.d);
+    const V o = mul(obj.minv, q.o[k] - obj.t), d = mul(obj.minv, q.d[k]);
     const Span s = obj.proto->span(o, d, prim);
     n_world = mul_transposed(obj.minv, s.n);
     return s;
 }
 
+// Embree calls these with N rays (1 for rtcIntersect1, up to 8 for rtcIntersect8), lane k of
+// the query being ray k of the call.
 void user_intersect(const RTCIntersectFunctionNArguments* a) {
-    if (!a->valid[0]) return;
     auto* q = reinterpret_cast<Query*>(a->context);
     const unsigned i = object_hit(*q->world, a->context->instID[0], a->primID);
-    V n;
-    const Span s = user_span(*q, q->world->objects[i], a->primID, n);
-    if (s.empty() || !(s.t0 > 0) || !(s.t0 < q->tmax)) return;
-    q->tmax = s.t0;
-    q->object = static_cast<int>(i);
-    q->n = n;
-    auto* rh = reinterpret_cast<RTCRayHit*>(a->rayhit);
-    rh->ray.tfar = float_up(s.t0);
-    rh->hit.geomID = a->geomID;
+    for (unsigned k = 0; k < a->N; ++k) {
+        if (!a->valid[k]) continue;
+        V n;
+        const Span s = user_span(*q, int(k), q->world->objects[i], a->primID, n);
+        if (s.empty() || !(s.t0 > 0) || !(s.t0 < q->tmax[k])) continue;
+        q->tmax[k] = s.t0, q->object[k] = int(i), q->n[k] = n;
+        RTCRayN_tfar(RTCRayHitN_RayN(a->rayhit, a->N), a->N, k) = float_up(s.t0);
+        RTCHitN_geomID(RTCRayHitN_HitN(a->rayhit, a->N), a->N, k) = a->geomID;
+    }
 }
 
 void user_occluded(const RTCOccludedFunctionNArguments* a) {
-    if (!a->valid[0]) return;
     auto* q = reinterpret_cast<Query*>(a->context);
     const unsigned i = object_hit(*q->world, a->context->instID[0], a->primID);
-    V n;
-    const Span s = user_span(*q, q->world->objects[i], a->primID, n);
-    if (!s.empty() && s.t1 > q->tmin && s.t0 < q->tmax) {
-        q->object = 0;
-        reinterpret_cast<RTCRay*>(a->ray)->tfar = -kInf;
+    for (unsigned k = 0; k < a->N; ++k) {
+        if (!a->valid[k]) continue;
+        V n;
+        const Span s = user_span(*q, int(k), q->world->objects[i], a->primID, n);
+        if (!s.empty() && s.t1 > q->tmin[k] && s.t0 < q->tmax[k]) RTCRayN_tfar(a->ray, a->N, k) = -kInf;
     }
 }
 
@@ -388,55 +391,82 @@ struct Hit {
     V n;  // outward, world, any length
 };
 
-void init_ray(RTCRay& r, const Query& q, double tmin, double tmax) {
-    r.org_x = float(q.o.x), r.org_y = float(q.o.y), r.org_z = float(q.o.z);
-    r.dir_x = float(q.d.x), r.dir_y = float(q.d.y), r.dir_z = float(q.d.z);
+Query query(const World& w) {
+    Query q;
+    rtcInitIntersectContext(&q.rtc);
+    q.world = &w;
+    return q;
+}
+
+void set_lane(Query& q, int k, V o, V d, double tmin, double tmax) {
+    q.o[k] = o, q.d[k] = d, q.tmin[k] = tmin, q.tmax[k] = tmax, q.object[k] = -1;
+}
+
+// The float ray Embree traverses with: a range that holds the double one.
+void init_ray(RTCRay& r, V o, V d, double tmin, double tmax) {
+    r.org_x = float(o.x), r.org_y = float(o.y), r.org_z = float(o.z);
+    r.dir_x = float(d.x), r.dir_y = float(d.y), r.dir_z = float(d.z);
     r.tnear = std::max(0.0f, std::nextafter(float(tmin), 0.0f));
     r.tfar = std::isfinite(tmax) ? float_up(tmax) : INFINITY;
     r.time = 0, r.mask = ~0u, r.id = 0, r.flags = 0;
 }
-
-Query query(const World& w, V o, V d, double tmin, double tmax) {
-    Query q;
-    rtcInitIntersectContext(&q.rtc);
-    q.world = &w, q.o = o, q.d = d, q.tmin = tmin, q.tmax = tmax;
-    return q;
+void init_ray(RTCRay8& r, int k, V o, V d, double tmin, double tmax) {
+    RTCRay one;
+    init_ray(one, o, d, tmin, tmax);
+    r.org_x[k] = one.org_x, r.org_y[k] = one.org_y, r.org_z[k] = one.org_z;
+    r.dir_x[k] = one.dir_x, r.dir_y[k] = one.dir_y, r.dir_z[k] = one.dir_z;
+    r.tnear[k] = one.tnear, r.tfar[k] = one.tfar;
+    r.time[k] = 0, r.mask[k] = ~0u, r.id[k] = 0, r.flags[k] = 0;
 }
 
-Hit closest(const World& w, V o, V d) {
-    Query q = query(w, o, d, 0, kInf);
-    RTCRayHit rh;
-    init_ray(rh.ray, q, 0, kInf);
-    rh.hit.geomID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(w.scene, &q.rtc, &rh);
-    Hit h;
-    if (!w.native && q.object >= 0) {
-        h = {q.tmax, q.object, q.n};
-    } else if (w.native && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-        h.t = rh.ray.tfar;
-        h.object = int(object_hit(w, rh.hit.instID[0], rh.hit.primID));
-        const V ng{rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};  // in the instance's space
-        h.n = w.objects[std::size_t(h.object)].proto ? mul_transposed(w.objects[std::size_t(h.object)].minv, ng) : ng;
-    }
+// A native hit: Embree's float distance and its normal, in the instance's space for instances.
+Hit native_hit(const World& w, float t, unsigned inst, unsigned prim, V ng) {
+    const unsigned i = object_hit(w, inst, prim);
+    const Object& o = w.objects[i];
+    return {t, int(i), o.proto ? mul_transposed(o.minv, ng) : ng};
+}
+
+// The half-spaces, tested in double after Embree.
+void add_planes(const World& w, V o, V d, Hit& h) {
     for (const unsigned i : w.planes) {
         const Object& p = w.objects[i];
         const double dn = dot(d, p.normal), t = -dot(o - p.point, p.normal) / dn;
         if (dn < 0 && t > 0 && t < h.t) h = {t, int(i), p.normal};
     }
+}
+bool planes_block(const World& w, V o, V d, double tmin, double tmax) {
+    for (const unsigned i : w.planes) {
+        const Object& p = w.objects[i];
+        const double dn = dot(d, p.normal), wn = dot(o - p.point, p.normal);
+        if (dn == 0 ? wn <= 0 : dn < 0 ? -wn / dn < tmax : -wn / dn > tmin) return true;
+    }
+    return false;
+}
+
+Hit closest(const World& w, V o, V d) {
+    Query q = query(w);
+    set_lane(q, 0, o, d, 0, kInf);
+    RTCRayHit rh;
+    init_ray(rh.ray, o, d, 0, kInf);
+    rh.hit.geomID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(w.scene, &q.rtc, &rh);
+    Hit h;
+    if (!w.native && q.object[0] >= 0)
+        h = {q.tmax[0], q.object[0], q.n[0]};
+    else if (w.native && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+        h = native_hit(w, rh.ray.tfar, rh.hit.instID[0], rh.hit.primID, {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z});
+    add_planes(w, o, d, h);
     return h;
 }
 
 // Is there solid on the segment o + t d, tmin < t < tmax? (d of unit length: Embree's float
 // curves over-report occlusion along a direction 600 units long.)
 bool blocked(const World& w, V o, V d, double tmin, double tmax) {
-    for (const unsigned i : w.planes) {
-        const Object& p = w.objects[i];
-        const double dn = dot(d, p.normal), wn = dot(o - p.point, p.normal);
-        if (dn == 0 ? wn <= 0 : dn < 0 ? -wn / dn < tmax : -wn / dn > tmin) return true;
-    }
-    Query q = query(w, o, d, tmin, tmax);
+    if (planes_block(w, o, d, tmin, tmax)) return true;
+    Query q = query(w);
+    set_lane(q, 0, o, d, tmin, tmax);
     RTCRay r;
-    init_ray(r, q, tmin, tmax);
+    init_ray(r, o, d, tmin, tmax);
     rtcOccluded1(w.scene, &q.rtc, &r);
     return r.tfar < 0;
 }
@@ -451,11 +481,22 @@ V camera_ray(const reftrace::Camera& cam, int i, int j) {
     return normalize(w + x * u + y * v);
 }
 
-// Phong with hard shadows, as the reference README defines it.
-V shade(const World& w, V o, V d) {
+// A shadow ray from p: unit direction, start and end.
+struct ShadowRay {
+    V l;
+    double tmin, tmax;
+};
+ShadowRay shadow_ray(const World& w, V p, const reftrace::Light& light) {
+    const V to = from(light.position) - p;
+    const double dist = std::sqrt(dot(to, to));
+    return {(1 / dist) * to, w.native ? kNativeShadowOffset : double(reftrace::kShadowEpsilon), dist};
+}
+
+// Phong with hard shadows, as the reference README defines it; seen(k): whether light k reaches
+// the hit (its shadow ray unblocked, or no shadows).
+template <class Seen>
+V phong(const World& w, const Hit& h, V o, V d, Seen&& seen) {
     const reftrace::Scene& s = w.ref;
-    const Hit h = closest(w, o, d);
-    if (h.object < 0) return from(s.background);
     const V p = o + h.t * d, view = -1 * d;
     V n = normalize(h.n);
     if (dot(n, view) < 0) n = -1 * n;
@@ -463,33 +504,122 @@ V shade(const World& w, V o, V d) {
     const V col = from(m.color), amb = from(s.ambient);
     const double ka = double(m.ka), kd = double(m.kd), ks = double(m.ks), shine = double(m.shininess);
     V c{ka * col.x * amb.x, ka * col.y * amb.y, ka * col.z * amb.z};
-    for (const reftrace::Light& light : s.lights) {
-        const V to = from(light.position) - p;
-        const double dist = std::sqrt(dot(to, to));
-        const V l = (1 / dist) * to;
-        const double offset = w.native ? kNativeShadowOffset : double(reftrace::kShadowEpsilon);
-        if (s.shadows && blocked(w, p, l, offset, dist)) continue;
+    for (std::size_t k = 0; k < s.lights.size(); ++k) {
+        if (!seen(k)) continue;
+        const V l = shadow_ray(w, p, s.lights[k]).l;
         const double nl = dot(n, l);
         const double spec = ks * std::pow(std::max(0.0, dot(2 * nl * n - l, view)), shine);
         const double diff = kd * std::max(0.0, nl);
-        const V in = from(light.intensity);
+        const V in = from(s.lights[k].intensity);
         c = c + V{in.x * (diff * col.x + spec), in.y * (diff * col.y + spec), in.z * (diff * col.z + spec)};
     }
     return c;
 }
 
+V shade(const World& w, V o, V d) {
+    const Hit h = closest(w, o, d);
+    if (h.object < 0) return from(w.ref.background);
+    const V p = o + h.t * d;
+    return phong(w, h, o, d, [&](std::size_t k) {
+        if (!w.ref.shadows) return true;
+        const ShadowRay r = shadow_ray(w, p, w.ref.lights[k]);
+        return !blocked(w, p, r.l, r.tmin, r.tmax);
+    });
+}
+
+// count (at most kLanes) camera rays from o along d[], as one packet each way: their hits.
+void closest8(const World& w, V o, const V* d, int count, Hit* out) {
+    Query q = query(w);
+    RTCRayHit8 rh;
+    int valid[kLanes];
+    for (int k = 0; k < kLanes; ++k) {
+        valid[k] = k < count ? -1 : 0;
+        const V dk = k < count ? d[k] : d[0];
+        set_lane(q, k, o, dk, 0, kInf);
+        init_ray(rh.ray, k, o, dk, 0, kInf);
+        rh.hit.geomID[k] = rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, w.scene, &q.rtc, &rh);
+    for (int k = 0; k < count; ++k) {
+        Hit& h = out[k];
+        h = {};
+        if (!w.native && q.object[k] >= 0)
+            h = {q.tmax[k], q.object[k], q.n[k]};
+        else if (w.native && rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID)
+            h = native_hit(w, rh.ray.tfar[k], rh.hit.instID[0][k], rh.hit.primID[k],
+                           {rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]});
+        add_planes(w, o, d[k], h);
+    }
+}
+
+// Whether light `light` reaches each hit of the packet (seen[k]), its shadow rays as one packet.
+void seen8(const World& w, V o, const V* d, const Hit* h, int count, std::size_t light, bool* seen) {
+    Query q = query(w);
+    RTCRay8 r;
+    int valid[kLanes];
+    bool any = false;
+    for (int k = 0; k < kLanes; ++k) {
+        valid[k] = 0;
+        seen[k] = true;
+        set_lane(q, k, o, d[0], 0, 0);
+        init_ray(r, k, o, d[0], 0, 0);
+        if (k >= count || h[k].object < 0) continue;
+        const V p = o + h[k].t * d[k];
+        const ShadowRay s = shadow_ray(w, p, w.ref.lights[light]);
+        if (planes_block(w, p, s.l, s.tmin, s.tmax)) {
+            seen[k] = false;
+            continue;
+        }
+        set_lane(q, k, p, s.l, s.tmin, s.tmax);
+        init_ray(r, k, p, s.l, s.tmin, s.tmax);
+        valid[k] = -1, any = true;
+    }
+    if (any) rtcOccluded8(valid, w.scene, &q.rtc, &r);
+    for (int k = 0; k < count; ++k)
+        if (valid[k]) seen[k] = r.tfar[k] >= 0;
+}
+
+// Pixels (i0, j) .. (i0 + count - 1, j), traced as packets.
+void shade8(const World& w, int i0, int j, int count, V* colors) {
+    const reftrace::Camera& cam = w.ref.camera;
+    const V eye = from(cam.eye);
+    V d[kLanes];
+    for (int k = 0; k < count; ++k) d[k] = camera_ray(cam, i0 + k, j);
+    Hit h[kLanes];
+    closest8(w, eye, d, count, h);
+    const std::size_t nl = w.ref.shadows ? w.ref.lights.size() : 0;
+    std::vector<bool> seen(nl * kLanes, true);
+    for (std::size_t l = 0; l < nl; ++l) {
+        bool s[kLanes];
+        seen8(w, eye, d, h, count, l, s);
+        for (int k = 0; k < count; ++k) seen[l * kLanes + std::size_t(k)] = s[k];
+    }
+    for (int k = 0; k < count; ++k)
+        colors[k] = h[k].object < 0 ? from(w.ref.background)
+                                    : phong(w, h[k], eye, d[k], [&](std::size_t l) {
+                                          return l >= nl || seen[l * kLanes + std::size_t(k)];
+                                      });
+}
+
 std::uint8_t to_byte(double c) { return static_cast<std::uint8_t>(std::lround(255 * std::clamp(c, 0.0, 1.0))); }
 
-lat::Image8 render(const World& w) {
+lat::Image8 render(const World& w, bool packets) {
     const reftrace::Camera& cam = w.ref.camera;
     lat::Image8 img{cam.width, cam.height, std::vector<std::uint8_t>(3 * std::size_t(cam.width) * cam.height)};
     const V eye = from(cam.eye);
     tbb::parallel_for(tbb::blocked_range<int>(0, cam.height), [&](const tbb::blocked_range<int>& rows) {
         for (int j = rows.begin(); j != rows.end(); ++j)
-            for (int i = 0; i < cam.width; ++i) {
-                const V c = shade(w, eye, camera_ray(cam, i, j));
-                std::uint8_t* px = &img.rgb[3 * (std::size_t(j) * cam.width + i)];
-                px[0] = to_byte(c.x), px[1] = to_byte(c.y), px[2] = to_byte(c.z);
+            for (int i = 0; i < cam.width; i += kLanes) {
+                const int count = std::min(kLanes, cam.width - i);
+                V c[kLanes];
+                if (packets)
+                    shade8(w, i, j, count, c);
+                else
+                    for (int k = 0; k < count; ++k) c[k] = shade(w, eye, camera_ray(cam, i + k, j));
+                for (int k = 0; k < count; ++k) {
+                    std::uint8_t* px = &img.rgb[3 * (std::size_t(j) * cam.width + std::size_t(i + k))];
+                    px[0] = to_byte(c[k].x), px[1] = to_byte(c[k].y), px[2] = to_byte(c[k].z);
+                }
             }
     });
     return img;
@@ -511,6 +641,8 @@ int main(int argc, char** argv) {
     app.add_option("--geometry", geometry, "user: double-precision user geometry; native: Embree's float primitives")
         ->check(CLI::IsMember({"user", "native"}));
     app.add_option("--rounds", rounds, "Renders timed (the median is reported)")->check(CLI::Range(1, 1000));
+    bool packets = false;
+    app.add_flag("--packets", packets, "Rays 8 at a time (rtcIntersect8 / rtcOccluded8: a row's 8 pixels, their shadow rays)");
     CLI11_PARSE(app, argc, argv);
     try {
         const int n = threads > 0 ? threads : int(tbb::this_task_arena::max_concurrency());
@@ -529,14 +661,14 @@ int main(int argc, char** argv) {
         lat::Image8 img;
         for (int r = 0; r < rounds; ++r) {
             const auto t = std::chrono::steady_clock::now();
-            img = render(w);
+            img = render(w, packets);
             times.push_back(ms_since(t));
         }
         lat::write_png(out_path, img);
         std::vector<double> sorted = times;
         std::sort(sorted.begin(), sorted.end());
-        std::printf("{\"scene\": \"%s\", \"geometry\": \"%s\", \"threads\": %d, \"build_ms\": %.3f, \"render_ms\": %.3f, \"rounds_ms\": [",
-                    scene_path.c_str(), geometry.c_str(), n, build_ms, sorted[sorted.size() / 2]);
+        std::printf("{\"scene\": \"%s\", \"geometry\": \"%s\", \"packets\": %s, \"threads\": %d, \"build_ms\": %.3f, \"render_ms\": %.3f, \"rounds_ms\": [",
+                    scene_path.c_str(), geometry.c_str(), packets ? "true" : "false", n, build_ms, sorted[sorted.size() / 2]);
         for (std::size_t k = 0; k < times.size(); ++k) std::printf("%s%.3f", k ? ", " : "", times[k]);
         std::printf("]}\n");
     } catch (const std::exception& e) {
