@@ -23,10 +23,12 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -665,6 +667,10 @@ int main(int argc, char** argv) {
         World w;
         w.ref = reftrace::load_scene(scene_path);
         if (w.ref.lights.size() > 64) packets = false;  // shade8 keeps a bit per light
+        const reftrace::Camera& cam = w.ref.camera;
+        if (cam.width < 1 || cam.height < 1 || std::int64_t(cam.width) * cam.height > (std::int64_t{1} << 26))
+            throw std::runtime_error(scene_path + ": camera: " + std::to_string(cam.width) + " x " +
+                                     std::to_string(cam.height) + " pixels (1 to 2^26 pixels)");
         w.native = geometry == "native";
         const std::string config = "threads=" + std::to_string(n);
         w.device = rtcNewDevice(config.c_str());
