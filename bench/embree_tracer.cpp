@@ -1,4 +1,4 @@
-// embree_tracer SCENE.json -o OUT.png [--threads N] [--geometry user|native] [--rounds R]
+// embree_tracer SCENE.json -o OUT.png [--threads N] [--geometry user|native] [--packets] [--rounds R]
 // An independent Embree tracer for "lattice-reference/1" scenes (hairs of balls and cylinders,
 // spheres, half-spaces): the yardstick of issue 9's "exact mode at most the time of an
 // independent Embree tracer on the same machine" (bench/embree_tracer.py, docs/complexity.md).
@@ -126,6 +126,7 @@ struct Proto {
     std::vector<Ball> balls;
     std::vector<Cylinder> cylinders;
     RTCScene scene = nullptr;
+    float pad = 0;  // how far its parts' boxes are widened (pad_for_instances)
     Span span(V o, V d, unsigned part) const {
         return part < balls.size() ? ball_span(o, d, balls[part]) : cylinder_span(o, d, cylinders[part - balls.size()]);
     }
@@ -176,7 +177,10 @@ struct World {
 
 // The float above t's nearest float, from the bits (t finite and positive here; libm's nextafterf
 // cost this tracer 5 % of its instructions).
-float float_up(double t) { return std::bit_cast<float>(std::bit_cast<std::uint32_t>(static_cast<float>(t)) + 1); }
+float float_up(double t) {
+    const float f = static_cast<float>(t);
+    return std::isinf(f) ? f : std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + 1);
+}
 float float_down(double t) {
     const float f = static_cast<float>(t);
     return f > 0 ? std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) - 1) : 0.0f;
@@ -202,18 +206,20 @@ Span user_span(const Query& q, int k, const Object& obj, unsigned prim, V& n_wor
     return s;
 }
 
-// Embree calls these with N rays (1 for rtcIntersect1, up to 8 for rtcIntersect8), lane k of
-// the query being ray k of the call.
+// Embree calls these with N rays (1 for rtcIntersect1, up to 8 for rtcIntersect8); ray k of the
+// call is the query's lane RTCRayN_id (init_ray sets it), whatever order Embree passes them in.
 void user_intersect(const RTCIntersectFunctionNArguments* a) {
     auto* q = reinterpret_cast<Query*>(a->context);
     const unsigned i = object_hit(*q->world, a->context->instID[0], a->primID);
+    RTCRayN* ray = RTCRayHitN_RayN(a->rayhit, a->N);
     for (unsigned k = 0; k < a->N; ++k) {
         if (!a->valid[k]) continue;
+        const int lane = int(RTCRayN_id(ray, a->N, k));
         V n;
-        const Span s = user_span(*q, int(k), q->world->objects[i], a->primID, n);
-        if (s.empty() || !(s.t0 > 0) || !(s.t0 < q->tmax[k])) continue;
-        q->tmax[k] = s.t0, q->object[k] = int(i), q->n[k] = n;
-        RTCRayN_tfar(RTCRayHitN_RayN(a->rayhit, a->N), a->N, k) = float_up(s.t0);
+        const Span s = user_span(*q, lane, q->world->objects[i], a->primID, n);
+        if (s.empty() || !(s.t0 > 0) || !(s.t0 < q->tmax[lane])) continue;
+        q->tmax[lane] = s.t0, q->object[lane] = int(i), q->n[lane] = n;
+        RTCRayN_tfar(ray, a->N, k) = float_up(s.t0);
         RTCHitN_geomID(RTCRayHitN_HitN(a->rayhit, a->N), a->N, k) = a->geomID;
     }
 }
@@ -223,17 +229,18 @@ void user_occluded(const RTCOccludedFunctionNArguments* a) {
     const unsigned i = object_hit(*q->world, a->context->instID[0], a->primID);
     for (unsigned k = 0; k < a->N; ++k) {
         if (!a->valid[k]) continue;
+        const int lane = int(RTCRayN_id(a->ray, a->N, k));
         V n;
-        const Span s = user_span(*q, int(k), q->world->objects[i], a->primID, n);
-        if (!s.empty() && s.t1 > q->tmin[k] && s.t0 < q->tmax[k]) RTCRayN_tfar(a->ray, a->N, k) = -kInf;
+        const Span s = user_span(*q, lane, q->world->objects[i], a->primID, n);
+        if (!s.empty() && s.t1 > q->tmin[lane] && s.t0 < q->tmax[lane]) RTCRayN_tfar(a->ray, a->N, k) = -kInf;
     }
 }
 
-// Bounds of a user primitive, padded so that the float transforms Embree traverses with never
-// cull what the double test would find.
-void pad_box(RTCBounds& b) {
-    const float pad = 1e-4f * (1 + std::max({std::fabs(b.lower_x), std::fabs(b.upper_x), std::fabs(b.lower_y),
-                                              std::fabs(b.upper_y), std::fabs(b.lower_z), std::fabs(b.upper_z)}));
+// Bounds of a user primitive widened by `extra` and by 1e-4 of its own largest coordinate (plus 1),
+// so that float boxes never cull what the double test would find.
+void pad_box(RTCBounds& b, float extra) {
+    const float pad = extra + 1e-4f * (1 + std::max({std::fabs(b.lower_x), std::fabs(b.upper_x), std::fabs(b.lower_y),
+                                                      std::fabs(b.upper_y), std::fabs(b.lower_z), std::fabs(b.upper_z)}));
     b.lower_x -= pad, b.lower_y -= pad, b.lower_z -= pad;
     b.upper_x += pad, b.upper_y += pad, b.upper_z += pad;
 }
@@ -254,14 +261,14 @@ void proto_bounds(const RTCBoundsFunctionArguments* a) {
         b = {float(std::min(c.a.x, e.x) - c.r), float(std::min(c.a.y, e.y) - c.r), float(std::min(c.a.z, e.z) - c.r), 0,
              float(std::max(c.a.x, e.x) + c.r), float(std::max(c.a.y, e.y) + c.r), float(std::max(c.a.z, e.z) + c.r), 0};
     }
-    pad_box(b);
+    pad_box(b, p->pad);
     *a->bounds_o = b;
 }
 
 void sphere_bounds(const RTCBoundsFunctionArguments* a) {
     const auto* w = static_cast<const World*>(a->geometryUserPtr);
     RTCBounds b = ball_bounds(w->objects[w->sphere_object[a->primID]].ball);
-    pad_box(b);
+    pad_box(b, 0);
     *a->bounds_o = b;
 }
 
@@ -275,13 +282,19 @@ RTCGeometry user_geometry(RTCDevice dev, unsigned count, void* ptr, RTCBoundsFun
     return g;
 }
 
+// Balls as Embree's points with a radius, one primitive each.
+RTCGeometry native_points(RTCDevice dev, const std::vector<Ball>& balls) {
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    auto* v = static_cast<float*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), balls.size()));
+    for (const Ball& b : balls) *v++ = float(b.c.x), *v++ = float(b.c.y), *v++ = float(b.c.z), *v++ = float(b.r);
+    return g;
+}
+
 // Embree's own primitives: balls as points with a radius, cylinders as capped cones.
 void attach_native(RTCDevice dev, RTCScene s, const Proto& p) {
     if (!p.balls.empty()) {
-        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                               4 * sizeof(float), p.balls.size()));
-        for (const Ball& b : p.balls) *v++ = float(b.c.x), *v++ = float(b.c.y), *v++ = float(b.c.z), *v++ = float(b.r);
+        RTCGeometry g = native_points(dev, p.balls);
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(s, g, 0);
         rtcReleaseGeometry(g);
@@ -305,6 +318,28 @@ void attach_native(RTCDevice dev, RTCScene s, const Proto& p) {
     }
 }
 
+// Embree maps a world ray into an instance's space in float: the mapped origin is off by a few
+// float roundings of |minv| (|origin| + |t|), origins being the eye or points of the scene. Each
+// prototype's boxes are widened by 1e-5 of that (about 100 roundings) for its most magnifying
+// instance, so that a small instance far from the eye is not culled where the double test hits.
+void pad_for_instances(World& w) {
+    double reach = 1 + std::max({std::fabs(w.ref.camera.eye.x), std::fabs(w.ref.camera.eye.y),
+                                 std::fabs(w.ref.camera.eye.z)});
+    for (const reftrace::Object& ro : w.ref.objects)
+        if (ro.kind == reftrace::Kind::instance)
+            reach = std::max({reach, 1 + std::fabs(double(ro.t.x)), 1 + std::fabs(double(ro.t.y)),
+                              1 + std::fabs(double(ro.t.z))});
+    for (const reftrace::Object& ro : w.ref.objects) {
+        if (ro.kind != reftrace::Kind::instance) continue;
+        double norm = 0;  // the inverse's largest row sum
+        for (int r = 0; r < 3; ++r)
+            norm = std::max(norm, std::fabs(double(ro.minv[r][0])) + std::fabs(double(ro.minv[r][1])) +
+                                      std::fabs(double(ro.minv[r][2])));
+        Proto& p = w.protos[std::size_t(ro.primitive)];
+        p.pad = std::max(p.pad, float(1e-5 * norm * 2 * reach));
+    }
+}
+
 void build_protos(World& w) {
     for (const reftrace::Primitive& rp : w.ref.primitives) {
         Proto p;
@@ -312,6 +347,7 @@ void build_protos(World& w) {
         for (const auto& c : rp.cylinders) p.cylinders.push_back({from(c.a), from(c.axis), double(c.length), double(c.r)});
         w.protos.push_back(std::move(p));
     }
+    pad_for_instances(w);
     for (Proto& p : w.protos) {  // stable addresses from here on
         p.scene = rtcNewScene(w.device);
         rtcSetSceneBuildQuality(p.scene, RTC_BUILD_QUALITY_HIGH);
@@ -352,13 +388,9 @@ void attach_spheres(World& w) {
     if (spheres.empty()) return;
     RTCGeometry g;
     if (w.native) {
-        g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                               4 * sizeof(float), spheres.size()));
-        for (const unsigned i : spheres) {
-            const Ball& b = w.objects[i].ball;
-            *v++ = float(b.c.x), *v++ = float(b.c.y), *v++ = float(b.c.z), *v++ = float(b.r);
-        }
+        std::vector<Ball> balls;
+        for (const unsigned i : spheres) balls.push_back(w.objects[i].ball);
+        g = native_points(w.device, balls);
     } else {
         g = user_geometry(w.device, unsigned(spheres.size()), &w, sphere_bounds);
     }
@@ -394,8 +426,10 @@ void build_world(World& w) {
 // double: in double, a hit point on a thin strand under an instance's transform lies inside its
 // own part by up to ~1e-10 of the world ray's length, and a ray leaving it at a slant met that part
 // again (tuft2000: 0.8 % of the pixels lost a light). So 1e-7 of the point's largest coordinate
-// (plus 1), far above double rounding and far below any part; native hits' distances are
-// float, so 1e-3 there.
+// (plus 1), far above double rounding and far below any part. This is exact mode's own rule
+// (src/render/shading.cpp's shadow_epsilon), so the images' identity with exact mode is partly by
+// construction: it checks the geometry and shading, not the choice of offset. Native hits'
+// distances are float, so 1e-3 there.
 double shadow_offset(const World& w, V p) {
     if (w.native) return 1e-3;
     return 1e-7 * (1 + std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}));
@@ -432,7 +466,7 @@ void init_ray(RTCRay8& r, int k, V o, V d, double tmin, double tmax) {
     r.org_x[k] = one.org_x, r.org_y[k] = one.org_y, r.org_z[k] = one.org_z;
     r.dir_x[k] = one.dir_x, r.dir_y[k] = one.dir_y, r.dir_z[k] = one.dir_z;
     r.tnear[k] = one.tnear, r.tfar[k] = one.tfar;
-    r.time[k] = 0, r.mask[k] = ~0u, r.id[k] = 0, r.flags[k] = 0;
+    r.time[k] = 0, r.mask[k] = ~0u, r.id[k] = unsigned(k), r.flags[k] = 0;  // id: the query's lane
 }
 
 // A native hit: Embree's float distance and its normal, in the instance's space for instances.
@@ -440,6 +474,12 @@ Hit native_hit(const World& w, float t, unsigned inst, unsigned prim, V ng) {
     const unsigned i = object_hit(w, inst, prim);
     const Object& o = w.objects[i];
     return {t, int(i), o.proto ? mul_transposed(o.minv, ng) : ng};
+}
+
+// Lane k's hit: the user callbacks' double one, or Embree's native one (geom invalid: none).
+Hit lane_hit(const World& w, const Query& q, int k, unsigned geom, float t, unsigned inst, unsigned prim, V ng) {
+    if (!w.native) return q.object[k] >= 0 ? Hit{q.tmax[k], q.object[k], q.n[k]} : Hit{};
+    return geom != RTC_INVALID_GEOMETRY_ID ? native_hit(w, t, inst, prim, ng) : Hit{};
 }
 
 // The half-spaces, tested in double after Embree.
@@ -466,11 +506,8 @@ Hit closest(const World& w, V o, V d) {
     init_ray(rh.ray, o, d, 0, kInf);
     rh.hit.geomID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(w.scene, &q.rtc, &rh);
-    Hit h;
-    if (!w.native && q.object[0] >= 0)
-        h = {q.tmax[0], q.object[0], q.n[0]};
-    else if (w.native && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
-        h = native_hit(w, rh.ray.tfar, rh.hit.instID[0], rh.hit.primID, {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z});
+    Hit h = lane_hit(w, q, 0, rh.hit.geomID, rh.ray.tfar, rh.hit.instID[0], rh.hit.primID,
+                     {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z});
     add_planes(w, o, d, h);
     return h;
 }
@@ -551,7 +588,7 @@ V shade(const World& w, V o, V d) {
 void closest8(const World& w, V o, const V* d, int count, Hit* out) {
     Query q = query(w);
     RTCRayHit8 rh;
-    int valid[kLanes];
+    alignas(32) int valid[kLanes];  // Embree reads the mask as one 32-byte vector
     for (int k = 0; k < kLanes; ++k) {
         valid[k] = k < count ? -1 : 0;
         const V dk = k < count ? d[k] : d[0];
@@ -561,14 +598,9 @@ void closest8(const World& w, V o, const V* d, int count, Hit* out) {
     }
     rtcIntersect8(valid, w.scene, &q.rtc, &rh);
     for (int k = 0; k < count; ++k) {
-        Hit& h = out[k];
-        h = {};
-        if (!w.native && q.object[k] >= 0)
-            h = {q.tmax[k], q.object[k], q.n[k]};
-        else if (w.native && rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID)
-            h = native_hit(w, rh.ray.tfar[k], rh.hit.instID[0][k], rh.hit.primID[k],
-                           {rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]});
-        add_planes(w, o, d[k], h);
+        out[k] = lane_hit(w, q, k, rh.hit.geomID[k], rh.ray.tfar[k], rh.hit.instID[0][k], rh.hit.primID[k],
+                          {rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]});
+        add_planes(w, o, d[k], out[k]);
     }
 }
 
@@ -576,7 +608,7 @@ void closest8(const World& w, V o, const V* d, int count, Hit* out) {
 void seen8(const World& w, V o, const V* d, const Hit* h, int count, std::size_t light, bool* seen) {
     Query q = query(w);
     RTCRay8 r;
-    int valid[kLanes];
+    alignas(32) int valid[kLanes];  // Embree reads the mask as one 32-byte vector
     bool any = false;
     for (int k = 0; k < kLanes; ++k) {
         valid[k] = 0;
@@ -673,7 +705,9 @@ int main(int argc, char** argv) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(n));
         World w;
         w.ref = reftrace::load_scene(scene_path);
-        if (w.ref.lights.size() > 64) packets = false;  // shade8 keeps a bit per light
+        if (packets && w.ref.lights.size() > 64)  // shade8 keeps a bit per light
+            throw std::runtime_error(scene_path + ": lights: " + std::to_string(w.ref.lights.size()) +
+                                     " (--packets takes at most 64)");
         const reftrace::Camera& cam = w.ref.camera;
         if (cam.width < 1 || cam.height < 1 || std::int64_t(cam.width) * cam.height > (std::int64_t{1} << 26))
             throw std::runtime_error(scene_path + ": camera: " + std::to_string(cam.width) + " x " +
