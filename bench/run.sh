@@ -20,7 +20,7 @@ echo "== complexity (exact against lattice mode as the primitive grows; docs/com
 python3 "$here/complexity.py" "$build/bin/lattice" "$out" --work "$build/complexity" > "$out/complexity.md"
 echo "== exact mode against an independent Embree tracer (issue 9, deliverable 4; docs/complexity.md)"
 python3 "$here/embree_tracer.py" "$build/bin/lattice" "$build/bin/embree_tracer" "$out" --work "$build/embree_tracer" > "$out/embree_tracer.md"
-echo "== filtering (the default filter against exact mode at 1 and 4 spp; docs/filtering.md)"
+echo "== filtering (the default filter against exact mode at 1 and 4 spp, and at equal fidelity; docs/filtering.md)"
 python3 "$here/filtering.py" "$build/bin/lattice" "$out" --work "$build/filtering" > "$out/filtering.md"
 echo "== scatter (fur on a mesh, 100,000 instances)"
 python3 "$here/scatter.py" "$build/bin/lattice" "$out" > "$out/scatter.md"
