@@ -130,6 +130,10 @@ def report(results, gt_spp):
         cells = " | ".join(f"{fmt_db(m[k]['psnr_db'])} / {m[k]['ms']:.0f}" for k in MODES)
         print(f"| {r['scene']} | {r['loadavg']:.1f} | {cells} | {gain:+.2f} | {ratio:.2f} | {met} |")
     print()
+    report_equal_fidelity(results)
+
+
+def report_equal_fidelity(results):
     print("At equal fidelity: the fewest samples (of " + ", ".join(map(str, MATCH_SPP)) +
           ") at which exact mode is at least as faithful as the default filter, timed in the "
           "same rounds.\n")
