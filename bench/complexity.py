@@ -111,7 +111,7 @@ def bench_primitive(a, name, cost):
             assert s["tables_built"] == 0, "the table should have come from the cache"
             r["lattice"][enc]["runs_ms"].append(s["render_ms"])
             r["lattice"][enc]["rays"] = s["primary_rays"] + s["shadow_rays"]
-            r["lattice"][enc]["lattice_visits"] = s.get("lattice_visits")
+            r["lattice"][enc]["lattice_visits"] = s.get("table_visits")
     r["exact_ms"] = statistics.median(r["exact_runs_ms"])
     r["exact_min_ms"] = min(r["exact_runs_ms"])
     r["base_ms"] = base_ms = statistics.median(r["base_runs_ms"])
@@ -214,7 +214,7 @@ def markdown(res):
             nsv = f"{nsv:.0f}" if nsv is not None else "n/a"
             print(f"| {r['primitive']} | {e} | {fmt_ms(L['ms'])} | {vpr} | {nsv} | "
                   f"{L['table_bytes']} | {L['build_s']:.2f} | {fmt_db(L['psnr_db'])} |")
-    print("\nvisits: calls of a lattice's intersect/occluded/spans (render --stats lattice_visits); "
+    print("\nvisits: calls of a lattice's intersect/occluded/spans (render --stats table_visits); "
           "ns/visit: (lattice ms - ms without instances) x threads / visits.\n")
 
 

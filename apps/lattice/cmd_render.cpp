@@ -1,8 +1,10 @@
 // lattice render SCENE.json -o OUT.png [--threads N] [--spp N] [--stats FILE.json] [--mode M]
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <vector>
 #include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -51,10 +53,63 @@ struct RenderArgs {
     std::string filter = "smooth";
     std::string lod = "on";
     double lod_budget = kLodBudgetMinutes;  // of one core
+    std::string footprint = "off";
     bool quiet = false;
+    // Options given that cannot act in this mode, said once each (option_notes).
+    std::vector<std::string> notes;
 
-    bool lattice_mode() const { return kModes.at(mode) == RenderMode::kLattice; }
+    RenderMode render_mode() const { return kModes.at(mode); }
+    // Whether instances are answered by lattices: tables or sub-rays (SceneLattices).
+    bool answers_instances() const {
+        return render_mode() == RenderMode::kLattice || render_mode() == RenderMode::kAuto ||
+               (render_mode() == RenderMode::kExact && kOnOff.at(footprint));
+    }
 };
+
+// The modes each mode-specific option acts in: a given option outside them gets a note (it
+// would otherwise change nothing, silently).
+struct OptionScope {
+    const char* option;
+    std::vector<RenderMode> modes;
+};
+const std::vector<OptionScope>& option_scopes() {
+    using M = RenderMode;
+    static const std::vector<OptionScope> scopes{
+        {"--sigma-inv", {M::kLattice, M::kAuto}},     {"--encoding", {M::kLattice, M::kAuto}},
+        {"--max-point-error", {M::kLattice, M::kAuto}}, {"--max-normal-error", {M::kLattice, M::kAuto}},
+        {"--dense-normals", {M::kLattice, M::kAuto}}, {"--filter", {M::kLattice, M::kAuto}},
+        {"--lod", {M::kLattice, M::kAuto}},           {"--lod-budget", {M::kLattice, M::kAuto}},
+        {"--lattice-dir", {M::kLattice, M::kAuto}},   {"--footprint", {M::kExact}},
+        {"--texture-size", {M::kTexture}},            {"--texture-subsamples", {M::kTexture}},
+        {"--shadow-map-size", {M::kParticles}},
+        {"--instancing", {M::kExact, M::kLattice, M::kAuto}},
+    };
+    return scopes;
+}
+
+// A note for each option given that cannot act here: outside its modes, or (--lod,
+// --lod-budget) without what it refines.
+std::vector<std::string> option_notes(const CLI::App& app, const RenderArgs& a) {
+    std::vector<std::string> notes;
+    const auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
+    for (const OptionScope& s : option_scopes()) {
+        if (!given(s.option) ||
+            std::find(s.modes.begin(), s.modes.end(), a.render_mode()) != s.modes.end())
+            continue;
+        std::string where;
+        for (const RenderMode m : s.modes)
+            where += (where.empty() ? "" : ", ") + std::string(mode_description(m).name);
+        notes.push_back(std::string(s.option) + " has no effect in " + a.mode +
+                        " mode (it acts in: " + where + ")");
+    }
+    const bool tables = a.render_mode() == RenderMode::kLattice || a.render_mode() == RenderMode::kAuto;
+    if (tables && kFilters.at(a.filter) == LatticeFilter::kNone && given("--lod"))
+        notes.push_back("--lod has no effect with --filter none (point-sampled tables have one level)");
+    if (tables && given("--lod-budget") &&
+        (kFilters.at(a.filter) == LatticeFilter::kNone || !kOnOff.at(a.lod)))
+        notes.push_back("--lod-budget has no effect without levels of detail (--lod on and a filter)");
+    return notes;
+}
 
 // Wall-clock milestones of a render command, in milliseconds from its start.
 struct Timings {
@@ -74,16 +129,50 @@ double mrays_per_s(const RenderStats& st) {
     return st.render_ms > 0 ? static_cast<double>(rays) / (st.render_ms * 1e3) : 0.0;
 }
 
+// "sigma^-1 = 1, 2, 4".
+std::string levels_text(const std::vector<long long>& sigma_inv) {
+    std::string text;
+    for (const long long k : sigma_inv) text += (text.empty() ? "" : ", ") + std::to_string(k);
+    return "sigma^-1 = " + text;
+}
+
+// How one primitive's instances were answered, in words.
+std::string answer_text(const PrimitiveAnswer& p, LatticeFilter filter) {
+    std::string text;
+    switch (p.by) {
+        case AnsweredBy::kTable:
+            text = "point-sampled " + p.encoding + " table, " + levels_text(p.sigma_inv);
+            break;
+        case AnsweredBy::kFilteredTables:
+            text = std::string(filter == LatticeFilter::kBox ? "box" : "smooth") + "-filtered " +
+                   p.encoding + " table" + (p.sigma_inv.size() == 1 ? ", " : "s, ") +
+                   levels_text(p.sigma_inv);
+            break;
+        case AnsweredBy::kSubRayCrossings:
+            text = "its own crossings of " + std::to_string(kExactSubRays) + " x " +
+                   std::to_string(kExactSubRays) + " sub-rays across each ray's footprint, no table";
+            break;
+        case AnsweredBy::kExact: text = "exact point samples, no table"; break;
+    }
+    return text + (p.why.empty() ? "" : " (" + p.why + ")");
+}
+
 void print_summary(const RenderArgs& a, const Scene& scene, const ModeResult& r, const Timings& t) {
     const SceneLattices& lattices = r.lattices;
     const RenderStats& st = r.out.stats;
-    if (a.lattice_mode())
-        std::fprintf(stderr, "lattice: %zu table%s (%s, %s hits), %d built in %.1f s\n",
+    for (const PrimitiveAnswer& p : lattices.answers)
+        std::fprintf(stderr, "lattice: %s: %s\n", p.where.c_str(),
+                     answer_text(p, kFilters.at(a.filter)).c_str());
+    if (!lattices.paths.empty() || (a.answers_instances() && a.render_mode() != RenderMode::kExact))
+        std::fprintf(stderr, "lattice: %zu table%s read (%s, %s hits), %d built in %.1f s, %llu table visits\n",
                      lattices.paths.size(), lattices.paths.size() == 1 ? "" : "s",
                      human_bytes(static_cast<double>(lattices.table_bytes)).c_str(),
                      std::to_string(lattices.table_entries).c_str(), lattices.built,
-                     lattices.build_seconds);
+                     lattices.build_seconds, static_cast<unsigned long long>(st.lattice_visits));
+    if (a.answers_instances() && lattices.answers.empty())
+        std::fprintf(stderr, "lattice: note: the scene has no instances of a primitive: every object is traced exactly\n");
     for (const std::string& note : lattices.notes) std::fprintf(stderr, "lattice: note: %s\n", note.c_str());
+    for (const std::string& note : a.notes) std::fprintf(stderr, "lattice: note: %s\n", note.c_str());
     if (st.ranks.size() > 1)
         std::fprintf(stderr, "lattice: render spread over %zu MPI ranks (tiles per rank:%s)\n",
                      st.ranks.size(), [&] {
@@ -92,10 +181,12 @@ void print_summary(const RenderArgs& a, const Scene& scene, const ModeResult& r,
                          return tiles;
                      }().c_str());
     std::fprintf(stderr,
-                 "lattice: %s %dx%d, %d spp, %s mode: render %.1f ms on %d threads, "
+                 "lattice: %s %dx%d, %d spp, %s mode%s: render %.1f ms on %d threads, "
                  "%llu primary + %llu shadow rays, %.2f M rays/s (total %.1f ms, peak %.1f MB)\n",
                  a.output.c_str(), scene.camera.width, scene.camera.height, std::max(1, a.spp),
-                 a.mode.c_str(), st.render_ms, st.threads,
+                 a.mode.c_str(),
+                 a.render_mode() == RenderMode::kExact && kOnOff.at(a.footprint) ? " with footprint filtering" : "",
+                 st.render_ms, st.threads,
                  static_cast<unsigned long long>(st.primary_rays),
                  static_cast<unsigned long long>(st.shadow_rays), mrays_per_s(st), t.written,
                  static_cast<double>(peak_rss_bytes()) / (1 << 20));
@@ -109,6 +200,7 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeRes
     j["scene"] = a.scene;
     j["output"] = a.output;
     j["mode"] = a.mode;
+    if (a.render_mode() == RenderMode::kExact) j["footprint"] = a.footprint;
     j["width"] = scene.camera.width;
     j["height"] = scene.camera.height;
     j["spp"] = std::max(1, a.spp);
@@ -117,20 +209,28 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeRes
     j["build_ms"] = r.build_ms;
     j["prepare_ms"] = r.prepare_ms;
     j["bytes_added"] = r.bytes_added;
-    if (a.lattice_mode()) {
-        j["sigma_inv"] = a.spec.sigma_inv;
-        j["encoding"] = a.spec.encoding;
-        j["filter"] = a.filter;
-        j["lod"] = a.lod;
-        j["lod_budget_minutes"] = a.lod_budget;
+    if (a.answers_instances()) {
+        // What answered, per primitive: the effective settings, not the requested ones.
+        j["primitives"] = nlohmann::json::array();
+        for (const PrimitiveAnswer& p : lattices.answers) {
+            nlohmann::json e{{"primitive", p.primitive}, {"where", p.where},
+                             {"answered_by", answer_name(p.by)}, {"how", answer_text(p, kFilters.at(a.filter))}};
+            if (!p.encoding.empty()) e["encoding"] = p.encoding;
+            if (p.by == AnsweredBy::kFilteredTables) e["filter"] = a.filter;
+            if (!p.sigma_inv.empty()) e["sigma_inv"] = p.sigma_inv;
+            if (p.by == AnsweredBy::kSubRayCrossings) e["sub_rays"] = kSubRays;
+            if (!p.why.empty()) e["why"] = p.why;
+            j["primitives"].push_back(std::move(e));
+        }
         j["lattice_notes"] = lattices.notes;
         j["tables_ms"] = r.prepare_ms;
         j["tables_built"] = lattices.built;
         j["table_bytes"] = lattices.table_bytes;
         j["table_entries"] = lattices.table_entries;
         j["table_files"] = lattices.paths;
-        j["lattice_visits"] = st.lattice_visits;
+        j["table_visits"] = st.lattice_visits;
     }
+    j["option_notes"] = a.notes;
     j["render_ms"] = st.render_ms;
     j["render_cpu_ms"] = st.cpu_ms;
     j["total_ms"] = t.written;
@@ -195,6 +295,7 @@ int run_render(const RenderArgs& a) {
     settings.filtering.filter = kFilters.at(a.filter);
     settings.filtering.lod = kOnOff.at(a.lod);
     settings.filtering.max_work = lod_work(a.lod_budget);
+    settings.footprint = kOnOff.at(a.footprint);
     settings.accel.instancing = kInstancing.at(a.instancing);
     settings.texture = a.texture;
     settings.shadow_map_size = a.shadow_map_size;
@@ -222,7 +323,7 @@ Command add_render_command(CLI::App& parent) {
     c.app->add_option("-o,--output", args->output, "Output image: .png, .pfm or .exr")->required();
     c.app->add_option("--threads", args->threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(0, 4096));
-    c.app->add_option("--spp", args->spp, "Stratified samples per pixel (1 = pixel centre)")
+    c.app->add_option("--spp", args->spp, "Samples per pixel (1 = pixel centre)")
         ->check(CLI::Range(1, 65536));
     c.app->add_option("--stats", args->stats, "Write timing and ray counts as JSON");
     std::string mode_help;
@@ -243,27 +344,22 @@ Command add_render_command(CLI::App& parent) {
                       "$XDG_CACHE_HOME/lattice or ~/.cache/lattice)");
     add_table_options(*c.app, args->spec);
     c.app->add_option("--filter", args->filter,
-                      "lattice mode: none (point-sampled tables, as rasterized), box (each pair's "
+                      "lattice and auto modes: none (point-sampled tables, as rasterized), box (each pair's "
                       "coverage) or smooth (coverage blended over the neighbouring pairs, the "
                       "default unless --encoding names one without coverage); a filter uses the "
                       "coverage encoding")
         ->check(CLI::IsMember(kFilters));
     c.app->add_option("--lod", args->lod,
-                      "lattice mode with a filter: a chain of spheres and cylinders (any number "
-                      "of parts) or another primitive cheap to intersect (at most " +
-                          std::to_string(static_cast<int>(kMaxExactCost)) +
-                          " simple tests) answered by the crossings of " +
-                          std::to_string(kExactSubRays) + " x " + std::to_string(kExactSubRays) +
-                          " sub-rays across each ray's footprint, a costlier one by levels of detail, sigma^-1 = "
-                          "K, 2K, 4K as the pixels' footprints need, or by its crossings where they "
-                          "are past --lod-budget (on); or only K, tables alone (off)")
+                      "lattice and auto modes with a filter: levels of detail, tables at sigma^-1 = "
+                      "K, 2K, 4K as the pixels' footprints need, within --lod-budget (on); or K "
+                      "alone (off)")
         ->check(CLI::IsMember(kOnOff));
     c.app->add_option("--lod-budget", args->lod_budget,
-                      "lattice mode, --lod on: a costlier primitive's levels of detail beyond K are "
-                      "built only if each takes at most about this many minutes of one core "
-                      "(estimated from its pairs and the primitive's cost); past it the primitive "
-                      "is answered by its crossings, and the summary says so. A level in the "
-                      "cache is read whatever the budget")
+                      "lattice and auto modes, --lod on: levels of detail beyond K are built only "
+                      "if each takes at most about this many minutes of one core (estimated from "
+                      "its pairs and the primitive's cost); past it lattice mode reads the finest "
+                      "level within it and auto mode answers the primitive by its sub-rays, and the "
+                      "summary says so. A level in the cache is read whatever the budget")
         // Not CLI::Range: its comparisons let "nan" through.
         ->check([](const std::string& text) -> std::string {
             char* end = nullptr;
@@ -277,6 +373,14 @@ Command add_render_command(CLI::App& parent) {
                       "Multi-part objects as Embree instances (always), flattened into one "
                       "hierarchy (never), or flattened unless that would be huge (auto)")
         ->check(CLI::IsMember(kInstancing));
+    c.app->add_option("--footprint", args->footprint,
+                      "exact mode: each instance answered by its own crossings of " +
+                          std::to_string(kExactSubRays) + " x " + std::to_string(kExactSubRays) +
+                          " sub-rays across the ray's footprint (a pixel's, split by --spp), their "
+                          "partial coverage composited front to back and shadowed per layer: "
+                          "antialiased hair at 1 spp (on); or point samples (off)")
+        ->check(CLI::IsMember(kOnOff))
+        ->capture_default_str();
     c.app->add_flag("-q,--quiet", args->quiet, "No progress bar or summary line");
     c.across_ranks = true;
     c.run = [args, app = c.app] {
@@ -287,7 +391,8 @@ Command add_render_command(CLI::App& parent) {
         if (encoding_given && !filter_given && !find_encoding(args->spec.encoding).coverage)
             args->filter = "none";
         if (kFilters.at(args->filter) != LatticeFilter::kNone && !encoding_given)
-            args->spec.encoding = "coverage";
+            args->spec.encoding = coverage_encoding().name;
+        args->notes = option_notes(*app, *args);
         return run_render(*args);
     };
     return c;

@@ -51,13 +51,6 @@ struct Row {
     ImageDiffStats diff;
 };
 
-// The encoding a filtered lattice uses: the first that stores coverage.
-std::string coverage_encoding() {
-    for (const Encoding* e : lat::encodings())
-        if (e->coverage) return std::string(e->name);
-    return {};
-}
-
 std::string fixed(double v, int digits) {
     if (std::isinf(v)) return "inf";
     char text[64];
@@ -115,7 +108,7 @@ int run_table2(const Table2Args& a) {
         for (const Encoding* e : lat::encodings()) encodings.emplace_back(e->name);
     for (const std::string& e : encodings) find_encoding(e);
     const LatticeFilter filter = lattice_filters().at(a.filter);
-    const std::string filtered_encoding = filter == LatticeFilter::kNone ? "" : coverage_encoding();
+    const std::string filtered_encoding = filter == LatticeFilter::kNone ? "" : std::string(coverage_encoding().name);
     const Scene scene = load_scene(a.scene);
     check_render_budget(scene.camera, std::max(a.spp, a.truth_spp), a.scene);
     // The texture mode needs a base surface it can map; without one its row is left out (and

@@ -67,5 +67,7 @@ struct Encoding {
 std::span<const Encoding* const> encodings();
 // Throws InputError listing the known encodings when `name` is not one.
 const Encoding& find_encoding(std::string_view name);
+// The encoding filtered lattices use: the first that stores coverage.
+const Encoding& coverage_encoding();
 
 }  // namespace lat

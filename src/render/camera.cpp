@@ -1,5 +1,6 @@
 #include "render/camera.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lat {
@@ -13,6 +14,10 @@ PinholeCamera::PinholeCamera(const Camera& c)
     w_ = normalize(c.look_at - c.eye);
     u_ = normalize(cross(w_, c.up));
     v_ = cross(u_, w_);
+}
+
+double sample_spread(const Camera& c, int spp) {
+    return 2 * std::tan(c.fov_y_deg * M_PI / 360.0) / c.height / std::sqrt(double(std::max(1, spp)));
 }
 
 }  // namespace lat

@@ -6,6 +6,11 @@
 
 namespace lat {
 
+// A camera sample's footprint per unit distance along its ray: the pixel's angle, shared by
+// the spp samples that split it. The one home of the footprint's spread: the renderer traces
+// with it, and lattice levels of detail and sub-ray bounds are planned with it.
+double sample_spread(const Camera& c, int spp);
+
 class PinholeCamera {
 public:
     explicit PinholeCamera(const Camera& c);

@@ -3,19 +3,29 @@
 #include <array>
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <cmath>
 
 #include "dist/timeline.h"
 #include "geometry/chain.h"
+#include "lattice/encoding.h"
+#include "render/camera.h"
 #include "render/scene_parts.h"
 
 namespace lat {
 namespace {
 
-constexpr std::array<ModeDescription, 4> kModes{{
-    {"exact", RenderMode::kExact, "full ray trace of every primitive", "full ray trace", "high", "slow",
-     "medium", true},
-    {"lattice", RenderMode::kLattice, "instances through their lattice tables (built on first use and cached)",
+constexpr std::array<ModeDescription, 5> kModes{{
+    {"exact", RenderMode::kExact,
+     "full ray trace of every primitive (with --footprint on, instances by sub-rays across each "
+     "pixel's footprint)",
+     "full ray trace", "high", "slow", "medium", true},
+    {"lattice", RenderMode::kLattice,
+     "every instance answered from its lattice tables (built on first use and cached)", "lattice",
+     "high", "moderate", "large", true},
+    {"auto", RenderMode::kAuto,
+     "per primitive: sub-rays across the footprint for one cheap to intersect, filtered tables "
+     "for a costlier one; the summary line names each choice",
      "lattice", "high", "moderate", "large", true},
     {"texture", RenderMode::kTexture,
      "instances replaced by colour, coverage and normal maps baked on the surface they grow from",
@@ -38,6 +48,26 @@ std::uint64_t instance_geometry_bytes(const Scene& scene) {
             bytes += c->spheres().size() * sizeof(ChainSphere) + c->cylinders().size() * sizeof(ChainCylinder);
     }
     return bytes;
+}
+
+// How the mode answers instances: the one place a mode becomes a LatticePolicy. None for exact
+// mode without footprint filtering (instances traced as they are).
+std::optional<LatticeFiltering> lattice_policy(const Scene& scene, RenderMode mode,
+                                               const ModeSettings& settings) {
+    LatticeFiltering f = settings.filtering;
+    switch (mode) {
+        case RenderMode::kExact:
+            if (!settings.footprint) return std::nullopt;
+            f.policy = LatticePolicy::kFootprint;
+            f.filter = LatticeFilter::kSmooth;
+            f.lod = true;
+            break;
+        case RenderMode::kLattice: f.policy = LatticePolicy::kTables; break;
+        case RenderMode::kAuto: f.policy = LatticePolicy::kAuto; break;
+        default: return std::nullopt;
+    }
+    f.spread = sample_spread(scene.camera, settings.spp);
+    return f;
 }
 
 }  // namespace
@@ -63,21 +93,29 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
     auto t0 = clock::now();
     switch (mode) {
         case RenderMode::kExact:
-        case RenderMode::kLattice: {
-            RenderScene::InstanceShapeFn instance_shape;
+        case RenderMode::kLattice:
+        case RenderMode::kAuto: {
             r.bytes_added = instance_geometry_bytes(scene);
-            if (mode == RenderMode::kLattice) {
-                const TableCache cache(settings.lattice_dir.empty() ? default_cache_dir() : settings.lattice_dir,
-                                       !settings.lattice_dir.empty(), opt.across_ranks);
-                LatticeFiltering filtering = settings.filtering;
-                // A pixel's angle, narrowed by the samples that share it.
-                filtering.spread = 2 * std::tan(scene.camera.fov_y_deg * M_PI / 360.0) /
-                                   scene.camera.height / std::sqrt(double(std::max(1, settings.spp)));
-                r.lattices = scene_lattices(scene, cache, settings.spec, settings.progress, filtering);
-                opt.layered = filtering.filter != LatticeFilter::kNone;
-                instance_shape = [&r](int prim) { return r.lattices.shapes[static_cast<std::size_t>(prim)]; };
+            const std::optional<LatticeFiltering> filtering = lattice_policy(scene, mode, settings);
+            if (filtering) {
+                std::optional<TableCache> cache;
+                if (filtering->policy != LatticePolicy::kFootprint)
+                    cache.emplace(settings.lattice_dir.empty() ? default_cache_dir() : settings.lattice_dir,
+                                  !settings.lattice_dir.empty(), opt.across_ranks);
+                // Sub-rays read no table: the lattice box at sigma^-1 = 1 frames their culling.
+                const TableSpec spec = cache ? settings.spec : TableSpec{1, std::string(coverage_encoding().name), {}};
+                r.lattices = scene_lattices(scene, cache ? &*cache : nullptr, spec,
+                                            settings.progress, *filtering);
+                opt.layered = filtering->policy == LatticePolicy::kFootprint ||
+                              filtering->filter != LatticeFilter::kNone;
                 r.bytes_added += r.lattices.table_bytes;
             }
+            RenderScene::InstanceShapeFn instance_shape;
+            if (filtering)
+                instance_shape = [&](int prim) {
+                    const auto i = static_cast<std::size_t>(prim);
+                    return r.lattices.shapes[i] ? r.lattices.shapes[i] : scene.primitives[i].shape;
+                };
             r.prepare_ms = ms_since(t0);
             dist::mark(dist::Step::kTables);
             t0 = clock::now();

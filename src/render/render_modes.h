@@ -17,7 +17,7 @@
 
 namespace lat {
 
-enum class RenderMode { kExact, kLattice, kTexture, kParticles };
+enum class RenderMode { kExact, kLattice, kAuto, kTexture, kParticles };
 
 struct ModeDescription {
     std::string_view name;
@@ -38,7 +38,10 @@ struct ModeSettings {
     bool progress = false;
     std::string lattice_dir;  // empty: default_cache_dir()
     TableSpec spec;           // lattice mode
-    LatticeFiltering filtering;  // lattice mode; spread is set from the camera and spp
+    LatticeFiltering filtering;  // lattice and auto modes; spread is set from the camera and spp
+    // Exact mode: every instance answered by its own crossings of sub-rays across each ray's
+    // footprint, partial coverage composited front to back (LatticePolicy::kFootprint).
+    bool footprint = false;
     AccelOptions accel;
     TextureOptions texture;
     int shadow_map_size = ParticleOptions{}.shadow_map_size;
@@ -59,7 +62,7 @@ struct ModeResult {
     // (primitive parts and one transform per instance), plus the tables in lattice mode; the
     // maps in texture mode; the particle buffer in particle mode.
     std::uint64_t bytes_added = 0;
-    SceneLattices lattices;  // lattice mode
+    SceneLattices lattices;  // lattice and auto modes, and exact mode's footprint filtering
 };
 
 ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSettings& settings);

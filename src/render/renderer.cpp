@@ -215,8 +215,7 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     int sx_n, sy_n;
     stratify(std::max(1, opt.spp), sx_n, sy_n);
     const int spp = sx_n * sy_n;
-    // A sample's footprint per unit distance: the pixel's angle, shared by its samples.
-    const double spread = 2 * std::tan(s.camera.fov_y_deg * M_PI / 360.0) / h / std::sqrt(double(spp));
+    const double spread = sample_spread(s.camera, spp);
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
     const TileContext tc{rs, opt, PinholeCamera(s.camera), w, h, sx_n, sy_n, spp, tiles_x, spread, out};
 

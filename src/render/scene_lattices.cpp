@@ -1,6 +1,7 @@
 #include "render/scene_lattices.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 
@@ -148,55 +149,82 @@ double sub_ray_bounds(const Scene& scene, int prim, const TableContext& base, do
     return widest;
 }
 
-// A primitive's filtered lattice: its levels from the cache, coarse to fine. csg_leaf: some CSG
-// tree holds an instance of it.
-void filtered_lattice(const Scene& scene, int prim, const TableCache& cache, const TableSpec& spec,
+// Why auto mode answers a primitive by its sub-rays (answered_by_primitive).
+std::string cheap_reason(const Shape& primitive) {
+    const double cost = primitive.intersect_cost();
+    if (cost <= kMaxExactCost)
+        return "cheap to intersect: " + std::to_string(static_cast<long long>(std::ceil(cost))) +
+               " simple tests, at most " + std::to_string(static_cast<int>(kMaxExactCost));
+    return "a chain of spheres and cylinders: its sub-rays test only the parts near them";
+}
+
+// One level's table from the cache, counted in out's totals and in the answer's levels.
+std::shared_ptr<const LatticeTable> read_table(const TableCache& cache, const TablePlan& plan,
+                                               bool progress, SceneLattices& out,
+                                               PrimitiveAnswer& answer) {
+    const TableCache::Entry e = cache.get(plan, progress);
+    out.table_bytes += e.bytes;
+    out.table_entries += e.table->entries();
+    out.built += e.built ? 1 : 0;
+    out.build_seconds += e.build_seconds;
+    out.paths.push_back(e.path);
+    answer.sigma_inv.push_back(std::llround(plan.context.sigma / plan.context.cell));
+    return e.table;
+}
+
+// A primitive's filtered lattice: its levels from the cache, coarse to fine, or its own
+// crossings of sub-rays, as filtering.policy has it. csg_leaf: some CSG tree holds an instance
+// of it; instanced: some object is an instance of it.
+void filtered_lattice(const Scene& scene, int prim, const TableCache* cache, const TableSpec& spec,
                       bool progress, const LatticeFiltering& filtering, bool csg_leaf,
-                      SceneLattices& out) {
+                      bool instanced, SceneLattices& out, PrimitiveAnswer& answer) {
     const Primitive& p = scene.primitives[static_cast<std::size_t>(prim)];
     // A primitive answered by its own crossings reads its table only as a CSG leaf (spans,
-    // `inside`): the lattice asked for serves it there, and elsewhere no table is loaded or
-    // built (the first run of Plates 3, 4 and 5 and of the furry bunny built a 4 MB table,
-    // 0.4 s, that no ray read). On each instance its sub-rays, and so its culling, span at
-    // most kSubRayWidening times the widest footprint of the camera's pixels on that instance
-    // (AccelObject::widest_footprint): the farthest instance's is 1.4 times the nearest's on
-    // Plates 4 and 5, 1.9 times on the furry bunny, 3.7 on grass. The shape's own bound is the
-    // widest over its instances; above 0 exactly when the shape answers by its crossings.
-    // A costlier primitive whose levels wanted are past the work budget answers by its crossings
-    // too: tables coarser than its footprints blur it, and cost more than finer ones, their
-    // sheets being wider and less opaque. `ball-csg7` (512^2, 1 spp, 1 thread, against exact at
-    // 64 spp; it wants 4K, 37 minutes of one core): tables at 2K 30.38 dB in 1059 ms, at K
-    // 27.15 dB in 1603 ms; its crossings 41.52 dB in 3013 ms; exact 32.80 dB in 679 ms, at 4 spp
-    // 38.73 dB in 2596 ms.
+    // `inside`), and only in auto mode: the lattice asked for serves it there, and elsewhere no
+    // table is loaded or built. With footprint filtering in exact mode a CSG leaf keeps its
+    // exact shape (the shape's spans are the primitive's). On each instance its sub-rays, and
+    // so its culling, span at most kSubRayWidening times the widest footprint of the camera's
+    // pixels on that instance (AccelObject::widest_footprint); the shape's own bound is the
+    // widest over its instances, above 0 exactly when the shape answers by its crossings.
+    // In auto mode a costlier primitive whose levels wanted are past the work budget answers by
+    // its crossings too: tables coarser than its footprints blur it, and cost more than finer
+    // ones, their sheets being wider and less opaque (bench/notes).
     const TableContext base = plan_table(p, spec, scene.file).context;
     const bool lod = filtering.lod && filtering.spread > 0;
-    bool by_crossings = lod && base.primitive && answered_by_primitive(*base.primitive);
+    const bool sub_rays_everywhere = filtering.policy == LatticePolicy::kFootprint;
+    bool by_crossings = sub_rays_everywhere ||
+                        (filtering.policy == LatticePolicy::kAuto && lod && base.primitive &&
+                         answered_by_primitive(*base.primitive));
+    if (by_crossings && filtering.policy == LatticePolicy::kAuto)
+        answer.why = cheap_reason(*base.primitive);
     std::pair<int, int> range{0, 0};
     if (lod && !by_crossings) {
         const LevelCosts costs{scene, p, spec};
         const std::pair<int, int> wanted = lod_range(scene, prim, base, filtering.spread);
-        const LevelChoice choice = choose_levels(costs, cache, wanted, filtering);
-        by_crossings = choice.over_budget && base.primitive;
+        assert(cache);  // every policy but kSubRays reads tables
+        const LevelChoice choice = choose_levels(costs, *cache, wanted, filtering);
+        by_crossings = filtering.policy == LatticePolicy::kAuto && choice.over_budget && base.primitive;
+        if (by_crossings) answer.why = "its finer levels are over --lod-budget";
         if (!by_crossings) range = choice.range;
         const std::string note = levels_note(costs, wanted, choice, filtering, by_crossings);
         if (!note.empty()) out.notes.push_back(note);
     }
+    if (by_crossings && !instanced) return;  // only in CSG: its own shape, exact
     const double exact_width =
         by_crossings ? sub_ray_bounds(scene, prim, base, filtering.spread, out) : 0;
+    answer.by = by_crossings ? AnsweredBy::kSubRayCrossings : AnsweredBy::kFilteredTables;
+    if (!by_crossings) answer.encoding = spec.encoding;
     std::vector<FilterLevel> levels;
     double error = 0;
-    const bool reads_tables = exact_width == 0 || csg_leaf;
+    const bool reads_tables = !by_crossings || (csg_leaf && !sub_rays_everywhere);
     if (!reads_tables) levels.push_back({nullptr, base});
+    PrimitiveAnswer csg_tables;  // tables read for CSG alone are not how instances are answered
     for (int j = range.first; reads_tables && j <= range.second; ++j) {
         const TablePlan plan = level_plan(scene, p, spec, j);
-        const TableCache::Entry e = cache.get(plan, progress);
-        levels.push_back({e.table, plan.context});
+        assert(cache);
+        levels.push_back({read_table(*cache, plan, progress, out, by_crossings ? csg_tables : answer),
+                          plan.context});
         error = plan.error_bound();
-        out.table_bytes += e.bytes;
-        out.table_entries += e.table->entries();
-        out.built += e.built ? 1 : 0;
-        out.build_seconds += e.build_seconds;
-        out.paths.push_back(e.path);
     }
     out.shapes[static_cast<std::size_t>(prim)] =
         std::make_shared<FilteredLatticeShape>(std::move(levels), filtering.filter, error,
@@ -231,37 +259,54 @@ std::pair<double, double> footprint_range(const Scene& scene, int prim, const Ta
     return {lo, hi};
 }
 
-SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const TableSpec& spec,
+std::string_view answer_name(AnsweredBy by) {
+    switch (by) {
+        case AnsweredBy::kTable: return "table";
+        case AnsweredBy::kFilteredTables: return "filtered tables";
+        case AnsweredBy::kSubRayCrossings: return "sub-rays";
+        case AnsweredBy::kExact: return "exact";
+    }
+    return "";
+}
+
+SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const TableSpec& spec,
                              bool progress, const LatticeFiltering& filtering) {
     SceneLattices out;
     out.shapes.resize(scene.primitives.size());
     out.widest_footprints.assign(scene.objects.size(), kInfinity);
     // Instances, at the top level or as CSG leaves.
-    std::vector<bool> used(scene.primitives.size(), false), csg_leaf(used);
+    std::vector<bool> used(scene.primitives.size(), false), csg_leaf(used), instanced(used);
     for (const SceneObject& o : scene.objects) {
-        if (o.primitive >= 0) used[static_cast<std::size_t>(o.primitive)] = true;
+        if (o.primitive >= 0) used[static_cast<std::size_t>(o.primitive)] = instanced[static_cast<std::size_t>(o.primitive)] = true;
         if (const auto* csg = dynamic_cast<const CsgShape*>(o.shape.get()))
             for (const int p : csg->leaf_primitives())
                 used[static_cast<std::size_t>(p)] = csg_leaf[static_cast<std::size_t>(p)] = true;
     }
-    if (filtering.filter != LatticeFilter::kNone && !find_encoding(spec.encoding).coverage)
+    const bool sub_rays = filtering.policy == LatticePolicy::kFootprint;
+    if (!sub_rays && filtering.filter != LatticeFilter::kNone &&
+        !find_encoding(spec.encoding).coverage)
         throw InputError("--filter: filtered lattices need a table encoding that stores coverage "
                          "(--encoding coverage), not '" + spec.encoding + "'");
+    assert(sub_rays || cache);
     for (std::size_t i = 0; i < scene.primitives.size(); ++i) {
         if (!used[i]) continue;
-        if (filtering.filter != LatticeFilter::kNone) {
+        const Primitive& p = scene.primitives[i];
+        PrimitiveAnswer answer;
+        answer.primitive = p.name;
+        answer.where = p.where;
+        if (sub_rays && !p.lattice) {
+            answer.by = AnsweredBy::kExact;
+            answer.why = "it has no lattice box";
+        } else if (sub_rays || filtering.filter != LatticeFilter::kNone) {
             filtered_lattice(scene, static_cast<int>(i), cache, spec, progress, filtering,
-                             csg_leaf[i], out);
-            continue;
+                             csg_leaf[i], instanced[i], out, answer);
+        } else {
+            const TablePlan plan = plan_table(p, spec, scene.file);
+            answer.encoding = spec.encoding;
+            out.shapes[i] = make_lattice_shape(read_table(*cache, plan, progress, out, answer),
+                                               plan.context, plan.error_bound());
         }
-        const TablePlan plan = plan_table(scene.primitives[i], spec, scene.file);
-        const TableCache::Entry e = cache.get(plan, progress);
-        out.shapes[i] = make_lattice_shape(e.table, plan.context, plan.error_bound());
-        out.table_bytes += e.bytes;
-        out.table_entries += e.table->entries();
-        out.built += e.built ? 1 : 0;
-        out.build_seconds += e.build_seconds;
-        out.paths.push_back(e.path);
+        if (instanced[i]) out.answers.push_back(std::move(answer));
     }
     return out;
 }

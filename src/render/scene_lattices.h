@@ -2,6 +2,7 @@
 // Lattice mode: the lattice shape of every primitive a scene's instances use, from the table
 // cache (built on demand).
 #include <memory>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -11,8 +12,36 @@
 
 namespace lat {
 
+// How an instanced primitive's rays are answered: the one list of the ways, as reported on the
+// summary line and in --stats (answer_name).
+enum class AnsweredBy {
+    kTable,           // its point-sampled table (no filter), as rasterized
+    kFilteredTables,  // its coverage tables, filtered, at the levels of detail read
+    kSubRayCrossings, // its own exact crossings of sub-rays across each ray's footprint
+    kExact,           // its own exact crossing of each ray (no lattice box to cull sub-rays by)
+};
+std::string_view answer_name(AnsweredBy by);
+
+// What answers one primitive, and why, for the summary line and --stats.
+struct PrimitiveAnswer {
+    std::string primitive;  // its name in the scene
+    std::string where;      // e.g. "primitives.hair"
+    AnsweredBy by = AnsweredBy::kTable;
+    std::string encoding;              // of the tables read; empty for sub-rays
+    std::vector<long long> sigma_inv;  // the levels read, coarse to fine; empty for sub-rays
+    std::string why;                   // how the mode chose (auto mode), else empty
+};
+
+// Who decides how instanced primitives are answered: the render mode (render/render_modes.h).
+enum class LatticePolicy {
+    kTables,   // lattice mode: every primitive by its tables, never its own crossings
+    kAuto,     // auto mode: a primitive cheap to intersect by sub-rays, a costlier one by its
+               // tables while the levels it wants are within the build budget
+    kFootprint,  // exact mode with footprint filtering: every primitive by sub-rays, no table
+};
+
 struct SceneLattices {
-    std::vector<std::shared_ptr<const Shape>> shapes;  // per primitive; null if unused
+    std::vector<std::shared_ptr<const Shape>> shapes;  // per primitive; null: its own shape
     // Per object: the widest footprint (object units) its rays are traced with, for instances
     // of primitives answered by sub-rays (AccelObject::widest_footprint); else infinity.
     std::vector<double> widest_footprints;
@@ -21,12 +50,13 @@ struct SceneLattices {
     int built = 0;
     double build_seconds = 0;
     std::vector<std::string> paths;
+    std::vector<PrimitiveAnswer> answers;  // per instanced primitive, in scene order
     // What the user should know about the lattices chosen: levels of detail left out for a
     // budget, and what serves their rays instead.
     std::vector<std::string> notes;
 };
 
-// How lattices are filtered (issue 10): the filter, and whether levels of detail are built. With
+// How lattices are filtered: the filter, and whether levels of detail are built. With
 // lod, each primitive gets the levels sigma^-1 = K 2^j whose cells match the footprints of the
 // camera's pixels (spread: a pixel's angle) somewhere on its instances, at most kMaxLodLevels;
 // a primitive answered_by_primitive, or one whose levels wanted are past the work budget (below),
@@ -59,6 +89,7 @@ struct LatticeFiltering {
     double spread = 0;
     double max_pairs = kMaxLodPairs;
     double max_work = kMaxLodWork;
+    LatticePolicy policy = LatticePolicy::kAuto;
 };
 // Three levels, K to 4K: the next (8K) of the paper's hair would take 28 GB to build.
 inline constexpr int kMaxLodLevels = 3;
@@ -74,7 +105,13 @@ std::pair<double, double> instance_footprints(const Scene& scene, const SceneObj
                                               const TableContext& base, double spread);
 
 // With filtering, spec's encoding must store coverage (Encoding::coverage; else InputError).
-SceneLattices scene_lattices(const Scene& scene, const TableCache& cache, const TableSpec& spec,
+// cache may be null only for LatticePolicy::kFootprint, which reads no table.
+SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const TableSpec& spec,
                              bool progress, const LatticeFiltering& filtering = {});
+inline SceneLattices scene_lattices(const Scene& scene, const TableCache& cache,
+                                    const TableSpec& spec, bool progress,
+                                    const LatticeFiltering& filtering = {}) {
+    return scene_lattices(scene, &cache, spec, progress, filtering);
+}
 
 }  // namespace lat

@@ -2,6 +2,8 @@
 // its descriptor (see docs/encodings.md, "Adding an encoding"), and its name in both lists here.
 #include "lattice/encoding.h"
 
+#include <cassert>
+
 #include "util/error.h"
 
 namespace lat {
@@ -24,6 +26,13 @@ const Encoding& find_encoding(std::string_view name) {
         known += (known.empty() ? "" : ", ") + std::string(e->name);
     }
     throw InputError("unknown table encoding '" + std::string(name) + "' (known: " + known + ")");
+}
+
+const Encoding& coverage_encoding() {
+    for (const Encoding* e : encodings())
+        if (e->coverage) return *e;
+    assert(false && "an encoding stores coverage");
+    return *encodings().front();
 }
 
 }  // namespace lat
