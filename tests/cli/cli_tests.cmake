@@ -90,6 +90,13 @@ foreach(case corrupt truncated other_primitive missing_dir not_a_dir too_big unk
             -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/lattice_cases.cmake)
 endforeach()
 
+# Every default path of render (exact, exact with footprint filtering, lattice, auto) against an
+# exact many-sample truth, with floors a broken path fails.
+add_test(NAME cli.mode_paths
+  COMMAND ${CMAKE_COMMAND} -DLATTICE=$<TARGET_FILE:lattice>
+          -DSCENE=${CMAKE_CURRENT_SOURCE_DIR}/data/modes/fuzzy-ball.json -DWORK=${CLI_OUT}/mode-paths
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/mode_paths.cmake)
+
 # The complexity benchmark's generated scenes load and render (tiny; no ../shared needed).
 find_package(Python3 COMPONENTS Interpreter QUIET)
 if(Python3_Interpreter_FOUND)
