@@ -172,6 +172,10 @@ int run_table2(const Table2Args& a) {
         settings.filtering.lod = true;
         settings.spp = a.filter_spp;
         run("lattice-" + filtered_encoding + "-" + a.filter, RenderMode::kLattice);
+        // The same filtering from each primitive's cheaper answer, and exact mode's own.
+        run("auto-" + a.filter, RenderMode::kAuto);
+        settings.footprint = true;
+        run("exact-footprint", RenderMode::kExact);
     }
 
     std::vector<const Image8*> images{&truth.out.display};
@@ -230,10 +234,10 @@ Command add_table2_command(CLI::App& parent) {
     c.app->add_option("--shadow-map-size", args->shadow_map_size, "Particles mode: shadow map texels a side")
         ->check(CLI::Range(16, 16384));
     c.app->add_option("--filter", args->filter,
-                      "The filtered-lattice row: the coverage encoding with this filter (none: no such row)")
+                      "The filtered rows: the coverage encoding with this filter in lattice and auto modes, and exact mode with footprint filtering (none: no such rows)")
         ->check(CLI::IsMember(lattice_filters()));
     c.app->add_option("--filter-spp", args->filter_spp,
-                      "Samples per pixel of the filtered lattice (filtering stands in for supersampling)")
+                      "Samples per pixel of the filtered rows: lattice, auto and exact mode with footprint filtering (filtering stands in for supersampling)")
         ->check(CLI::Range(1, 65536));
     c.app->add_option("--crop-size", args->crop_size, "Side of the magnified crops, pixels")
         ->check(CLI::Range(8, 4096));
