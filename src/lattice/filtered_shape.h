@@ -1,5 +1,6 @@
 #pragma once
-// A lattice rendered through its prefiltered tables (issue 10; tables with Encoding::coverage).
+// A lattice rendered through its prefiltered tables (tables with Encoding::coverage), or through
+// the primitive's own crossings of sub-rays across each ray's footprint.
 // A ray gets one "sheet" from the lattice: a point, a normal and a coverage alpha, the share of
 // the rays around it that meet the primitive. The renderer shades alpha of it and lets the ray
 // go on behind for the rest (render/layers.h). Filters:
@@ -8,8 +9,8 @@
 //           linearly over a simplex of the 4-D (entry, exit) grid: continuous in ray space.
 // Levels of detail: tables of the same box at sigma^-1 doubling from level to level; each ray
 // takes the level whose cell matches its footprint (ray_footprint()), blending the two nearest.
-// With levels of detail, a primitive cheap to intersect answers rays with a footprint from its
-// own crossings instead (answered_by_primitive).
+// Answered by the primitive's own crossings (exact_width above 0), it reads no table for rays:
+// the sub-rays across each ray's footprint answer (kExactSubRays).
 // As a CSG leaf, for `inside` and for spans, the lattice is point-sampled through the finest
 // level's own hits, exactly as without filtering.
 #include <algorithm>
@@ -48,91 +49,53 @@ void set_ray_footprint(const RayFootprint& f);
 const RayFootprint& ray_footprint();
 
 // A level's cell is made this many footprints wide: the box over a cell, widened by the smooth
-// filter's linear blend, then matches a pixel's box best (Plate 4 at 512^2: 0.7, 0.85, 1.0 and
-// 1.2 gave 35.9, 36.0, 35.8 and 34.9 dB against the 256-spp exact image, with shadow rays
-// that missed the hairs they started in). Retuned once those were fixed, on six fur scenes
-// (docs/filtering.md): 0.78 against 0.85, -0.01 to +0.25 dB on each; 0.7 lost 0.3 dB on one.
+// filter's linear blend, then matches a pixel's box best (tuned on six fur scenes against the
+// 256-spp exact image; bench/notes/filtering-constants.md).
 inline constexpr double kCellPerFootprint = 0.78;
 // The level (real; 0 is the lattice of cell cell0, each next one halves it) for a footprint of
 // this width, in the same units.
 double lod_level(double cell0, double width);
 // Levels are blended only within a band of this width around the midpoint between two (as
 // "brilinear" texture filtering does): elsewhere a ray reads one level, half the lookups of a
-// blend. Plate 4 (512^2, 1 spp, against 256-spp exact): a band of 1 (linear blending across
-// the whole interval) 36.04 dB, 1/2 35.92 dB, 1/4 35.89 dB in 0.75 of its time, 0 (the
-// nearest level) 35.88 dB in 0.70; the loss is all in shadow rays. 1/4 keeps changes of level
-// across an image from showing as seams.
+// blend, for a loss under 0.2 dB; a band, not the nearest level alone, keeps changes of level
+// across an image from showing as seams (bench/notes/filtering-constants.md).
 inline constexpr double kLodBlendBand = 0.25;
 // The weight of the finer of two levels at fraction f (0 to 1) of the way to it.
 double lod_blend(double f, double band);
-// With levels of detail, a primitive cheap to intersect (answered_by_primitive) is answered by
-// its own crossings, not its tables, for every ray with a footprint: those of kExactSubRays^2
-// sub-rays parallel to the ray across its footprint (exact_sub_rays), for camera rays shaded
-// once a sheet (those within kSheetDepth of each other) at their mean point with their own
-// normals (the pixel's box filter on this primitive), for shadow rays
-// their share as the coverage (a ray without a footprint: its own line's). Its table then
-// serves CSG (spans, `inside`) only, and is built only when a CSG tree holds a copy, no finer
-// level ever (scene_lattices). A costly primitive is answered by its tables and their levels,
+// A primitive answered by its own crossings (auto mode for one answered_by_primitive, exact
+// mode's footprint filtering for every one) answers each ray with a footprint by those of
+// kExactSubRays^2 sub-rays parallel to the ray across its footprint (exact_sub_rays): for camera
+// rays shaded once a sheet (those within kSheetDepth of each other) at their mean point with
+// their own normals (the pixel's box filter on this primitive), for shadow rays their share as
+// the coverage (a ray without a footprint: its own line's). Its table then serves CSG (spans,
+// `inside`) only. A costly primitive in auto mode is answered by its tables and their levels,
 // unless the levels its footprints want are past the build budget (render/scene_lattices.h):
 // then by its crossings too, its shadow rays testing their sub-rays in pairs (blocked_pairs).
-//   Why: where intersecting the primitive is cheap, its sub-rays give a better image than the
-// tables in less time, at every footprint tried. 1 spp, 2 threads, ms and PSNR against exact
-// ground truth (256 spp; 64 for the bunny and grass), on Plates 2 / 3 / 4 / 5, the furry bunny,
-// grass, and Plates 5 and 4 at 128^2 (their hairs a few pixels long, read from the tables'
-// coarsest level); one run of the final code, the tables' row from an earlier one that day:
-//     sub-rays (kept)           118 / 35 / 203 / 313 / 734 / 893 / 147 / 42 ms
-//                               47.25 / 53.15 / 38.28 / 40.12 / 32.90 / 37.43 / 35.80 / 33.75 dB
-//       composed from lattice   120 / 42 / 197 / 300 / 593 / 449 / 56 / -- ms
-//       to lattice (sub_rays.h) 47.18 / 53.15 / 38.47 / 40.27 / 32.92 / 37.45 / 36.16 / -- dB
-//       four at once, thinner   114 / 43 / 163 / 232 / 416 / 318 / 40 / 25 ms
-//       culling (a later day)   47.16 / 53.05 / 38.44 / 40.26 / 32.76 / 37.46 / 36.14 / 33.76 dB
-//       each instance's own     118 / 40 / 161 / 236 / 393 / 281 / 39 / 22 ms
-//       reach (the next day)    47.16 / 53.05 / 38.40 / 40.23 / 32.76 / 37.43 / 36.13 / 33.66 dB
-//       shadow rays: any-hit,   111 / 39 / 150 / 219 / 355 / 287 / 37 / 21 ms, same images;
-//       own object last, no     exact 4 spp in those runs 162 / 102 / 255 / 302 / 357 / 238 /
-//       surface hits (later)    23 / 20 ms (docs/filtering.md, "Shadow rays: what they ...")
-//     tables, with half the     238 / 39 / 439 / 934 / 1720 / 2103 / 480 / 106 ms
-//     sub-rays' weight blended  45.98 / 51.64 / 39.35 / 40.33 / 33.01 / 38.45 / 35.95 / 34.09 dB
-//     in (camera rays) and one
-//     crossing past the finest
-//     table (shadow rays)
-//     exact, 4 spp              163 / 89 / 237 / 289 / 371 / 228 / 22 / 25 ms
-//                               44.45 / 52.81 / 36.92 / 39.46 / 30.97 / 35.65 / 33.82 / 31.68 dB
-// Shadow rays through the tables cost most of the difference: with the camera rays on
-// sub-rays, tables for shadows took Plates 4 and 5 331 and 628 ms for 38.52 and 40.10 dB.
-// 3 x 3 sub-rays: Plates 4 and 5 39.21 and 40.49 dB in 281 and 510 ms; one (point sampling)
-// 32.68 and 35.00 dB. docs/filtering.md, "The primitive's own crossings, for every ray".
+//   Why 2 x 2: where intersecting the primitive is cheap, its sub-rays give a better image than
+// the tables in less time at every footprint tried; 3 x 3 gained 0.2 to 0.8 dB for 1.7 to 2.2
+// times the time, and one sub-ray is point sampling (bench/notes/filtering-constants.md).
 inline constexpr int kExactSubRays = 2;
 static_assert(kExactSubRays * kExactSubRays == kSubRays);
 static_assert(kSubRays <= Shape::kMaxSheets, "a sheet per sub-ray at most");
 // A camera ray's sub-rays that meet the primitive within this many footprint widths (along the
-// ray) of the nearest one make one sheet, shaded once at their mean point; those
-// farther make sheets of their own, each shaded with its own shadow rays (sheets). One sheet
-// for them all had a tuft's strands one behind another shaded, and shadowed from the light, at
-// a point between them: PSNR against exact ground truth, 1 spp, ball-tuft216 / tuft200 /
-// Plate 4 / Plate 5 / grass: one sheet 32.93 / 37.38 / 38.40 / 40.23 / 37.43 dB; depth 1:
-// 36.33 / 39.62 / 38.72 / 41.23 / 37.44 dB; 2: 36.10 / 39.49 / 38.66 / 41.05 / 37.44 dB;
-// 4: 35.45 dB on ball-tuft216. (Exact at 4 spp: 34.37 / 37.48 / 36.92 / 39.46 / 35.65 dB.)
+// ray) of the nearest one make one sheet, shaded once at their mean point; those farther make
+// sheets of their own, each shaded with its own shadow rays (sheets). One sheet for them all had
+// a tuft's strands one behind another shaded, and shadowed from the light, at a point between
+// them; 1 was best of 1, 2 and 4 on five fur scenes (bench/notes/filtering-constants.md).
 inline constexpr double kSheetDepth = 1;
 // How far from a ray its farthest sub-ray lies, for a footprint this wide.
 double farthest_sub_ray(double width);
 // Primitives other than chains whose exact intersection costs more than this many simple tests
-// (Shape::intersect_cost) are answered by their tables, when the levels their footprints want
-// are within the build budget (render/scene_lattices.h, kMaxLodWork; else by their crossings).
-// The ball of CSG tori (6 tori and a sphere, cost 73; 2026-11-26): tables 34.49 dB in 262 ms,
-// with the half blend of sub-rays 36.55 dB in 628 ms, sub-rays alone 37.48 dB in 1055 ms; exact
-// 1 spp 32.80 dB in 240 ms, 4 spp 38.73 dB in 876 ms (the tables are ahead of exact at equal
-// time). Its sub-rays, since sheets by depth (2026-11-27, 1 thread): 41.52 dB in 3013 ms against
-// exact 4 spp's 38.73 dB in 2596 ms.
+// (Shape::intersect_cost) are answered by their tables in auto mode, when the levels their
+// footprints want are within the build budget (render/scene_lattices.h, kMaxLodWork; else by
+// their crossings): past it a sub-ray costs more than a table's blend of pairs, and the tables
+// are ahead of exact mode at equal time (bench/notes/filtering-constants.md).
 inline constexpr double kMaxExactCost = 64;
-// Whether a filtered lattice with levels of detail answers its rays from the primitive itself:
-// a chain (spheres and cylinders: hairs, tufts) always, whatever its parts, since its sub-rays
-// test only the parts near the ray, found through a tree of their boxes (PartBoxes); other
-// shapes when they cost at most kMaxExactCost. Tufts of 200 / 400 / 600 / 2,000 parts on the
-// Plate 4 placement, sub-rays against their tables: 324 / 468 / 515 / 649 ms against 611 / 854 /
-// 858 / 680 ms, 37.38 / 36.50 / 36.12 / 34.92 dB against 36.57 / 35.41 / 34.85 / 33.97 dB
-// (64-spp truth; exact at 4 spp 287 / 312 / 329 / 379 ms, 37.48 / 37.14 / 37.01 / 36.59 dB);
-// 10,000 parts: 1089 ms, where the tables' level at sigma^-1 = 4 had not built in 30 minutes.
+// Whether auto mode answers a primitive's rays from the primitive itself: a chain (spheres and
+// cylinders: hairs, tufts) always, whatever its parts, since its sub-rays test only the parts
+// near the ray, found through a tree of their boxes (PartBoxes), and were faster and more
+// faithful than its tables from 200 to 10,000 parts; other shapes when they cost at most
+// kMaxExactCost (bench/notes/filtering-constants.md).
 bool answered_by_primitive(const Shape& primitive);
 
 // One level: a coverage table and its lattice. The table may be null for a primitive answered

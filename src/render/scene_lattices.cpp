@@ -14,20 +14,12 @@
 namespace lat {
 namespace {
 
-// Shadow rays leaving a surface seen at a slant are up to kMaxShadowWidening times as wide as
-// the camera's footprint there; wider sub-rays make wider culling boxes (their reach), and those
-// cost more than the shadows gain: the accelerator calls back for every box a ray meets, and
-// the boxes of dense fur overlap. Plates 3, 4 and 5, the furry bunny, grass, and the bunny and
-// Plate 5 at 128^2, 1 spp, 2 threads (2026-11-26, after sub-rays went four at once):
-//   1:     37 / 160 / 232 / 397 / 298 / 115 / 38 ms
-//          52.86 / 38.35 / 40.23 / 32.66 / 37.46 / 29.66 / 36.15 dB
-//   1.25:  43 / 163 / 232 / 416 / 318 / 131 / 40 ms
-//          53.05 / 38.44 / 40.26 / 32.76 / 37.46 / 29.67 / 36.14 dB (kept)
-//   1.5:   40 / 176 / 237 / 434 / 341 / -- / -- ms, 53.13 / 38.46 / 40.27 / 32.85 / 37.45 dB
-//   2:     39 / 169 / 243 / 476 / 386 / 179 / 49 ms
-//          53.15 / 38.47 / 40.27 / 32.92 / 37.45 / 29.68 / 36.16 dB
-// (Medians of 3; Plate 3's times vary by a few ms from run to run. Exact at 4 spp: Plate 3
-// 52.81 dB, which 1 beats by too little; the bunny 30.97 dB.)
+// Shadow rays leaving a surface seen at a slant are wider than the camera's footprint there;
+// sub-rays as wide as the camera's footprint times this bound, no wider: wider sub-rays make wider
+// culling boxes (their reach), and those cost more than the shadows gain, since the accelerator
+// calls back for every box a ray meets and the boxes of dense fur overlap. 1.25 gained up to
+// 0.2 dB over 1 for up to 16 % more time; 2 gained under 0.3 dB more for up to 56 % more
+// (bench/notes/filtering-constants.md).
 constexpr double kSubRayWidening = 1.25;
 
 
