@@ -36,7 +36,7 @@ MODES = {
 
 
 # The sample counts exact mode is tried at to find the fewest that are as faithful as the default
-# filter: counts the renderer lays on a near-square grid (renderer.cpp, stratify; 5 spp is a
+# filter: counts the renderer lays on a near-square grid (sampler.cpp, stratify; 5 spp is a
 # 1 x 5 grid, and on grass and the furry bunny gained only 0.1 dB over 4).
 MATCH_SPP = [6, 9, 12, 16, 25, 36, 64]
 MATCH = "exact at equal fidelity"
@@ -55,12 +55,13 @@ def psnr(lattice, image, truth):
 
 
 def ground_truth(lattice, scene, work, spp):
-    """The exact render at spp samples, kept under a name that depends on the scene's bytes."""
+    """The exact render at spp samples, kept under a name that depends on the scene's bytes.
+    Stratified jitter: the truth shares no samples with a sequence's renders it is set against."""
     digest = hashlib.sha256(open(scene, "rb").read()).hexdigest()[:16]
     path = os.path.join(work, f"truth-{os.path.basename(scene)[:-5]}-{spp}spp-{digest}.png")
     if not os.path.exists(path):
         render(lattice, scene, path + ".tmp.png", os.path.join(work, "stats.json"),
-               ["--mode", "exact", "--spp", str(spp)])
+               ["--mode", "exact", "--spp", str(spp), "--sampler", "jitter"])
         os.replace(path + ".tmp.png", path)
     return path
 
