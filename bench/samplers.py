@@ -56,10 +56,11 @@ def report(results):
     print("## Samplers at low sample counts\n")
     print(f"Exact mode, each scene at its own size, 2 threads; PSNR against exact at {GT_SPP} spp "
           f"(stratified jitter) and the median render time of {results['runs']} interleaved rounds. "
-          "At 1 spp every sampler takes the pixel centre. The best at each count is in bold.\n")
-    print("| scene | centre (1 spp) dB / ms | spp | " +
+          "At 1 spp every sampler takes the pixel centre. The best at each count is in bold; load is "
+          "the machine's load average as the scene began.\n")
+    print("| scene | load | centre (1 spp) dB / ms | spp | " +
           " | ".join(f"{s} dB / ms" for s in SAMPLERS) + " |")
-    print("| --- | ---: | ---: | " + " | ".join("---:" for _ in SAMPLERS) + " |")
+    print("| --- | ---: | ---: | ---: | " + " | ".join("---:" for _ in SAMPLERS) + " |")
     for r in results["scenes"]:
         c = r["renders"]["centre"]
         for i, spp in enumerate(spps):
@@ -69,7 +70,8 @@ def report(results):
                 m = r["renders"][f"{s} {spp}"]
                 db = f"{m['psnr_db']:.2f}"
                 cells.append(f"{'**' + db + '**' if s == best else db} / {m['ms']:.0f}")
-            head = (f"| {r['scene']} | {c['psnr_db']:.2f} / {c['ms']:.0f}" if i == 0 else "| | ")
+            head = (f"| {r['scene']} | {r['loadavg']:.1f} | {c['psnr_db']:.2f} / {c['ms']:.0f}"
+                    if i == 0 else "| | | ")
             print(f"{head} | {spp} | " + " | ".join(cells) + " |")
     print()
     print("Mean over the scenes (dB), and the scenes on which each sampler is best:\n")
