@@ -2,8 +2,9 @@
 """Where lattices pay: every way `lattice render` can answer fur, against exact mode at its best.
 
 For each scene (at its own size, 2 threads): PSNR (8-bit) against exact mode at 256 samples per
-pixel (the truth, cached in the work directory by the scene's bytes) and render time of
-  exact mode at 1 and 4 spp (its default sampler), exact mode with footprint filtering at 1 spp,
+pixel with stratified jitter (the truth, cached in the work directory by the scene's bytes) and
+render time of exact mode at 1 and 4 spp (its default sampler, the best at low counts:
+bench/results/samplers.md), exact mode with footprint filtering at 1 spp,
   lattice mode (tables: the default filter with levels of detail, and point-sampled), and auto
   mode (each primitive's cheaper answer).
 Renders are interleaved round by round so that load from other processes falls on all alike;
@@ -54,12 +55,13 @@ def psnr(lattice, image, truth):
 
 
 def ground_truth(lattice, scene, work, spp):
-    """The exact render at spp samples, kept under a name that depends on the scene's bytes."""
+    """The exact render at spp samples, kept under a name that depends on the scene's bytes.
+    Stratified jitter: the truth shares no samples with a sequence's renders it is set against."""
     digest = hashlib.sha256(open(scene, "rb").read()).hexdigest()[:16]
     path = os.path.join(work, f"truth-{os.path.basename(scene)[:-5]}-{spp}spp-{digest}.png")
     if not os.path.exists(path):
         render(lattice, scene, path + ".tmp.png", os.path.join(work, "stats.json"),
-               ["--mode", "exact", "--spp", str(spp)])
+               ["--mode", "exact", "--spp", str(spp), "--sampler", "jitter"])
         os.replace(path + ".tmp.png", path)
     return path
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # make bench: runs every bench/*_bench program, writes bench/results/<name>.json (Google
 # Benchmark's JSON) and bench/results/summary.md (a readable table of all of them), then the
-# encodings, complexity, independent-tracer and modes benchmarks through the lattice command
+# encodings, complexity, independent-tracer, modes and sampler benchmarks through the lattice command
 # (and docs/images/complexity.png).
 set -euo pipefail
 build=${1:-build}
@@ -22,6 +22,8 @@ echo "== exact mode against an independent Embree tracer (issue 9, deliverable 4
 python3 "$here/embree_tracer.py" "$build/bin/lattice" "$build/bin/embree_tracer" "$out" --work "$build/embree_tracer" > "$out/embree_tracer.md"
 echo "== modes (where lattices pay: every mode against exact mode at its best, at equal time and fidelity)"
 python3 "$here/modes.py" "$build/bin/lattice" "$out" --work "$build/modes" > "$out/modes.md"
+echo "== samplers (where a pixel's samples fall, at 2 to 16 spp; the truths are modes')"
+python3 "$here/samplers.py" "$build/bin/lattice" "$out" --work "$build/modes" > "$out/samplers.md"
 echo "== scatter (fur on a mesh, 100,000 instances)"
 python3 "$here/scatter.py" "$build/bin/lattice" "$out" > "$out/scatter.md"
 echo "== MPI (2 ranks x 1 thread against 1 rank x 2 threads; docs/distributed.md)"
@@ -34,7 +36,7 @@ fi
 # (pyenv, a virtualenv) comes first in PATH.
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 "$py" "$here/plot_complexity.py" "$out/complexity.json" "$here/../docs/images/complexity.png"
-{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/modes.md" "$out/scatter.md" "$out/distributed.md"; } > "$out/summary.md"
+{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/modes.md" "$out/samplers.md" "$out/scatter.md" "$out/distributed.md"; } > "$out/summary.md"
 echo
 cat "$out/summary.md"
 echo "results: $out"

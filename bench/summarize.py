@@ -20,7 +20,7 @@ def main(results):
     for path in sorted(pathlib.Path(results).glob("*.json")):
         data = json.loads(path.read_text())
         if "benchmarks" not in data:
-            continue  # not Google Benchmark output (encodings.json has its own summary)
+            continue  # not Google Benchmark output: encodings.json, samplers.json ... have their own
         ctx = data.get("context", {})
         print(f"## {path.stem}\n")
         print(f"{ctx.get('date', '')}, {ctx.get('num_cpus', '?')} CPUs at "

@@ -33,6 +33,12 @@ std::map<std::string, RenderMode> mode_names() {
     return m;
 }
 const std::map<std::string, RenderMode> kModes = mode_names();
+std::map<std::string, SamplerKind> sampler_names() {
+    std::map<std::string, SamplerKind> m;
+    for (const SamplerDescription& d : samplers()) m.emplace(std::string(d.name), d.kind);
+    return m;
+}
+const std::map<std::string, SamplerKind> kSamplers = sampler_names();
 const std::map<std::string, bool> kOnOff{{"on", true}, {"off", false}};
 const std::map<std::string, LatticeFilter>& kFilters = lattice_filters();
 const std::map<std::string, Instancing> kInstancing{
@@ -43,6 +49,7 @@ struct RenderArgs {
     std::string output;
     int threads = 0;
     int spp = 1;
+    std::string sampler{sampler_description(kDefaultSampler).name};
     std::string stats;
     std::string mode = "exact";
     std::string lattice_dir;
@@ -82,6 +89,7 @@ const std::vector<OptionScope>& option_scopes() {
         {"--lattice-dir", {M::kLattice, M::kAuto}},   {"--footprint", {M::kExact}},
         {"--texture-size", {M::kTexture}},            {"--texture-subsamples", {M::kTexture}},
         {"--shadow-map-size", {M::kParticles}},
+        {"--sampler", {M::kExact, M::kLattice, M::kAuto, M::kTexture}},
         {"--instancing", {M::kExact, M::kLattice, M::kAuto}},
     };
     return scopes;
@@ -181,10 +189,10 @@ void print_summary(const RenderArgs& a, const Scene& scene, const ModeResult& r,
                          return tiles;
                      }().c_str());
     std::fprintf(stderr,
-                 "lattice: %s %dx%d, %d spp, %s mode%s: render %.1f ms on %d threads, "
+                 "lattice: %s %dx%d, %d spp (%s), %s mode%s: render %.1f ms on %d threads, "
                  "%llu primary + %llu shadow rays, %.2f M rays/s (total %.1f ms, peak %.1f MB)\n",
                  a.output.c_str(), scene.camera.width, scene.camera.height, std::max(1, a.spp),
-                 a.mode.c_str(),
+                 std::string(st.sampler).c_str(), a.mode.c_str(),
                  a.render_mode() == RenderMode::kExact && kOnOff.at(a.footprint) ? " with footprint filtering" : "",
                  st.render_ms, st.threads,
                  static_cast<unsigned long long>(st.primary_rays),
@@ -204,6 +212,7 @@ nlohmann::json stats_json(const RenderArgs& a, const Scene& scene, const ModeRes
     j["width"] = scene.camera.width;
     j["height"] = scene.camera.height;
     j["spp"] = std::max(1, a.spp);
+    j["sampler"] = st.sampler;
     j["threads"] = st.threads;
     j["load_ms"] = t.loaded;
     j["build_ms"] = r.build_ms;
@@ -289,6 +298,7 @@ int run_render(const RenderArgs& a) {
     t.loaded = since_start();
     ModeSettings settings;
     settings.spp = a.spp;
+    settings.sampler = kSamplers.at(a.sampler);
     settings.progress = progress;
     settings.lattice_dir = a.lattice_dir;
     settings.spec = a.spec;
@@ -323,8 +333,15 @@ Command add_render_command(CLI::App& parent) {
     c.app->add_option("-o,--output", args->output, "Output image: .png, .pfm or .exr")->required();
     c.app->add_option("--threads", args->threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(0, 4096));
-    c.app->add_option("--spp", args->spp, "Samples per pixel (1 = pixel centre)")
+    c.app->add_option("--spp", args->spp, "Samples per pixel (1 = the pixel centre; see --sampler)")
         ->check(CLI::Range(1, 65536));
+    std::string sampler_help = "Where a pixel's samples fall when --spp > 1 (exact, lattice and texture "
+                               "modes; particles mode always takes the grid): ";
+    for (const SamplerDescription& d : samplers())
+        sampler_help += std::string(d.name) + (d.kind == kDefaultSampler ? " (the default)" : "") + ": " +
+                        std::string(d.help) + "; ";
+    sampler_help.resize(sampler_help.size() - 2);
+    c.app->add_option("--sampler", args->sampler, sampler_help)->check(CLI::IsMember(kSamplers));
     c.app->add_option("--stats", args->stats, "Write timing and ray counts as JSON");
     std::string mode_help;
     for (const ModeDescription& d : render_modes())

@@ -62,7 +62,9 @@ std::string markdown(const Table2Args& a, const std::vector<Row>& rows, double t
                      const std::string& texture_unavailable) {
     std::ostringstream md;
     md << "Scene `" << a.scene << "`, against exact at " << a.truth_spp << " spp (" << fixed(truth_ms / 1000, 1)
-       << " s), " << a.threads << " threads. The base alone (exact, without its instances) renders in "
+       << " s, " << sampler_description(kTruthSampler).name << " sampler; the rows "
+       << sampler_description(kDefaultSampler).name << "), " << a.threads
+       << " threads. The base alone (exact, without its instances) renders in "
        << fixed(bare_ms, 0) << " ms at " << a.spp << " spp.\n\n";
     md << "| technique | mode | spp | paper: fidelity / speed / space | PSNR dB | SSIM | pixels off > 8 | "
           "render ms | build/bake ms | bytes added |\n";
@@ -89,6 +91,7 @@ nlohmann::json row_json(const Row& r) {
                        {"space", r.mode->paper_space}}},
             {"image", r.name + ".png"},
             {"spp", r.spp},
+            {"sampler", r.result.out.stats.sampler},
             {"psnr_db", num(r.diff.psnr_db)},
             {"ssim", std::isnan(r.diff.ssim) ? nlohmann::json(nullptr) : nlohmann::json(r.diff.ssim)},
             {"share_over_8", r.diff.share_over_8},
@@ -140,11 +143,14 @@ int run_table2(const Table2Args& a) {
     settings.texture = a.texture;
     settings.shadow_map_size = a.shadow_map_size;
     settings.spp = a.truth_spp;
+    // Independent random points: a truth from the rows' own sampler could share their samples.
+    settings.sampler = kTruthSampler;
     std::fprintf(stderr, "table2: truth, exact at %d spp\n", a.truth_spp);
     const ModeResult truth = render_in_mode(scene, RenderMode::kExact, settings);
     write_png((fs::path(a.out_dir) / "truth.png").string(), truth.out.display);
 
     settings.spp = a.spp;
+    settings.sampler = kDefaultSampler;
     std::fprintf(stderr, "table2: the base alone\n");
     const double bare_ms = render_in_mode(base_scene(scene), RenderMode::kExact, settings).out.stats.render_ms;
     std::vector<Row> rows;
@@ -198,6 +204,7 @@ int run_table2(const Table2Args& a) {
     nlohmann::json j = {{"scene", a.scene},
                         {"spp", a.spp},
                         {"truth_spp", a.truth_spp},
+                        {"truth_sampler", sampler_description(kTruthSampler).name},
                         {"threads", a.threads},
                         {"width", scene.camera.width},
                         {"height", scene.camera.height},

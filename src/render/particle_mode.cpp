@@ -11,6 +11,7 @@
 
 #include "geometry/chain.h"
 #include "render/camera.h"
+#include "render/sampler.h"
 #include "render/render_scene.h"
 #include "render/scene_parts.h"
 #include "render/shading.h"
@@ -351,6 +352,8 @@ RenderOutput render_particles(const Scene& scene, const ParticleSet& set, const 
     out.stats.primary_rays = primary.load();
     out.stats.shadow_rays = shadow.load();
     out.stats.threads = thread_count();
+    // Splats are depth-tested at fixed points: the cell centres whatever the sampler.
+    out.stats.sampler = spp == 1 ? "centre" : sampler_description(SamplerKind::kGrid).name;
     return out;
 }
 

@@ -88,6 +88,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
     ModeResult r;
     RenderOptions opt;
     opt.spp = settings.spp;
+    opt.sampler = settings.sampler;
     opt.progress = settings.progress;
     opt.across_ranks = settings.across_ranks && mode_description(mode).spreads_over_ranks;
     auto t0 = clock::now();

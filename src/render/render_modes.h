@@ -35,6 +35,7 @@ const ModeDescription& mode_description(RenderMode mode);
 
 struct ModeSettings {
     int spp = 1;
+    SamplerKind sampler = kDefaultSampler;  // exact, lattice and texture modes
     bool progress = false;
     std::string lattice_dir;  // empty: default_cache_dir()
     TableSpec spec;           // lattice mode

@@ -25,16 +25,6 @@ namespace {
 
 constexpr int kTile = 16;
 
-// A well-mixed hash (splitmix64 finaliser): jitter that depends on the pixel and sample only.
-std::uint64_t mix(std::uint64_t x) {
-    x += 0x9E3779B97F4A7C15ull;
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-    return x ^ (x >> 31);
-}
-
-double unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
-
 }  // namespace
 
 void check_render_budget(const Camera& camera, int spp, const std::string& file) {
@@ -49,20 +39,15 @@ void check_render_budget(const Camera& camera, int spp, const std::string& file)
                 std::to_string(kMaxRenderSamples) + " samples"));
 }
 
-void stratify(int n, int& nx, int& ny) {
-    nx = static_cast<int>(std::sqrt(static_cast<double>(n)));
-    while (nx > 1 && n % nx != 0) --nx;
-    ny = n / nx;
-}
-
 namespace {
 
-// What every tile needs: the scene, the camera, the sample grid, the image being filled.
+// What every tile needs: the scene, the camera, the samples, the image being filled.
 struct TileContext {
     const RenderScene& rs;
     const RenderOptions& opt;
     PinholeCamera cam;
-    int w, h, sx_n, sy_n, spp, tiles_x;
+    PixelSampler sampler;
+    int w, h, spp, tiles_x;
     double spread;
     RenderOutput& out;
 };
@@ -87,12 +72,7 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
             if (interrupted()) return;
             Vec3 sum, sum_clamped;
             for (int k = 0; k < spp; ++k) {
-                double ox = 0.5, oy = 0.5;
-                if (spp > 1) {
-                    const std::uint64_t seed = mix((static_cast<std::uint64_t>(j) * w + i) * 1024 + k);
-                    ox = ((k % tc.sx_n) + unit(seed)) / tc.sx_n;
-                    oy = ((k / tc.sx_n) + unit(mix(seed))) / tc.sy_n;
-                }
+                const auto [ox, oy] = tc.sampler.offset(static_cast<std::uint64_t>(j) * w + i, k);
                 const Ray ray = tc.cam.ray(i, j, ox, oy);
                 ++rays;
                 SurfaceHit hit;
@@ -212,12 +192,11 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     RenderOutput out;
     out.radiance = {w, h, std::vector<float>(static_cast<std::size_t>(w) * h * 3)};
     out.display = {w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 3)};
-    int sx_n, sy_n;
-    stratify(std::max(1, opt.spp), sx_n, sy_n);
-    const int spp = sx_n * sy_n;
+    const PixelSampler sampler(opt.sampler, opt.spp);
+    const int spp = sampler.spp();
     const double spread = sample_spread(s.camera, spp);
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-    const TileContext tc{rs, opt, PinholeCamera(s.camera), w, h, sx_n, sy_n, spp, tiles_x, spread, out};
+    const TileContext tc{rs, opt, PinholeCamera(s.camera), sampler, w, h, spp, tiles_x, spread, out};
 
     TileCounts counts;
     const bool across = opt.across_ranks && dist::distributed();
@@ -237,6 +216,7 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     out.stats.shadow_rays = counts.shadow.load();
     out.stats.lattice_visits = counts.visits.load();
     out.stats.threads = deal.threads;
+    out.stats.sampler = spp == 1 ? "centre" : sampler_description(opt.sampler).name;
     if (across) {
         gather_tiles(tc, deal);
         dist::mark(dist::Step::kGathered);

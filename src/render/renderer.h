@@ -5,11 +5,13 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dist/timeline.h"
 #include "io/image.h"
 #include "render/render_scene.h"
+#include "render/sampler.h"
 #include "render/shading.h"
 
 namespace lat {
@@ -19,7 +21,8 @@ namespace lat {
 using SurfaceShader = std::function<Vec3(const Ray&, const SurfaceHit&, ShadeState&)>;
 
 struct RenderOptions {
-    int spp = 1;  // stratified samples per pixel; 1 is the pixel centre
+    int spp = 1;  // samples per pixel; 1 is the pixel centre
+    SamplerKind sampler = kDefaultSampler;  // where the samples fall in the pixel
     // Trace rays front to back through partial hits (prefiltered lattices, render/layers.h).
     bool layered = false;
     bool progress = false;
@@ -44,6 +47,8 @@ struct RankStats {
 };
 
 struct RenderStats {
+    // Where the samples fell: the sampler's name, or "centre" at one sample per pixel.
+    std::string_view sampler;
     double render_ms = 0;
     double cpu_ms = 0;  // CPU time of the render, all threads (across_ranks: all ranks')
     std::uint64_t primary_rays = 0;
@@ -67,8 +72,5 @@ void check_render_budget(const Camera& camera, int spp, const std::string& file)
 
 // Throws Interrupted (util/interrupt.h) when a signal arrives: it stops at the next pixel.
 RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt);
-
-// The sample grid for n samples: nx * ny = n with nx, ny as close as possible.
-void stratify(int n, int& nx, int& ny);
 
 }  // namespace lat

@@ -56,6 +56,19 @@ add_test(NAME cli.unknown_extension
 add_test(NAME cli.usage_error
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--spp;0;${BAD}/good.json;-o;${CLI_OUT}/u.png"
           -DEXIT=2 "-DPATTERN=--spp" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.sampler_refused
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--sampler;halton;${BAD}/good.json;-o;${CLI_OUT}/sa.png"
+          -DEXIT=2 "-DPATTERN=--sampler" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+# The summary line names the sampler that ran: the one asked for, the default, the centre at 1 spp.
+foreach(case "sobol|--sampler;sobol;--spp;4|4 spp .sobol." "default|--spp;4|4 spp .grid."
+             "centre|--sampler;jitter|1 spp .centre.")
+  string(REPLACE "|" ";" case "${case}")
+  list(POP_FRONT case name)
+  list(POP_BACK case pattern)
+  add_test(NAME cli.sampler_reported_${name}
+    COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;${case};${BAD}/good.json;-o;${CLI_OUT}/sr-${name}.png"
+            -DEXIT=0 "-DPATTERN=${pattern}" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+endforeach()
 foreach(budget nan -1 inf 12x)
   add_test(NAME cli.lod_budget_refused_${budget}
     COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;lattice;--lod-budget;${budget};${BAD}/good.json;-o;${CLI_OUT}/lb.png"

@@ -35,15 +35,18 @@ function(run_timed expect_code pattern seconds)
 endfunction()
 
 if(CASE STREQUAL "render_exact")
-  # Radiance (PFM, floats) and display (PNG) pixels both travel; 2 spp jitters every sample.
-  foreach(ext pfm png)
-    run(0 "" ${LATTICE} render -q ${P4} --spp 2 -o ${WORK}/one.${ext})
-    run(0 "" ${MPI2} ${LATTICE} render -q ${P4} --spp 2 -o ${WORK}/two.${ext})
-    same(${WORK}/one.${ext} ${WORK}/two.${ext} "exact render (${ext})")
+  # Radiance (PFM, floats) and display (PNG) pixels both travel; at 2 spp the random samplers
+  # draw every sample from its pixel's seed.
+  foreach(sampler sobol jitter)
+    foreach(ext pfm png)
+      run(0 "" ${LATTICE} render -q ${P4} --spp 2 --sampler ${sampler} -o ${WORK}/one.${ext})
+      run(0 "" ${MPI2} ${LATTICE} render -q ${P4} --spp 2 --sampler ${sampler} -o ${WORK}/two.${ext})
+      same(${WORK}/one.${ext} ${WORK}/two.${ext} "exact render (${sampler}, ${ext})")
+    endforeach()
   endforeach()
   # 3 ranks x 2 threads: rank 0 deals to two askers; on an image of 3 tiles, fewer than the
   # job's 6 threads, some ranks' first chunks are empty (they must not be waited for).
-  run(0 "" ${MPIEXEC} -q -n 3 --oversubscribe ${LATTICE} render -q ${P4} --spp 2 --threads 2 -o ${WORK}/three.png)
+  run(0 "" ${MPIEXEC} -q -n 3 --oversubscribe ${LATTICE} render -q ${P4} --spp 2 --sampler jitter --threads 2 -o ${WORK}/three.png)
   same(${WORK}/one.png ${WORK}/three.png "exact render (3 ranks)")
   file(READ ${P4} scene)
   string(JSON scene SET "${scene}" camera width 40)
