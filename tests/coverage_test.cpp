@@ -239,7 +239,8 @@ CullLoss cull_loss(const TwoLevels& t, LatticeFilter filter, bool inside, double
         }
         return false;
     };
-    set_ray_footprint({footprint, 0, false});
+    RayFootprint f;
+    f.width0 = footprint;
     std::mt19937_64 rng(11);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::normal_distribution<double> g(0.0, 1.0);
@@ -251,10 +252,10 @@ CullLoss cull_loss(const TwoLevels& t, LatticeFilter filter, bool inside, double
         Ray ray;
         if (inside) {
             const Vec3 d{g(rng), g(rng), g(rng)};
-            ray = {point(box), d / length(d)};
+            ray = {point(box), d / length(d), &f};
         } else {
             const Vec3 p = point(around), q = point(around);
-            ray = {p - (q - p), (q - p) / length(q - p)};
+            ray = {p - (q - p), (q - p) / length(q - p), &f};
         }
         Crossing c;
         const double alpha = shape.intersect(ray, 0.0, kInfinity, c) ? double(c.coverage) : 0.0;
@@ -263,7 +264,6 @@ CullLoss cull_loss(const TwoLevels& t, LatticeFilter filter, bool inside, double
         ++out.turned_away;
         lost += alpha;
     }
-    set_ray_footprint({});
     EXPECT_GT(total, 100.0);
     out.lost = lost / total;
     return out;
@@ -303,22 +303,21 @@ TEST(Coverage, ShadowRaysGetTheSameSheetsWithoutNormals) {
     auto point = [&] {
         return box.lo + Vec3{u(rng), u(rng), u(rng)} * (box.hi - box.lo);
     };
+    RayFootprint coverage_only;
+    coverage_only.coverage_only = true;
     int hits = 0;
     for (int i = 0; i < 3000; ++i) {
         const Vec3 p = point(), q = point();
         const Ray ray{p - (q - p), (q - p) / length(q - p)};
         Crossing camera, shadow;
-        set_ray_footprint({});
         const bool h1 = shape.intersect(ray, 0.0, kInfinity, camera);
-        set_ray_footprint({0, 0, true});
-        const bool h2 = shape.intersect(ray, 0.0, kInfinity, shadow);
+        const bool h2 = shape.intersect({ray.o, ray.d, &coverage_only}, 0.0, kInfinity, shadow);
         ASSERT_EQ(h1, h2);
         if (!h1) continue;
         ++hits;
         EXPECT_EQ(camera.t, shadow.t);
         EXPECT_EQ(camera.coverage, shadow.coverage);
     }
-    set_ray_footprint({});
     EXPECT_GT(hits, 100);
 }
 
@@ -332,7 +331,8 @@ TEST(Coverage, ARayStartingBetweenTwoCrossingsIsStillBlocked) {
     std::mt19937_64 rng(11);
     const Bounds3 box = shape.bounds();
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    set_ray_footprint({0, 0, true});
+    RayFootprint coverage_only;
+    coverage_only.coverage_only = true;
     int between = 0, blocked = 0;
     for (int i = 0; i < 200000 && between < 300; ++i) {
         const Vec3 o = box.lo + Vec3{u(rng), u(rng), u(rng)} * (box.hi - box.lo);
@@ -346,9 +346,9 @@ TEST(Coverage, ARayStartingBetweenTwoCrossingsIsStillBlocked) {
             continue;
         ++between;
         Crossing c;
-        blocked += shape.intersect({o, d}, 1e-9, kInfinity, c) && c.t > 0 && c.coverage >= 0.5f;
+        blocked += shape.intersect({o, d, &coverage_only}, 1e-9, kInfinity, c) && c.t > 0 &&
+                   c.coverage >= 0.5f;
     }
-    set_ray_footprint({});
     ASSERT_GE(between, 100);
     EXPECT_GT(double(blocked) / between, 0.8) << blocked << " of " << between;
 }

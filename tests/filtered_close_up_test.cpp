@@ -60,6 +60,20 @@ HookLattice hook_lattice(const Shape& primitive = hook()) {
     return h;
 }
 
+// A footprint of this width, spread and purpose, without directions across the ray or a bound:
+// what a shape tested outside a traversal is given.
+RayFootprint width_footprint(double width0, double spread = 0, bool coverage_only = false) {
+    RayFootprint f;
+    f.width0 = width0;
+    f.spread = spread;
+    f.coverage_only = coverage_only;
+    return f;
+}
+// r with footprint f.
+Ray with(const Ray& r, const RayFootprint& f) {
+    return {r.o, r.d, &f};
+}
+
 // Rays through the hook's box: lines from outside it, or rays starting inside it.
 std::vector<Ray> rays(int n, bool inside = false) {
     std::mt19937_64 rng(5);
@@ -81,7 +95,7 @@ std::vector<Ray> rays(int n, bool inside = false) {
 TEST(FilteredCloseUps, ShadowRaysAreBlockedWhereThePrimitiveCrossesThem) {
     const HookLattice h = hook_lattice();
     for (const double footprint : {1e-9, 0.0}) {
-        set_ray_footprint({footprint, 0, true});
+        const RayFootprint f = width_footprint(footprint, 0, true);
         int hits = 0;
         for (const bool inside : {false, true})
             for (const Ray& r : rays(3000, inside)) {
@@ -91,8 +105,8 @@ TEST(FilteredCloseUps, ShadowRaysAreBlockedWhereThePrimitiveCrossesThem) {
                 for (const double tmax : {kInfinity, e ? exact.t + 0.01 : 20.0, e ? exact.t - 0.01 : 5.0}) {
                     const bool want = e && exact.t < tmax;
                     Crossing got;
-                    ASSERT_EQ(h.exact->intersect(r, tmin, tmax, got), want);
-                    EXPECT_EQ(h.exact->occluded(r, tmin, tmax), want);
+                    ASSERT_EQ(h.exact->intersect(with(r, f), tmin, tmax, got), want);
+                    EXPECT_EQ(h.exact->occluded(with(r, f), tmin, tmax), want);
                     if (!want) continue;
                     ++hits;
                     EXPECT_EQ(got.coverage, 1.0f);
@@ -102,7 +116,6 @@ TEST(FilteredCloseUps, ShadowRaysAreBlockedWhereThePrimitiveCrossesThem) {
             }
         EXPECT_GT(hits, 2000);
     }
-    set_ray_footprint({});
 }
 
 // Camera rays: a vanishing footprint puts all their sub-rays on the ray, so the sheet is the
@@ -110,35 +123,34 @@ TEST(FilteredCloseUps, ShadowRaysAreBlockedWhereThePrimitiveCrossesThem) {
 // steps of one sub-ray.
 TEST(FilteredCloseUps, CameraRaysGetTheirSubRaysCrossings) {
     const HookLattice h = hook_lattice();
-    set_ray_footprint({1e-9, 0, false});
+    const RayFootprint vanishing = width_footprint(1e-9);
     int hits = 0, tables_differ = 0;
     for (const Ray& r : rays(5000)) {
         Crossing exact, got, table;
         const bool e = hook().intersect(r, 0.0, kInfinity, exact);
-        ASSERT_EQ(h.exact->intersect(r, 0.0, kInfinity, got), e);
+        ASSERT_EQ(h.exact->intersect(with(r, vanishing), 0.0, kInfinity, got), e);
         if (!e) continue;
         ++hits;
         EXPECT_NEAR(got.t, exact.t, 1e-6);
         EXPECT_EQ(got.coverage, 1.0f);
         EXPECT_NEAR(length(got.stored.n - normalize(hook().normal(r, exact))), 0.0, 1e-6);
-        tables_differ += !h.tables_only->intersect(r, 0.0, kInfinity, table) ||
+        tables_differ += !h.tables_only->intersect(with(r, vanishing), 0.0, kInfinity, table) ||
                          std::abs(table.t - exact.t) > 1e-6;
     }
     EXPECT_GT(hits, 500);
     EXPECT_GT(tables_differ, hits / 2);  // the test can tell the tables from the primitive
 
-    set_ray_footprint({1.0, 0, false});
+    const RayFootprint wide = width_footprint(1.0);
     const int n = kExactSubRays * kExactSubRays;
     int partial = 0;
     for (const Ray& r : rays(20000)) {
         Crossing got;
-        if (!h.exact->intersect(r, 0.0, kInfinity, got)) continue;
+        if (!h.exact->intersect(with(r, wide), 0.0, kInfinity, got)) continue;
         const double k = double(got.coverage) * n;
         EXPECT_NEAR(k, std::round(k), 1e-5);
         partial += got.coverage < 1.0f;
     }
     EXPECT_GT(partial, 20);
-    set_ray_footprint({});
 }
 
 // A ray's sheet is the crossings of its sub-rays (a grid across the footprint, recomputed
@@ -158,7 +170,7 @@ void expect_sheets_are_their_sub_rays_crossings(const Shape& prim, bool shadow,
     int checked = 0;
     for (const double footprint : {0.4, 1.0, 2 * kExactWidth}) {
         const double width = std::min(footprint, kExactWidth);
-        set_ray_footprint({footprint, 0, shadow});
+        const RayFootprint f = width_footprint(footprint, 0, shadow);
         for (const Ray& r : rays(2000)) {
             const double tmax = shadow ? dot(box.center() - r.o, r.d) : kInfinity;
             double alpha = 0;
@@ -186,7 +198,7 @@ void expect_sheets_are_their_sub_rays_crossings(const Shape& prim, bool shadow,
                     if (live[a] ? met[a] : met[b]) alpha += (live[a] + live[b]) / 4.0;
             }
             Crossing got;
-            const bool hit = h.exact->intersect(r, 0.0, tmax, got);
+            const bool hit = h.exact->intersect(with(r, f), 0.0, tmax, got);
             ASSERT_EQ(hit, alpha > 0) << "footprint " << footprint;
             if (!hit) continue;
             ++checked;
@@ -197,7 +209,6 @@ void expect_sheets_are_their_sub_rays_crossings(const Shape& prim, bool shadow,
             }
         }
     }
-    set_ray_footprint({});
     EXPECT_GT(checked, least_checked);
 }
 
@@ -259,10 +270,12 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
     const int n = kExactSubRays;
     int split = 0, whole = 0;
     for (const double footprint : {0.4, 1.0, kExactWidth}) {
-        set_ray_footprint({footprint, 0, false});
-        for (const Ray& r : rays(2000)) {
-            const ScopedAcrossRay across(r.d);  // unit: the world's directions are r's basis
-            set_across_ray_in_object(Affine{}, true, true, kInfinity);
+        // Without the world's directions across the ray.
+        const RayFootprint own = width_footprint(footprint);
+        for (const Ray& ray : rays(2000)) {
+            // unit: the world's directions are r's basis
+            const RayFootprint world = footprint_across(ray.d, footprint, 0, false);
+            const Ray r = with(ray, world);
             // Each sub-ray's first crossing, as the grid of
             // expect_sheets_are_their_sub_rays_crossings.
             std::array<double, kSubRays> t;
@@ -271,8 +284,8 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
             for (int i = 0; i < n; ++i)
                 for (int j = 0; j < n; ++j) {
                     const int k = i * n + j;
-                    const Vec3 offset = across_ray().u * (((i + 0.5) / n - 0.5) * footprint) +
-                                        across_ray().v * (((j + 0.5) / n - 0.5) * footprint);
+                    const Vec3 offset = world.u * (((i + 0.5) / n - 0.5) * footprint) +
+                                        world.v * (((j + 0.5) / n - 0.5) * footprint);
                     const Ray sub{r.o + offset, r.d};
                     double t0 = 0, t1 = kInfinity;
                     Crossing c;
@@ -329,15 +342,13 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
                 EXPECT_EQ(one.sub_rays, met);
             }
             // Without the world's directions: that one sheet.
-            clear_across_ray_in_object();
             if (met != 0) {
-                ASSERT_EQ(s.sheets(r, 0.0, kInfinity, got), 1);
+                ASSERT_EQ(s.sheets(with(ray, own), 0.0, kInfinity, got), 1);
                 EXPECT_NEAR(got[0].crossing.t, one.t, 1e-9);
                 EXPECT_EQ(got[0].normals.count, 0);
             }
         }
     }
-    set_ray_footprint({});
     EXPECT_GT(split, 200);
     EXPECT_GT(whole, 1000);
 }
@@ -366,8 +377,9 @@ TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
     };
     int hits = 0, culled = 0, outside = 0;
     for (const double footprint : {0.0, 0.05, 0.5, 2.0, kExactWidth, 3 * kExactWidth}) {
-        set_ray_footprint({footprint, 0, false});
-        for (const Ray& r : rays(4000)) {
+        const RayFootprint f = width_footprint(footprint);
+        for (const Ray& line : rays(4000)) {
+            const Ray r = with(line, f);
             Crossing c;
             if (s.intersect(r, 0.0, kInfinity, c)) {
                 ++hits;
@@ -380,7 +392,6 @@ TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
             }
         }
     }
-    set_ray_footprint({});
     EXPECT_GT(hits, 3000);
     EXPECT_GT(culled, 3000);
     EXPECT_GT(outside, 20);  // rays whose lines miss the lattice box, answered by sub-rays
@@ -439,12 +450,12 @@ void expect_instances_culled_by_their_own_bound(const Shape& primitive) {
                 return false;
             };
             for (const double footprint : {0.0, 0.05, 0.5, 2.0, kExactWidth, 3 * kExactWidth}) {
-                set_ray_footprint({footprint, 0, false});
+                // Outside a traversal: no directions across, the instance's bound.
+                RayFootprint f = width_footprint(footprint);
+                f.widest = widest;
                 for (const Ray& r : local_rays) {
                     const Ray world{xf.point(r.o), xf.vector(r.d)};
-                    const Ray local = xf.inverse_ray(world);
-                    // Outside a traversal: no directions across, the instance's bound.
-                    set_across_ray_in_object(Affine{}, true, true, widest);
+                    const Ray local = with(xf.inverse_ray(world), f);
                     Crossing c;
                     const bool hit = s.intersect(local, 0.0, kInfinity, c);
                     hits += hit;
@@ -460,8 +471,6 @@ void expect_instances_culled_by_their_own_bound(const Shape& primitive) {
         EXPECT_GT(culled, last_culled) << "widest " << widest;
         last_culled = culled;
     }
-    set_ray_footprint({});
-    clear_across_ray_in_object();
 }
 
 TEST(FilteredCloseUps, EachInstanceIsCulledByItsOwnWidestFootprint) {
@@ -487,19 +496,20 @@ TEST(FilteredCloseUps, TheAcceleratorHandsEachInstanceItsBound) {
         bool found = false;
         for (std::uint32_t i = 0; i < 2; ++i) {
             const Transform& xf = *objects[i].xf;
-            set_across_ray_in_object(xf.inverse_map(), xf.is_identity(), true,
-                                     i == 0 ? near_bound : kInfinity);
+            RayFootprint f = *world.footprint;
+            across_in_object(*world.footprint, xf.inverse_map(), xf.is_identity(), true,
+                             i == 0 ? near_bound : kInfinity, f);
             Crossing c;
-            if (s.intersect(xf.inverse_ray(world), 0.0, found ? out.t : kInfinity, c))
+            if (s.intersect(with(xf.inverse_ray(world), f), 0.0, found ? out.t : kInfinity, c))
                 found = true, out = {c.t, i, c, {}};
         }
         return found;
     };
     int near_hits = 0, differ_unbounded = 0;
     for (const double footprint : {0.05, 2.0, 3 * kExactWidth}) {
-        set_ray_footprint({footprint, 0, false});
+        const RayFootprint f = width_footprint(footprint);
         for (const Ray& r : rays(1500)) {
-            const Ray world{near.point(r.o), near.vector(r.d)};
+            const Ray world{near.point(r.o), near.vector(r.d), &f};
             AccelHit a, e, wide;
             const bool found = accel.intersect(world, 0.0, kInfinity, a);
             ASSERT_EQ(found, expected(world, near_widest, e)) << "footprint " << footprint;
@@ -512,8 +522,6 @@ TEST(FilteredCloseUps, TheAcceleratorHandsEachInstanceItsBound) {
             differ_unbounded += !expected(world, kInfinity, wide) || wide.t != e.t;
         }
     }
-    set_ray_footprint({});
-    clear_across_ray_in_object();
     EXPECT_GT(near_hits, 1000);
     EXPECT_GT(differ_unbounded, 100);  // the bound matters for these rays
 }
@@ -537,10 +545,10 @@ TEST(FilteredCloseUps, LongerDirectionsAreTheSameRay) {
             int hits = 0;
             for (const Ray& r : rays(2000)) {
                 Crossing a, b;
-                set_ray_footprint({width, 0, shadow});
-                const bool ha = h.exact->intersect(r, 0.0, kInfinity, a);
-                set_ray_footprint({width / 2, 0, shadow});
-                const bool hb = h.exact->intersect({r.o, r.d * 2.0}, 0.0, kInfinity, b);
+                const RayFootprint fa = width_footprint(width, 0, shadow);
+                const RayFootprint fb = width_footprint(width / 2, 0, shadow);
+                const bool ha = h.exact->intersect(with(r, fa), 0.0, kInfinity, a);
+                const bool hb = h.exact->intersect({r.o, r.d * 2.0, &fb}, 0.0, kInfinity, b);
                 ASSERT_EQ(ha, hb) << "width " << width;
                 if (!ha) continue;
                 ++hits;
@@ -551,7 +559,6 @@ TEST(FilteredCloseUps, LongerDirectionsAreTheSameRay) {
             EXPECT_GT(hits, 300);
         }
     }
-    set_ray_footprint({});
 }
 
 // How far a ray may go (tmax: for camera rays in the accelerator, the closest crossing found
@@ -560,8 +567,9 @@ TEST(FilteredCloseUps, LongerDirectionsAreTheSameRay) {
 TEST(FilteredCloseUps, TheSheetIsCutAtTmaxNotMadeOfWhatLiesBeforeIt) {
     const HookLattice h = hook_lattice();
     for (const double width : {1e-9, 1.0}) {
-        set_ray_footprint({width, 0, false});
-        for (const Ray& r : rays(3000)) {
+        const RayFootprint f = width_footprint(width);
+        for (const Ray& line : rays(3000)) {
+            const Ray r = with(line, f);
             Crossing whole, cut;
             if (!h.exact->intersect(r, 0.0, kInfinity, whole)) continue;
             for (const double tmax : {whole.t - 0.01, whole.t + 0.01}) {
@@ -573,14 +581,12 @@ TEST(FilteredCloseUps, TheSheetIsCutAtTmaxNotMadeOfWhatLiesBeforeIt) {
             }
         }
     }
-    set_ray_footprint({});
 }
 
 // Camera rays without a footprint (width 0: the camera in the box, say) get their own line's
 // crossing and normal from a primitive that answers, the continuous limit of a vanishing one.
 TEST(FilteredCloseUps, RaysWithoutAFootprintGetTheirLinesCrossing) {
     const HookLattice h = hook_lattice();
-    set_ray_footprint({0, 0, false});
     int hits = 0;
     for (const Ray& r : rays(3000)) {
         Crossing exact, got;
@@ -592,7 +598,6 @@ TEST(FilteredCloseUps, RaysWithoutAFootprintGetTheirLinesCrossing) {
         EXPECT_EQ(got.coverage, 1.0f);
         EXPECT_NEAR(length(got.stored.n - normalize(hook().normal(r, exact))), 0.0, 1e-9);
     }
-    set_ray_footprint({});
     EXPECT_GT(hits, 500);
 }
 
@@ -607,14 +612,14 @@ int differing_answers(const Shape& primitive) {
         {e.open(payload.data(), payload.size(), raster.hits, ctx), ctx}};
     const FilteredLatticeShape asked(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), kExactWidth);
     const FilteredLatticeShape tables(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), 0.0);
-    set_ray_footprint({1e-9, 0, false});
+    const RayFootprint vanishing = width_footprint(1e-9);
     int differ = 0;
-    for (const Ray& r : rays(3000)) {
+    for (const Ray& line : rays(3000)) {
+        const Ray r = with(line, vanishing);
         Crossing a, b;
         const bool ha = asked.intersect(r, 0.0, kInfinity, a), hb = tables.intersect(r, 0.0, kInfinity, b);
         differ += ha != hb || (ha && (a.t != b.t || a.coverage != b.coverage));
     }
-    set_ray_footprint({});
     return differ;
 }
 
@@ -638,10 +643,11 @@ TEST(FilteredCloseUps, APrimitiveAnsweredByItsCrossingsNeedsNoTable) {
     EXPECT_EQ(bare.bounds().lo, h.exact->bounds().lo);
     EXPECT_EQ(bare.bounds().hi, h.exact->bounds().hi);
     int hits = 0, spans = 0;
-    for (const RayFootprint f : {RayFootprint{0.4, 0.01, false}, RayFootprint{0.8, -0.05, true},
-                                 RayFootprint{0, 0, false}}) {
-        set_ray_footprint(f);
-        for (const Ray& r : rays(2000)) {
+    for (const RayFootprint& f :
+         {width_footprint(0.4, 0.01, false), width_footprint(0.8, -0.05, true),
+          width_footprint(0, 0, false)}) {
+        for (const Ray& line : rays(2000)) {
+            const Ray r = with(line, f);
             Crossing a, b;
             const bool ha = h.exact->intersect(r, 0.0, kInfinity, a);
             ASSERT_EQ(bare.intersect(r, 0.0, kInfinity, b), ha);
@@ -654,7 +660,6 @@ TEST(FilteredCloseUps, APrimitiveAnsweredByItsCrossingsNeedsNoTable) {
             EXPECT_EQ(a.stored.n, b.stored.n);
         }
     }
-    set_ray_footprint({});
     for (const Ray& r : rays(500)) {
         SpanList own, got;
         long_hook().spans(r, own);
@@ -687,9 +692,8 @@ TEST(FilteredCloseUps, ChainsOfAnyPartsAnswerFromTheirCrossings) {
         const FilteredLatticeShape asked(
             {{e.open(payload.data(), payload.size(), raster.hits, ctx), ctx}},
             LatticeFilter::kSmooth, e.error_bound(ctx, {}), kExactWidth);
-        set_ray_footprint({0, 0, false});
         int hits = 0;
-        for (const Ray& r : rays(3000)) {
+        for (const Ray& r : rays(3000)) {  // without a footprint
             Crossing exact, got;
             const bool hit = row.intersect(r, 0.0, kInfinity, exact);
             ASSERT_EQ(asked.intersect(r, 0.0, kInfinity, got), hit) << parts << " parts";
@@ -697,7 +701,6 @@ TEST(FilteredCloseUps, ChainsOfAnyPartsAnswerFromTheirCrossings) {
             ++hits;
             EXPECT_NEAR(got.t, exact.t, 1e-9);
         }
-        set_ray_footprint({});
         EXPECT_GT(hits, 300) << parts << " parts";
     }
 }

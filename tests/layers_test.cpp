@@ -388,52 +388,62 @@ TEST(Layers, CrossingsWithSubRaysBlockEachSubRayOnce) {
     EXPECT_NEAR(first, 0.7 * 0.4 * 0.25, 1e-15);
 }
 
-// A shape that records the directions across the ray the accelerator handed it.
+// A shape that records the footprint the accelerator handed it with the ray.
 class Probe final : public Shape {
 public:
     Bounds3 bounds() const override { return {{-1, -1, -1}, {1, 1, 1}}; }
     bool intersect(const Ray& r, double, double, Crossing&) const override {
-        seen = across_ray_in_object();
+        handed = r.footprint != nullptr;
+        seen = handed ? *r.footprint : RayFootprint{};
         local_d = r.d;
         return false;
     }
     void spans(const Ray&, SpanList&) const override {}
     Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
     bool inside(Vec3) const override { return false; }
-    mutable AcrossRay seen;
+    mutable bool handed = false;
+    mutable RayFootprint seen;
     mutable Vec3 local_d;
 };
 
-// The accelerator hands an object the world's directions across the ray in its own space
-// where its map is a similarity (turned and evenly scaled: still across the ray, as long as
-// its direction), and none where it is not (sheared or unevenly scaled); outside a scope, none.
-TEST(Layers, ObjectsGetTheDirectionsAcrossTheRayInTheirSpace) {
+// The accelerator hands an object the ray's footprint in its own space: its width, spread and
+// purpose, its own bound (AccelObject::widest_footprint), and the world's directions across the
+// ray where its map is a similarity (turned and evenly scaled: still across the ray, as long as
+// its direction), none where it is not (sheared or unevenly scaled). A ray without a footprint
+// hands none.
+TEST(Layers, ObjectsGetTheRaysFootprintInTheirSpace) {
     const Probe probe;
-    const Ray r{{0.3, -0.2, -5}, normalize(Vec3{0.1, 0.2, 1})};
-    const auto handed = [&](const Transform& xf) {
-        const std::vector<AccelObject> objects{{&probe, &xf}};
+    const Vec3 o{0.3, -0.2, -5}, d = normalize(Vec3{0.1, 0.2, 1});
+    const RayFootprint world = footprint_across(d, 0.25, 0.01, true);
+    const auto handed = [&](const Transform& xf, const Ray& r) {
+        const std::vector<AccelObject> objects{{&probe, &xf, 0.75}};
         const EmbreeAccel accel(objects);
         AccelHit hit;
+        probe.handed = false;
         probe.seen = {};
         accel.intersect(r, 0.0, kInfinity, hit);
         return probe.seen;
     };
     const Transform similar = Transform::rotate({1, 2, 3}, 0.7) * Transform::scale({3, 3, 3});
     const Transform uneven = Transform::scale({1, 1.01, 1});
-    {
-        const ScopedAcrossRay across(r.d);
-        const AcrossRay world = across_ray();
-        const AcrossRay a = handed(similar);
-        ASSERT_TRUE(a.set);
-        EXPECT_NEAR(length(similar.vector(a.u) - world.u), 0.0, 1e-12);
-        EXPECT_NEAR(length(similar.vector(a.v) - world.v), 0.0, 1e-12);
-        EXPECT_NEAR(dot(a.u, probe.local_d), 0.0, 1e-12);
-        EXPECT_NEAR(length(a.u), length(probe.local_d), 1e-12);
-        EXPECT_FALSE(handed(uneven).set);
-        EXPECT_TRUE(handed(Transform{}).set);
-    }
-    EXPECT_FALSE(across_ray().set);
-    EXPECT_FALSE(across_ray_in_object().set);
+    const RayFootprint a = handed(similar, {o, d, &world});
+    ASSERT_TRUE(probe.handed);
+    ASSERT_TRUE(a.across);
+    EXPECT_NEAR(length(similar.vector(a.u) - world.u), 0.0, 1e-12);
+    EXPECT_NEAR(length(similar.vector(a.v) - world.v), 0.0, 1e-12);
+    EXPECT_NEAR(dot(a.u, probe.local_d), 0.0, 1e-12);
+    EXPECT_NEAR(length(a.u), length(probe.local_d), 1e-12);
+    EXPECT_EQ(a.width0, 0.25);
+    EXPECT_EQ(a.spread, 0.01);
+    EXPECT_TRUE(a.coverage_only);
+    EXPECT_EQ(a.widest, 0.75);
+    EXPECT_FALSE(handed(uneven, {o, d, &world}).across);
+    EXPECT_TRUE(probe.handed);
+    EXPECT_EQ(probe.seen.widest, 0.75);
+    EXPECT_TRUE(handed(Transform{}, {o, d, &world}).across);
+    EXPECT_EQ(probe.seen.u, world.u);
+    handed(similar, {o, d});
+    EXPECT_FALSE(probe.handed);
 }
 
 TEST(Layers, AMeanNormalWidensTheSpecularLobeKeepingItsLight) {

@@ -117,17 +117,17 @@ struct EmbreeAccel::Impl {
     const Ray& local_ray(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->cached_obj != obj) {
             ctx->cached_obj = obj;
-            ctx->cached_local = objects[obj].local_ray(ctx->ray);
+            ctx->cached_local = objects[obj].local_ray(ctx->ray, ctx->local_footprint);
         }
         return ctx->cached_local;
     }
     // Before an object is tested: the directions across the ray in its space handed on
-    // (geometry/sub_rays.h), only when the object changes (within one query nothing else sets
-    // them), and not for the many objects that culling rejects.
+    // (QueryContext::object_footprint), only when the object changes (within a traversal
+    // nothing else sets them), and not for the many objects that culling rejects.
     void hand_across(QueryContext* ctx, std::uint32_t obj) const {
         if (ctx->across_obj == obj) return;
         ctx->across_obj = obj;
-        objects[obj].hand_across();
+        ctx->hand_across(objects[obj]);
     }
 
     // Whether a direct primitive's object is to be tested: it was not tested already for this
@@ -264,7 +264,7 @@ struct EmbreeAccel::Impl {
     void test_self_last(QueryContext& ctx) const {
         if (ctx.found || ctx.self >= objects.size() || !objects[ctx.self].direct) return;
         const Placed& o = objects[ctx.self];
-        const Ray local = object_ray(o, ctx.ray);
+        const Ray local = object_ray(o, ctx);
         const double tmin = occlusion_tmin(&ctx, ctx.self, local);
         const Target t{ctx.self, 0};
         if (ctx.stop.shadow())
@@ -297,7 +297,7 @@ struct EmbreeAccel::Impl {
         const bool whole = last->part == EmbreeAccel::kWhole;
         assert(whole ? o.cheap_blocker : last->part < o.shape->primitive_count());
         if (whole && last->object == ctx.self) return false;
-        const Ray local = object_ray(o, ctx.ray);
+        const Ray local = object_ray(o, ctx);
         const double tmin = occlusion_tmin(&ctx, last->object, local);
         bool blocked;
         if (ctx.stop.shadow()) {  // a transmittance: a partial crossing it meets is kept
@@ -507,7 +507,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 
     for (const std::uint32_t i : m.unbounded) {
         const Placed& o = m.objects[i];
-        const Ray local = object_ray(o, r);
+        const Ray local = object_ray(o, ctx);
         Crossing c;
         if (o.shape->intersect(local, tmin, ctx.found ? hit.t : tmax, c)) {
             ctx.found = true;
@@ -544,7 +544,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;
         const Placed& o = m.objects[i];
-        const Ray local = object_ray(o, r);
+        const Ray local = object_ray(o, ctx);
         Crossing c;
         const double t1 = ctx.found ? std::min(hit.t, ctx.tmax) : ctx.tmax;
         if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), t1, c)) continue;
@@ -574,7 +574,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     if (traceable && m.blocked_by_kept(ctx, last)) return true;
     for (const std::uint32_t i : m.unbounded) {
         const Placed& o = m.objects[i];
-        const Ray local = object_ray(o, r);
+        const Ray local = object_ray(o, ctx);
         if (o.shape->occluded(local, m.occlusion_tmin(&ctx, i, local), tmax)) {
             m.keep_blocker(ctx, last);  // nothing kept: unbounded objects are tested anyway
             return true;

@@ -36,18 +36,11 @@ struct Placed {
     // A direct object cheap enough to test before a shadow ray's traversal (LastBlocker).
     bool cheap_blocker = false;
 
-    Ray local_ray(const Ray& r) const { return {inverse.point(r.o), inverse.vector(r.d)}; }
-    // Before the object is tested: the directions across the ray in its space handed on.
-    void hand_across() const {
-        set_across_ray_in_object(inverse, identity, similar, widest_footprint);
+    // r in the object's space, with footprint f (the query's object copy, or none).
+    Ray local_ray(const Ray& r, const RayFootprint* f) const {
+        return {inverse.point(r.o), inverse.vector(r.d), f};
     }
 };
-
-// The object-space ray for objects tested outside Embree, with the directions across it.
-inline Ray object_ray(const Placed& o, const Ray& r) {
-    o.hand_across();
-    return o.identity ? r : o.local_ray(r);
-}
 
 // Partial crossings in ray order, ties by object: the same for any traversal order.
 inline bool in_ray_order(const AccelHit& a, const AccelHit& b) {
@@ -64,15 +57,30 @@ struct QueryContext {
     QueryContext(const EmbreeAccel::Impl& m, const Ray& r, double t0, double t1, AccelHit* h)
         : accel(&m), ray(r), tmin(t0), tmax(t1), hit(h) {
         rtcInitIntersectContext(&rtc);
+        if (!r.footprint) return;
+        object_footprint.width0 = r.footprint->width0;
+        object_footprint.spread = r.footprint->spread;
+        object_footprint.coverage_only = r.footprint->coverage_only;
+        local_footprint = &object_footprint;
     }
-    // The objects' copy of the directions across the ray ends with the query (sub_rays.h).
-    ~QueryContext() { clear_across_ray_in_object(); }
     QueryContext(const QueryContext&) = delete;
     QueryContext& operator=(const QueryContext&) = delete;
 
     RTCIntersectContext rtc;
     const EmbreeAccel::Impl* accel;
     Ray ray;  // world space, double
+    // The ray's footprint in the space of the object being tested: its width, spread and
+    // purpose the world ray's, its directions across and bound handed on per object
+    // (hand_across; between, the last object's). Every object-space ray handed to a shape
+    // points at it (local_footprint) when the world ray has a footprint, else carries none.
+    RayFootprint object_footprint;
+    const RayFootprint* local_footprint = nullptr;
+    // Before object o is tested: its copy of the directions across the ray and its bound.
+    void hand_across(const Placed& o) {
+        if (local_footprint)
+            across_in_object(*ray.footprint, o.inverse, o.identity, o.similar, o.widest_footprint,
+                             object_footprint);
+    }
     double tmin, tmax;
     AccelHit* hit;
     bool found = false;
@@ -142,5 +150,12 @@ struct QueryContext {
 };
 // Callbacks cast Embree's context pointer back to ours.
 static_assert(std::is_standard_layout_v<QueryContext> && offsetof(QueryContext, rtc) == 0);
+
+// The object-space ray for objects tested outside Embree, with its footprint handed on.
+inline Ray object_ray(const Placed& o, QueryContext& ctx) {
+    ctx.hand_across(o);
+    return o.identity ? Ray{ctx.ray.o, ctx.ray.d, ctx.local_footprint}
+                      : o.local_ray(ctx.ray, ctx.local_footprint);
+}
 
 }  // namespace lat::embree_detail

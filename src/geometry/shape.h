@@ -265,7 +265,8 @@ public:
     // The bounds of cull part i placed by xf. widest: the widest footprint (shape units) of the
     // rays this placement is traced with (AccelObject::widest_footprint; infinity: any). A shape
     // whose reach grows with the footprint (a filtered lattice's sub-rays) culls narrower for
-    // narrower ones; its queries then take the same bound from across_ray_in_object().
+    // narrower ones; its queries then take the same bound from their ray's footprint
+    // (RayFootprint::widest).
     virtual Bounds3 cull_bounds(std::size_t, const Transform& xf, double /*widest*/) const {
         return placed_bounds(xf);
     }

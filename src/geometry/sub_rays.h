@@ -16,43 +16,16 @@ namespace lat {
 
 inline constexpr int kSubRays = 4;  // a 2 x 2 grid
 
-// The directions across a ray along which its sub-rays are offset: unit, perpendicular to the
-// ray and to each other, in world space as the renderer set them (`set`: whether it did), and
-// in the space of the object being tested, as the accelerator hands them on per object (its
-// inverse transform applied; no longer unit under a scaled instance).
-struct AcrossRay {
-    Vec3 u, v;
-    bool set = false;
-    // The object's copy only (what the accelerator hands an object about the ray): the widest
-    // footprint (object units) its sub-rays may span, its placement's
-    // (AccelObject::widest_footprint), by which its culling was narrowed.
-    double widest = kInfinity;
-};
-const AcrossRay& across_ray();
-// Sets the directions across a ray (unit direction) for a scope: the previous ones after it,
-// and no object copy (so that a shape tested directly, outside a traversal, never sees a
-// stale one).
-class ScopedAcrossRay {
-public:
-    explicit ScopedAcrossRay(Vec3 unit_direction);
-    ~ScopedAcrossRay();
-    ScopedAcrossRay(const ScopedAcrossRay&) = delete;
-    ScopedAcrossRay& operator=(const ScopedAcrossRay&) = delete;
-
-private:
-    AcrossRay previous_;
-};
-// The accelerator: before testing an object, its own copy: the world one's directions through
-// the object's inverse linear map (xf: object -> world), when set and when the map keeps them
-// across the ray and as long as it (`similar`: a similarity, within 1e-3; else unset, and the
-// object uses its own directions), and the object's widest footprint (AcrossRay::widest).
-// Written in place: a copy built on the caller's stack and handed over stalled store
-// forwarding (4 % of a candidates lattice's samples).
+// The accelerator, before testing an object: the object's copy of the world ray's footprint
+// (RayFootprint) gets the world's directions across the ray through the object's inverse
+// linear map (xf: object -> world), when the world's are set and the map keeps them across the
+// ray and as long as it (`similar`: a similarity, within 1e-3; else unset, and the object uses
+// its own directions), and the object's widest footprint (RayFootprint::widest). Written in
+// place, only these fields (the width, spread and purpose are the world ray's, copied once a
+// query): a whole copy built on the stack and handed over stalled store forwarding.
 // inverse: xf's inverse map; identity: whether xf is the identity.
-void set_across_ray_in_object(const Affine& inverse, bool identity, bool similar, double widest);
-// After a query: no object copy, so that a shape tested directly never sees the last object's.
-void clear_across_ray_in_object();
-const AcrossRay& across_ray_in_object();
+void across_in_object(const RayFootprint& world, const Affine& inverse, bool identity, bool similar,
+                      double widest, RayFootprint& object);
 
 // Partial crossings of one ray composed: what is left of it after each, front to back (camera
 // rays), or in any order (a shadow ray's transmittance, which does not depend on it).

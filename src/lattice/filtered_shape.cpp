@@ -13,7 +13,12 @@
 namespace lat {
 namespace {
 
-thread_local RayFootprint t_footprint;
+// What a ray without a footprint is taken to have: a zero one (the finest level), no
+// directions across it, no bound.
+constexpr RayFootprint kNoFootprint{};
+const RayFootprint& footprint_of(const Ray& r) {
+    return r.footprint ? *r.footprint : kNoFootprint;
+}
 
 // How far (in cells of a level) a ray answered through a level can pass from the primitive: a
 // pair blended in has its ends within sqrt(2) cells of the ray's (smooth: a neighbouring grid
@@ -40,12 +45,9 @@ constexpr std::size_t kMinBoxedParts = 8;
 
 }  // namespace
 
-void set_ray_footprint(const RayFootprint& f) { t_footprint = f; }
-
 double lod_level(double cell0, double width) {
     return std::log2(cell0 / (width * kCellPerFootprint));
 }
-const RayFootprint& ray_footprint() { return t_footprint; }
 
 double farthest_sub_ray(double width) {
     // The corner one of n x n: sqrt(2) (n - 1) / 2n of the width from the ray, 1 % more for
@@ -210,7 +212,7 @@ void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, bool normal
 }
 
 bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const {
-    return sheet(r, tmin, tmax, !t_footprint.coverage_only, hit);
+    return sheet(r, tmin, tmax, !footprint_of(r).coverage_only, hit);
 }
 
 bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
@@ -235,10 +237,11 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
 
 int FilteredLatticeShape::sheets(const Ray& r, double tmin, double tmax,
                                  std::span<SheetCrossing, kMaxSheets> out) const {
-    const bool normal = !t_footprint.coverage_only;
+    const RayFootprint& f = footprint_of(r);
+    const bool normal = !f.coverage_only;
     // Sheets of sub-rays are told apart only where they compose sub-ray by sub-ray
     // (LayerComposite): with the world's directions across the ray.
-    if (!exact_ || !normal || !across_ray_in_object().set) {
+    if (!exact_ || !normal || !f.across) {
         out[0].normals.count = 0;
         return sheet(r, tmin, tmax, normal, out[0].crossing) ? 1 : 0;
     }
@@ -266,7 +269,7 @@ int FilteredLatticeShape::sheets(const Ray& r, double tmin, double tmax,
 
 double FilteredLatticeShape::sub_ray_width(const Ray& r) const {
     // The instance's own bound, by which its culling was narrowed (cull_bounds).
-    return std::min({footprint_width(r), exact_width_, across_ray_in_object().widest});
+    return std::min({footprint_width(r), exact_width_, footprint_of(r).widest});
 }
 
 void FilteredLatticeShape::add_sub_rays(const SubRayHits& h, unsigned which, Sheet& s,
@@ -293,7 +296,7 @@ bool FilteredLatticeShape::to_crossing(const Sheet& s, double finer, const Ray& 
     const Vec3 facing = -r.d / std::sqrt(dd);
     // The sub-rays of a ray whose directions across are the world's compose with the other
     // lattices' (LayerComposite); otherwise the coverage alone, as the tables'.
-    const std::uint8_t sub_rays = exact_ && across_ray_in_object().set ? s.sub_rays : 0;
+    const std::uint8_t sub_rays = exact_ && footprint_of(r).across ? s.sub_rays : 0;
     if (!normal) {
         hit = Crossing(t, 0, SurfacePoint{p, facing});
         hit.coverage = coverage;
@@ -323,7 +326,8 @@ double FilteredLatticeShape::footprint_width(const Ray& r) const {
     // At the box's centre along the ray.
     const double dd = dot(r.d, r.d);
     const double tc = dot(bounds().center() - r.o, r.d) / dd;
-    return (t_footprint.width0 + t_footprint.spread * std::max(0.0, tc)) * std::sqrt(dd);
+    const RayFootprint& f = footprint_of(r);
+    return (f.width0 + f.spread * std::max(0.0, tc)) * std::sqrt(dd);
 }
 
 bool FilteredLatticeShape::cull_meets(std::size_t i, const Ray& r) const {
@@ -390,10 +394,10 @@ void FilteredLatticeShape::exact_sub_rays(double width, bool normal, const Ray& 
     // k-th sub-ray is the same in every lattice (geometry/sub_rays.h).
     // (Perpendicular to the ray and each other within 1e-3, which farthest_sub_ray allows for:
     // made exactly so, the basis cost Plate 2 a sixth of its time.)
-    const AcrossRay& across = across_ray_in_object();
+    const RayFootprint& f = footprint_of(r);
     Vec3 u, v;
-    if (across.set) {
-        u = normalize(across.u), v = normalize(across.v);
+    if (f.across) {
+        u = normalize(f.u), v = normalize(f.v);
     } else {
         orthonormal_basis(r.d / length(r.d), u, v);
     }

@@ -8,7 +8,7 @@
 //   smooth  the coverages of the 5 pairs around the ray's real entry and exit points, blended
 //           linearly over a simplex of the 4-D (entry, exit) grid: continuous in ray space.
 // Levels of detail: tables of the same box at sigma^-1 doubling from level to level; each ray
-// takes the level whose cell matches its footprint (ray_footprint()), blending the two nearest.
+// takes the level whose cell matches its footprint (Ray::footprint), blending the two nearest.
 // Answered by the primitive's own crossings (exact_width above 0), it reads no table for rays:
 // the sub-rays across each ray's footprint answer (kExactSubRays).
 // As a CSG leaf, for `inside` and for spans, the lattice is point-sampled through the finest
@@ -34,19 +34,6 @@ enum class LatticeFilter { kNone, kBox, kSmooth };
 // The option names, "none", "box" and "smooth": the one place they are spelled.
 inline constexpr std::array<std::pair<std::string_view, LatticeFilter>, 3> kLatticeFilterNames{
     {{"none", LatticeFilter::kNone}, {"box", LatticeFilter::kBox}, {"smooth", LatticeFilter::kSmooth}}};
-
-// The footprint of the ray being traced, which picks the level of detail: its width (world
-// units) is width0 + spread * t at ray parameter t (world rays have unit directions). Set by the
-// renderer per ray on its thread, so that the shape interface (Embree's callbacks) stays as it
-// is; 0 (the default) asks for the finest level.
-struct RayFootprint {
-    double width0 = 0, spread = 0;
-    // The ray wants only each sheet's coverage and where it lies (a shadow ray's transmittance):
-    // the normals are not decoded, and the crossing's normal faces the ray.
-    bool coverage_only = false;
-};
-void set_ray_footprint(const RayFootprint& f);
-const RayFootprint& ray_footprint();
 
 // A level's cell is made this many footprints wide: the box over a cell, widened by the smooth
 // filter's linear blend, then matches a pixel's box best (tuned on six fur scenes against the
@@ -114,7 +101,7 @@ public:
     // answered_by_primitive, or one whose levels wanted are past the build budget); their
     // footprints are narrowed to at most exact_width (primitive units), which bounds how far from a
     // ray its sub-rays go and so how far culling must reach; each instance narrower still by its
-    // own bound (cull_bounds, AcrossRay::widest). A ray without a footprint gets the crossing of
+    // own bound (cull_bounds, RayFootprint::widest). A ray without a footprint gets the crossing of
     // its own line.
     FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter, double table_error,
                          double exact_width = 0);

@@ -7,15 +7,9 @@
 #include "lattice/candidate_table_shape.h"
 #include "lattice/float_snap.h"
 #include "lattice/hit_table_shape.h"
+#include "util/stats.h"
 
 namespace lat {
-namespace {
-thread_local std::uint64_t t_visits = 0;
-}  // namespace
-
-std::uint64_t lattice_visits_this_thread() {
-    return t_visits;
-}
 
 LatticeFrame::LatticeFrame(const TableContext& ctx, double reach, double beyond_box)
     : grid_(ctx.cells),
@@ -204,7 +198,7 @@ Bounds3 LatticeFrame::cull_bounds(std::size_t i, const Transform& xf, double nar
 }
 
 bool LatticeFrame::snap(const Ray& r, Snap& s) const {
-    ++t_visits;
+    stats::bump(stats::Counter::kLatticeVisits);
     const Vec3 o = r.o * inv_cell_, d = r.d * inv_cell_;
     s.o = o;
     s.d = d;

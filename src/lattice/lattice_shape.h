@@ -107,11 +107,6 @@ private:
     void split_in_halves();
 };
 
-// Lattice visits (snaps of a ray to a grid point pair: one per call of a lattice shape's
-// intersect, occluded, spans or inside) made by the calling thread so far. A thread-local count
-// costs one increment a visit and no contention; the renderer adds up its growth per tile.
-std::uint64_t lattice_visits_this_thread();
-
 // The shape for a table of either kind; ctx.primitive must be set (candidate tables intersect
 // it; both cull by it) and outlive the shape. hit_error: how far a stored hit can lie from the
 // primitive (Encoding::error_bound), infinity when unknown.

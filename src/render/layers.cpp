@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "geometry/sub_rays.h"
-#include "lattice/filtered_shape.h"
 
 namespace lat {
 namespace {
@@ -36,9 +35,11 @@ Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, d
                  ShadeState& state) {
     const auto visible = [&](std::size_t light, const Ray& r, double tmin, double tmax,
                              double dist) {
+        // Narrowing to the light; sub-rays along the same world directions in every lattice
+        // (geometry/sub_rays.h).
         const double w = shadow_width(ray, hit, r, width);
-        set_ray_footprint({w, -w / dist, true});
-        return transmittance(rs, r, tmin, tmax, hit.object, state.kept_blocker(light));
+        const RayFootprint f = footprint_across(normalize(r.d), w, -w / dist, true);
+        return transmittance(rs, {r.o, r.d, &f}, tmin, tmax, hit.object, state.kept_blocker(light));
     };
     return shade_with(rs, ray, hit, state, visible);
 }
@@ -48,8 +49,6 @@ Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, d
 double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tmax,
                      std::uint32_t self, EmbreeAccel::LastBlocker* last) {
     thread_local std::vector<AccelHit> partial;
-    // Sub-rays along the same world directions in every lattice (geometry/sub_rays.h).
-    const ScopedAcrossRay across(normalize(r.d));
     const LayerStop stop{.blocked_below = kMinTransmittance};
     if (rs.partial_crossings(r, tmin, tmax, self, partial, stop, last))
         return 0;
@@ -61,11 +60,12 @@ double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tm
 
 Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeState& state) {
     thread_local std::vector<SurfaceHit> partial;
-    set_ray_footprint({0, spread});
-    const ScopedAcrossRay across(normalize(ray.d));
+    // Sub-rays along the same world directions in every lattice (geometry/sub_rays.h).
+    const RayFootprint f = footprint_across(normalize(ray.d), 0, spread, false);
     SurfaceHit opaque;
-    const bool found = rs.intersect_layers(ray, 0.0, kInfinity, EmbreeAccel::kNoObject, opaque, partial,
-                                           {.max_layers = kMaxLayers, .min_left = kMinTransmittance});
+    const bool found =
+        rs.intersect_layers({ray.o, ray.d, &f}, 0.0, kInfinity, EmbreeAccel::kNoObject, opaque,
+                            partial, {.max_layers = kMaxLayers, .min_left = kMinTransmittance});
     // Shading moves the footprint (shadow rays): the layers are all found first. (Shadow rays
     // leave `partial` as it is: transmittance has its own.)
     Vec3 c;

@@ -29,9 +29,10 @@ inline constexpr double kMaxShadowWidening = 4;
 // pixel's angle), which picks the lattices' levels of detail (lattice/filtered_shape.h).
 Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeState& state);
 
-// The share of light that gets through from tmin to tmax along r (unit direction) leaving a
-// surface of object `self`, whose crossings within its surface tolerance are skipped. last: what
-// blocked the last ray of its run, if kept (EmbreeAccel::LastBlocker).
+// The share of light that gets through from tmin to tmax along r (unit direction, with its
+// footprint: a shadow ray's, RayFootprint::coverage_only) leaving a surface of object `self`,
+// whose crossings within its surface tolerance are skipped. last: what blocked the last ray of
+// its run, if kept (EmbreeAccel::LastBlocker).
 double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tmax,
                      std::uint32_t self, EmbreeAccel::LastBlocker* last = nullptr);
 

@@ -11,7 +11,6 @@
 #include "dist/job.h"
 #include "dist/message.h"
 #include "dist/timeline.h"
-#include "lattice/lattice_shape.h"
 #include "render/camera.h"
 #include "render/layers.h"
 #include "render/shading.h"
@@ -19,6 +18,7 @@
 #include "util/interrupt.h"
 #include "util/memory.h"
 #include "util/progress.h"
+#include "util/stats.h"
 
 namespace lat {
 namespace {
@@ -63,7 +63,7 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
     const int x0 = (tile % tc.tiles_x) * kTile, y0 = (tile / tc.tiles_x) * kTile;
     ShadeState state;
     // A tile runs on one thread from start to end: its visits are this thread's growth.
-    const std::uint64_t visits0 = lattice_visits_this_thread();
+    const std::uint64_t visits0 = stats::this_thread(stats::Counter::kLatticeVisits);
     std::uint64_t rays = 0;
     for (int j = y0; j < std::min(h, y0 + kTile); ++j) {
         for (int i = x0; i < std::min(w, x0 + kTile); ++i) {
@@ -95,7 +95,8 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
     }
     counts.primary.fetch_add(rays, std::memory_order_relaxed);
     counts.shadow.fetch_add(state.shadow_rays, std::memory_order_relaxed);
-    counts.visits.fetch_add(lattice_visits_this_thread() - visits0, std::memory_order_relaxed);
+    counts.visits.fetch_add(stats::this_thread(stats::Counter::kLatticeVisits) - visits0,
+                            std::memory_order_relaxed);
 }
 
 // Calls row(first, count) for each row of the chunks' tiles, in order: the index of its first

@@ -53,7 +53,7 @@ struct RenderStats {
     double cpu_ms = 0;  // CPU time of the render, all threads (across_ranks: all ranks')
     std::uint64_t primary_rays = 0;
     std::uint64_t shadow_rays = 0;
-    std::uint64_t lattice_visits = 0;  // see lattice_visits_this_thread
+    std::uint64_t lattice_visits = 0;  // stats::Counter::kLatticeVisits
     int threads = 0;  // across_ranks: summed over ranks; the counts too (on rank 0)
     std::vector<RankStats> ranks;  // across_ranks, on rank 0: one per rank
 };
