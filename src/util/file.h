@@ -1,9 +1,42 @@
 #pragma once
+// Every file a user names (scene, mesh, lattice table, PNG, cache entry) is opened through
+// here. A path that is not a regular file (FIFO, device, socket, directory) is refused before
+// anything can block on it or read without end, and a file larger than the caller's limit is
+// refused before any of it is read.
+#include <cstdint>
 #include <string>
 
 namespace lat {
 
-// The whole file; throws InputError "path: cannot open <what>: reason" when it cannot.
-std::string read_text_file(const std::string& path, const std::string& what = "file");
+// Scene files and other JSON: far beyond any scene written by hand or by a tool, small enough
+// that the parsed JSON (about ten times the text) fits in memory.
+constexpr std::uint64_t kMaxTextFileBytes = std::uint64_t{256} << 20;
+
+// A regular file open for reading. Throws InputError "path: cannot open <what>: reason", or
+// "path: <what> of N bytes is over the limit of M bytes".
+class InputFile {
+public:
+    InputFile(const std::string& path, const std::string& what, std::uint64_t max_bytes);
+    ~InputFile();
+    InputFile(const InputFile&) = delete;
+    InputFile& operator=(const InputFile&) = delete;
+
+    int fd() const { return fd_; }
+    std::uint64_t size() const { return size_; }
+    // Hands the descriptor over (the caller closes it).
+    int release();
+    // The whole file (throws InputError when reading fails or it has grown beyond the limit).
+    std::string read_all();
+
+private:
+    std::string path_, what_;
+    std::uint64_t max_bytes_;
+    std::uint64_t size_ = 0;
+    int fd_ = -1;
+};
+
+// The whole file, through InputFile.
+std::string read_text_file(const std::string& path, const std::string& what = "file",
+                           std::uint64_t max_bytes = kMaxTextFileBytes);
 
 }  // namespace lat
