@@ -68,7 +68,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             r.bytes_added = instance_geometry_bytes(scene);
             if (mode == RenderMode::kLattice) {
                 const TableCache cache(settings.lattice_dir.empty() ? default_cache_dir() : settings.lattice_dir,
-                                       !settings.lattice_dir.empty(), opt.across_ranks);
+                                       opt.across_ranks);
                 LatticeFiltering filtering = settings.filtering;
                 // A pixel's angle, narrowed by the samples that share it.
                 filtering.spread = 2 * std::tan(scene.camera.fov_y_deg * M_PI / 360.0) /
