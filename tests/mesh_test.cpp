@@ -114,6 +114,7 @@ bool ref_hit(const RefMesh& m, V o, V d, R tmin, R tmax, R& t, int& tri, R& bu, 
 }
 
 // The documented shading rule with the scene below: material m, ground z = 0 of material g.
+// `normals` per vertex, or empty for flat faces (each triangle's own normal).
 Image8 reference_image(const RefMesh& m, const std::vector<V>& normals, int w, int h) {
     const V eye{3.2L, -4.5L, 2.6L}, look{0, 0, 0.6L}, up{0, 0, 1};
     const V W = unit(look - eye), U = unit(crossv(W, up)), Vv = crossv(U, W);
@@ -142,7 +143,9 @@ Image8 reference_image(const RefMesh& m, const std::vector<V>& normals, int w, i
                 R ks = 0.1L;
                 if (on_mesh) {
                     const auto& k = m.tri[tri];
-                    n = unit((1 - bu - bv) * normals[k[0]] + bu * normals[k[1]] + bv * normals[k[2]]);
+                    n = normals.empty()
+                            ? unit(crossv(m.p[k[1]] - m.p[k[0]], m.p[k[2]] - m.p[k[0]]))
+                            : unit((1 - bu - bv) * normals[k[0]] + bu * normals[k[1]] + bv * normals[k[2]]);
                     col = col_m;
                     ks = 0.5L;
                 }
@@ -174,14 +177,14 @@ RefMesh float_vertices(RefMesh m) {
     return m;
 }
 
-std::string scene_json(const std::string& file) {
+std::string scene_json(const std::string& file, const std::string& mesh_fields = "") {
     return R"({
   "camera": {"eye": [3.2, -4.5, 2.6], "look_at": [0, 0, 0.6], "fov_y_deg": 30, "width": 160, "height": 120},
   "background": [0.1, 0.1, 0.2], "ambient": 1,
   "lights": [{"position": [4, -3, 6], "intensity": 0.8}, {"position": [-5, -4, 3], "intensity": 0.4}],
   "materials": {"m": {"color": [0.9, 0.6, 0.3], "ka": 0.1, "kd": 0.7, "ks": 0.5, "shininess": 20},
                 "g": {"color": [0.5, 0.6, 0.5], "ka": 0.1, "kd": 0.7, "ks": 0.1, "shininess": 20}},
-  "objects": [{"type": "mesh", "file": ")" + file + R"(", "material": "m"},
+  "objects": [{"type": "mesh", "file": ")" + file + R"(", "material": "m")" + mesh_fields + R"(},
               {"type": "halfspace", "normal": [0, 0, 1], "material": "g"}]})";
 }
 
@@ -208,22 +211,25 @@ TEST(Mesh, ObjWithNormalsMatchesBruteForceTracer) {
     expect_close(got, reference_image(float_vertices(m), n, 160, 120));
 }
 
-TEST(Mesh, PlyWithoutNormalsUsesAreaWeightedNormals) {
+// Without normals in the file the faces are flat; with "smooth": true each vertex normal is the
+// sum of its faces' cross products.
+TEST(Mesh, PlyWithoutNormalsIsFlatUnlessSmooth) {
     const test::TempDir dir;
     const RefMesh m = torus_mesh(40, 20);
     test::spit(dir.file("torus.ply"), to_ply(m));
-    const std::string scene_path = dir.file("scene.json");
-    test::spit(scene_path, scene_json("torus.ply"));
-    const Scene s = load_scene(scene_path);
-    const Image8 got = render_image(RenderScene(s), {}).display;
-    // The documented rule: each vertex normal is the sum of its faces' cross products.
+    test::spit(dir.file("flat.json"), scene_json("torus.ply"));
+    test::spit(dir.file("smooth.json"), scene_json("torus.ply", R"(, "smooth": true)"));
+    const Image8 flat = render_image(RenderScene(load_scene(dir.file("flat.json"))), {}).display;
+    const Image8 smooth = render_image(RenderScene(load_scene(dir.file("smooth.json"))), {}).display;
     std::vector<V> n(m.p.size());
     for (const auto& t : m.tri) {
         const V f = crossv(m.p[t[1]] - m.p[t[0]], m.p[t[2]] - m.p[t[0]]);
         for (int k : t) n[k] = n[k] + f;
     }
     for (V& x : n) x = unit(x);
-    expect_close(got, reference_image(float_vertices(m), n, 160, 120));
+    expect_close(flat, reference_image(float_vertices(m), {}, 160, 120));
+    expect_close(smooth, reference_image(float_vertices(m), n, 160, 120));
+    EXPECT_LT(compare_images(flat, smooth).psnr_db, 40.0);  // the two rules differ visibly
 }
 
 // A closed box mesh with per-face normals (so 24 vertices: closed by position, not by index).
