@@ -13,6 +13,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 #include "io/mesh_builder.h"
 #include "util/error.h"
@@ -41,7 +42,9 @@ bool parse_real(std::string_view token, T& out) {
         // from_chars says so on underflow too: then the value rounds to 0 or a denormal.
         if (token.size() > 64) return false;
         const std::string copy(token);
-        out = static_cast<T>(std::strtold(copy.c_str(), nullptr));
+        const long double x = std::strtold(copy.c_str(), nullptr);
+        if (!(std::fabs(x) <= static_cast<long double>(std::numeric_limits<T>::max()))) return false;  // overflow
+        out = static_cast<T>(x);
     } else if (ec != std::errc()) {
         return false;
     }

@@ -10,6 +10,8 @@
 // "vertex_indices" or "vertex_index" of integers), the vertices first; other elements and
 // properties are read past (and checked as numbers of their type in ASCII).
 #include <bit>
+#include <cmath>
+#include <limits>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -377,8 +379,17 @@ private:
                     ends(e, i);
                 }
             }
-            const Vec3 pos{v[ix], v[iy], v[iz]};
-            const Vec3 n = inx >= 0 ? Vec3{v[inx], v[iny], v[inz]} : Vec3{};
+            // Rounded to float whatever the property's type, as OBJ vertices are: products of
+            // coordinates (cross products, determinants) then stay far from overflowing.
+            // Beyond the float range counts as not finite (the cast itself would be undefined).
+            auto f = [&](int k) {
+                const double x = v[k];
+                return std::abs(x) <= static_cast<double>(std::numeric_limits<float>::max())
+                           ? static_cast<double>(static_cast<float>(x))
+                           : std::numeric_limits<double>::infinity();
+            };
+            const Vec3 pos{f(ix), f(iy), f(iz)};
+            const Vec3 n = inx >= 0 ? Vec3{f(inx), f(iny), f(inz)} : Vec3{};
             if (!is_finite(pos) || !is_finite(n))
                 fail(name_, place(), "vertex " + std::to_string(i + 1) + " is not finite (NaN or infinite)");
             mesh_.add_vertex(pos, n);

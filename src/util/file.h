@@ -8,9 +8,9 @@
 
 namespace lat {
 
-// Scene files and other JSON: far beyond any scene written by hand or by a tool, small enough
-// that the parsed JSON (about ten times the text) fits in memory.
-constexpr std::uint64_t kMaxTextFileBytes = std::uint64_t{256} << 20;
+// Scene files and other JSON: room for the largest arrays a scene may hold (10,000,000
+// entries), and a bound on what reading one can cost.
+constexpr std::uint64_t kMaxTextFileBytes = std::uint64_t{1} << 30;
 
 // A regular file open for reading. Throws InputError "path: cannot open <what>: reason", or
 // "path: <what> of N bytes is over the limit of M bytes".
