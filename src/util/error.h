@@ -22,8 +22,10 @@ std::string located_message(const std::string& file, const std::string& where,
 // max_bytes of the input, "..." when there was more.
 std::string printable(std::string_view bytes, std::size_t max_bytes = 40);
 // A message made fit for one line of a terminal: control bytes and DEL written as \xNN (text
-// quoted from a file may hold them; UTF-8 stays), at most max_bytes long.
-std::string message_line(std::string_view message, std::size_t max_bytes = 1000);
+// quoted from a file may hold them; UTF-8 stays), at most max_bytes long. Readers cap what they
+// quote (printable, quoted); this bound is a backstop that leaves room for the place in a
+// deeply nested scene (a CSG tree of 256 levels names a few kB of path).
+std::string message_line(std::string_view message, std::size_t max_bytes = 16384);
 // printable(bytes) in single quotes.
 std::string quoted(std::string_view bytes, std::size_t max_bytes = 40);
 
