@@ -180,7 +180,7 @@ Image8 reference_image(const RefMesh& m, const NormalAt& normal_at, int w, int h
     return img;
 }
 
-// Assimp reads vertices as floats: the reference traces the same rounded vertices.
+// Vertices are read as floats: the reference traces the same rounded vertices.
 RefMesh float_vertices(RefMesh m) {
     for (V& p : m.p) p = {R(float(p.x)), R(float(p.y)), R(float(p.z))};
     return m;
