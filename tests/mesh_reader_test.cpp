@@ -142,6 +142,47 @@ TEST(MeshReader, ObjSyntax) {
     EXPECT_EQ(r.triangles[1], (std::array<std::uint32_t, 3>{1, 2, 3}));
 }
 
+// A file is read a piece at a time: lines, CR LF pairs and numbers cut across pieces read as
+// they do whole, and only the current line is held.
+TEST(MeshReader, ObjInPieces) {
+    const std::string text = "v 0 0 0\r\nv 1.5 0 0\rv 0 1 0\r\nvn 0 0 1\n\nf 1//1 2//1 3//1\r\nf 1 2 3";
+    const MeshData whole = parse_obj(text, "m.obj");
+    auto in_pieces = [](const std::string& t, std::size_t size) {
+        std::size_t at = 0;
+        return parse_obj_pieces(
+            [&] {
+                const std::string_view piece = std::string_view(t).substr(at, size);
+                at += piece.size();
+                return piece;
+            },
+            "m.obj");
+    };
+    for (std::size_t size : {1, 2, 3, 7}) {
+        const MeshData d = in_pieces(text, size);
+        EXPECT_EQ(d.positions, whole.positions) << size;
+        EXPECT_EQ(d.triangles, whole.triangles) << size;
+        EXPECT_EQ(d.normals, whole.normals) << size;
+        // Lines are counted the same way (a CR LF cut in two is one line end).
+        EXPECT_EQ(test::error_of([&] { in_pieces(text + "\r\nf 1 2 9\n", size); }),
+                  "m.obj: line 8: face 3 refers to vertex 9, but 3 vertices come before it")
+            << size;
+    }
+    EXPECT_EQ(whole.triangles.size(), 2u);
+    EXPECT_EQ(whole.positions[1], (Vec3{1.5, 0, 0}));
+    // A line without end is refused once it is longer than the limit, not held whole.
+    const std::string endless(kMaxObjLineBytes + 1, 'x');
+    EXPECT_EQ(test::error_of([&] { parse_obj(endless, "m.obj"); }),
+              "m.obj: line 1 is longer than " + std::to_string(kMaxObjLineBytes) + " bytes");
+    // A file of many pieces (the reader takes 1 MiB at a time).
+    const test::TempDir dir;
+    std::string big;
+    while (big.size() < (std::size_t{3} << 20)) big += "v 0.25 0.5 0.75\r\n";
+    test::spit(dir.file("big.obj"), big + "f 1 2 -1\r\n");
+    const MeshData b = read_mesh_file(dir.file("big.obj"));
+    EXPECT_EQ(b.triangles.size(), 1u);
+    EXPECT_EQ(b.positions[2], (Vec3{0.25, 0.5, 0.75}));
+}
+
 std::string error_obj(const std::string& text) {
     return test::error_of([&] { parse_obj(text, "m.obj"); });
 }

@@ -14,6 +14,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <string_view>
+#include <vector>
 
 #include "io/mesh_builder.h"
 #include "util/error.h"
@@ -144,15 +146,32 @@ MeshData parse_mesh(std::string_view bytes, MeshFormat format, const std::string
 
 MeshData read_mesh_file(const std::string& path) {
     InputFile file(path, "mesh file", kMaxMeshFileBytes);
-    const std::string bytes = file.read_all();
-    if (bytes.starts_with("ply") && (bytes.size() == 3 || bytes[3] == '\n' || bytes[3] == '\r'))
-        return parse_ply(bytes, path);
+    std::vector<char> buf(std::size_t{1} << 20);
+    std::size_t head = 0;  // the first bytes, enough to tell a PLY file
+    while (head < 4) {
+        const std::size_t n = file.read_some(buf.data() + head, buf.size() - head);
+        if (n == 0) break;
+        head += n;
+    }
+    const std::string_view first(buf.data(), head);
     std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".ply") return parse_ply(bytes, path);  // says what is wrong with its first line
-    if (ext == ".obj") return parse_obj(bytes, path);
-    mesh_io::fail(path, "", "not a mesh file this program reads: OBJ (.obj) or PLY (a file that "
-                            "starts with 'ply')");
+    const bool ply = first.starts_with("ply") && (head == 3 || first[3] == '\n' || first[3] == '\r');
+    if (ply || ext == ".ply")  // a .ply that does not start so is told what is wrong with it
+        return parse_ply(std::string(first) + file.read_all(), path);
+    if (ext != ".obj")
+        mesh_io::fail(path, "", "not a mesh file this program reads: OBJ (.obj) or PLY (a file "
+                                "that starts with 'ply')");
+    bool first_piece = true;
+    return parse_obj_pieces(
+        [&]() -> std::string_view {
+            if (first_piece) {
+                first_piece = false;
+                if (head > 0) return first;
+            }
+            return {buf.data(), file.read_some(buf.data(), buf.size())};
+        },
+        path);
 }
 
 }  // namespace lat

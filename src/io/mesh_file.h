@@ -5,6 +5,7 @@
 // throw InputError "<path>: [line N: ]what" (the scene reader adds the place in the scene).
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,8 +26,10 @@ struct MeshData {
 // hierarchy (about 100 bytes per triangle) fit in memory.
 constexpr std::size_t kMaxMeshTriangles = 10'000'000;
 constexpr std::size_t kMaxMeshVertices = 3 * kMaxMeshTriangles;
-// Files larger than this are refused before reading (a file is read whole).
+// Files larger than this are refused before reading. A PLY file is read whole (its binary
+// body is smaller than the mesh it holds); an OBJ file a piece at a time.
 constexpr std::uint64_t kMaxMeshFileBytes = std::uint64_t{1} << 30;
+constexpr std::size_t kMaxObjLineBytes = std::size_t{16} << 20;
 
 enum class MeshFormat { kObj, kPly };
 
@@ -39,6 +42,9 @@ MeshData read_mesh_file(const std::string& path);
 // The same from bytes in memory; `name` stands for the file in messages.
 MeshData parse_mesh(std::string_view bytes, MeshFormat format, const std::string& name);
 MeshData parse_obj(std::string_view text, const std::string& name);
+// OBJ text in pieces, as a file is read: next_piece() gives the next, empty at the end. Lines
+// may run across pieces; only the current line is kept (at most kMaxObjLineBytes).
+MeshData parse_obj_pieces(const std::function<std::string_view()>& next_piece, const std::string& name);
 MeshData parse_ply(std::string_view bytes, const std::string& name);
 
 // Checks a mesh given in memory the same way (throws InputError "<name>: what").

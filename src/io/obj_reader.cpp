@@ -7,7 +7,9 @@
 // the last one read), referring to what comes before it in the file. Each distinct (v, vn)
 // pair becomes one vertex of the mesh, so normals belong to the corners that name them: an
 // object without vn next to one with them keeps its flat faces, the other its normals.
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -40,33 +42,59 @@ struct Tokens {
 
 class ObjReader {
 public:
-    ObjReader(std::string_view text, const std::string& name)
-        : text_(text), name_(name), mesh_(name, [this] { return where(); }) {}
+    explicit ObjReader(const std::string& name) : name_(name), mesh_(name, [this] { return where(); }) {}
 
-    MeshData read() {
+    // The next piece of the text. A line that runs past its end waits for the next piece (at
+    // most kMaxObjLineBytes of it is kept); a CR at its end may pair with an LF starting the next.
+    void feed(std::string_view piece) {
         std::size_t pos = 0;
-        while (pos < text_.size()) {
-            std::size_t end = pos;
-            while (end < text_.size() && text_[end] != '\n' && text_[end] != '\r') ++end;
-            ++line_;
-            statement(text_.substr(pos, end - pos));
-            pos = end;
-            if (pos < text_.size() && text_[pos] == '\r') {
-                if (++pos < text_.size() && text_[pos] == '\n') ++pos;
-            } else if (pos < text_.size()) {
-                ++pos;  // '\n'
+        if (after_cr_ && !piece.empty()) {
+            after_cr_ = false;
+            if (piece[0] == '\n') pos = 1;
+        }
+        while (pos < piece.size()) {
+            const std::size_t end = piece.find_first_of("\r\n", pos);
+            const std::size_t stop = end == std::string_view::npos ? piece.size() : end;
+            if (pending_.size() + (stop - pos) > kMaxObjLineBytes)
+                fail(name_, "", "line " + std::to_string(line_ + 1) + " is longer than " +
+                                    std::to_string(kMaxObjLineBytes) + " bytes");
+            if (end == std::string_view::npos) {
+                pending_.append(piece.substr(pos));
+                return;
             }
+            ++line_;
+            if (pending_.empty()) {
+                statement(piece.substr(pos, end - pos));
+            } else {
+                pending_.append(piece.substr(pos, end - pos));
+                statement(pending_);
+                pending_.clear();
+            }
+            pos = end + 1;
+            if (piece[end] == '\r') {
+                if (pos == piece.size()) after_cr_ = true;
+                else if (piece[pos] == '\n') ++pos;
+            }
+        }
+    }
+
+    MeshData finish() {
+        if (!pending_.empty()) {
+            ++line_;
+            statement(pending_);
         }
         return mesh_.finish();
     }
 
 private:
-    std::string_view text_;
     const std::string& name_;
     mesh_io::MeshBuilder mesh_;
+    std::string pending_;  // the start of a line that runs into the next piece
+    bool after_cr_ = false;
     long line_ = 0;
     std::size_t faces_ = 0, texcoords_ = 0;
-    std::vector<Vec3> v_, vn_;
+    // As read: floats (what the mesh keeps), so that a file of vertices costs 12 bytes each.
+    std::vector<std::array<float, 3>> v_, vn_;
     std::unordered_map<std::uint64_t, std::uint32_t> vertex_of_;  // (v, vn + 1) -> mesh vertex
     std::vector<std::uint32_t> corners_;
 
@@ -93,7 +121,7 @@ private:
         // Everything else (o, g, s, mtllib, usemtl, p, l, free-form geometry) is skipped.
     }
 
-    Vec3 numbers(Tokens& t, int least, int most, const char* what) {
+    std::array<float, 3> numbers(Tokens& t, int least, int most, const char* what) {
         float x[3] = {0, 0, 0};
         int n = 0;
         for (std::string_view tok; t.next(tok); ++n) {
@@ -107,6 +135,8 @@ private:
                                                     : std::to_string(least) + " to " + std::to_string(most)));
         return {x[0], x[1], x[2]};
     }
+
+    static Vec3 vec(const std::array<float, 3>& a) { return {a[0], a[1], a[2]}; }
 
     // An index of a corner: from 1, or negative from the end of what has been read so far.
     std::size_t index(std::string_view tok, std::size_t count, const char* what, const char* whats) {
@@ -138,7 +168,7 @@ private:
             if (s2 != std::string_view::npos) vn = index(tok.substr(s2 + 1), vn_.size(), "normal", "normals") + 1;
             const std::uint64_t key = (std::uint64_t{v} << 32) | vn;
             auto [it, fresh] = vertex_of_.try_emplace(key, 0);
-            if (fresh) it->second = mesh_.add_vertex(v_[v], vn ? vn_[vn - 1] : Vec3{});
+            if (fresh) it->second = mesh_.add_vertex(vec(v_[v]), vn ? vec(vn_[vn - 1]) : Vec3{});
             corners_.push_back(it->second);
         }
         mesh_.add_face(corners_, faces_);
@@ -147,8 +177,16 @@ private:
 
 }  // namespace
 
+MeshData parse_obj_pieces(const std::function<std::string_view()>& next_piece, const std::string& name) {
+    ObjReader r(name);
+    for (std::string_view piece = next_piece(); !piece.empty(); piece = next_piece()) r.feed(piece);
+    return r.finish();
+}
+
 MeshData parse_obj(std::string_view text, const std::string& name) {
-    return ObjReader(text, name).read();
+    ObjReader r(name);
+    r.feed(text);
+    return r.finish();
 }
 
 }  // namespace lat

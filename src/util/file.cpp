@@ -62,20 +62,24 @@ int InputFile::release() {
 
 // Reads to the end rather than trusting the size: a file may grow while it is read, and files
 // under /proc say 0. Either way no more than the limit is taken.
-std::string InputFile::read_all() {
-    std::string text;
-    text.reserve(static_cast<std::size_t>(size_));
-    char buf[65536];
+std::size_t InputFile::read_some(char* buf, std::size_t n) {
     for (;;) {
-        const ssize_t n = ::read(fd_, buf, sizeof buf);
-        if (n < 0 && errno == EINTR) continue;
-        if (n < 0) throw InputError(path_ + ": cannot read " + what_ + ": " + std::strerror(errno));
-        if (n == 0) break;
-        if (text.size() + static_cast<std::size_t>(n) > max_bytes_)
+        const ssize_t got = ::read(fd_, buf, n);
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0) throw InputError(path_ + ": cannot read " + what_ + ": " + std::strerror(errno));
+        read_ += static_cast<std::uint64_t>(got);
+        if (read_ > max_bytes_)
             throw InputError(path_ + ": " + what_ + " grew beyond the limit of " +
                              std::to_string(max_bytes_) + " bytes while it was read");
-        text.append(buf, static_cast<std::size_t>(n));
+        return static_cast<std::size_t>(got);
     }
+}
+
+std::string InputFile::read_all() {
+    std::string text;
+    text.reserve(static_cast<std::size_t>(size_ > read_ ? size_ - read_ : 0));
+    char buf[65536];
+    while (const std::size_t n = read_some(buf, sizeof buf)) text.append(buf, n);
     return text;
 }
 

@@ -25,13 +25,17 @@ public:
     std::uint64_t size() const { return size_; }
     // Hands the descriptor over (the caller closes it).
     int release();
-    // The whole file (throws InputError when reading fails or it has grown beyond the limit).
+    // The whole file, or the rest of it (throws InputError when reading fails or the file has
+    // grown beyond the limit).
     std::string read_all();
+    // Up to n bytes into buf; 0 at the end of the file (throws as read_all).
+    std::size_t read_some(char* buf, std::size_t n);
 
 private:
     std::string path_, what_;
     std::uint64_t max_bytes_;
     std::uint64_t size_ = 0;
+    std::uint64_t read_ = 0;  // bytes read so far
     int fd_ = -1;
 };
 
