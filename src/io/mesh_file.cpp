@@ -157,8 +157,13 @@ MeshData read_mesh_file(const std::string& path) {
     std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : "";
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     const bool ply = first.starts_with("ply") && (head == 3 || first[3] == '\n' || first[3] == '\r');
-    if (ply || ext == ".ply")  // a .ply that does not start so is told what is wrong with it
-        return parse_ply(std::string(first) + file.read_all(), path);
+    if (ply || ext == ".ply") {  // a .ply that does not start so is told what is wrong with it
+        std::string bytes;  // read whole, once: no second copy of a large file
+        bytes.reserve(static_cast<std::size_t>(file.size()));
+        bytes.append(first);
+        while (const std::size_t n = file.read_some(buf.data(), buf.size())) bytes.append(buf.data(), n);
+        return parse_ply(bytes, path);
+    }
     if (ext != ".obj")
         mesh_io::fail(path, "", "not a mesh file this program reads: OBJ (.obj) or PLY (a file "
                                 "that starts with 'ply')");
