@@ -20,7 +20,7 @@ FUZZ_HARNESSES := $(patsubst fuzz/%_fuzz.cpp,%,$(wildcard fuzz/*_fuzz.cpp))
 # g++ brings libasan and libubsan (through libgcc-12-dev). Open MPI: `lattice` under mpirun
 # (docs/distributed.md); the build works without it too.
 PACKAGES := cmake make g++ pkg-config libembree-dev libtbb-dev libpng-dev nlohmann-json3-dev \
-            libcli11-dev libopenexr-dev libassimp-dev libgtest-dev libgmock-dev libbenchmark-dev python3 \
+            libcli11-dev libopenexr-dev libgtest-dev libgmock-dev libbenchmark-dev python3 \
             libopenmpi-dev openmpi-bin
 # Only `make bench` plots (bench/plot_complexity.py): a target-specific value, inherited by its
 # prerequisites (build -> configure -> deps), so `make test` and `make demo` do not install it.

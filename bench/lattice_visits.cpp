@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
             limit = std::make_unique<tbb::global_control>(
                 tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
         const lat::Scene scene = lat::load_scene(scene_file);
-        const lat::TableCache cache(dir, true);
+        const lat::TableCache cache(dir);
         const lat::SceneLattices lattices = lat::scene_lattices(scene, cache, spec, false);
         Counts counts;
         std::vector<std::shared_ptr<const lat::Shape>> wrapped;

@@ -380,7 +380,7 @@ TEST(Coverage, AThinPrimitiveHasTheRightBrightness) {
     gt.spp = 64;
     const double exact = mean_brightness(render_image(RenderScene(s), gt).display);
     ASSERT_GT(exact, 2.0);
-    const TableCache cache(dir.path().string(), true);
+    const TableCache cache(dir.path().string());
     TableSpec spec;
     spec.encoding = "coverage";
     for (const LatticeFilter f : {LatticeFilter::kBox, LatticeFilter::kSmooth}) {
@@ -423,7 +423,7 @@ Image8 render_filtered(const std::string& text) {
     const std::string path = (dir.path() / "copies.json").string();
     std::ofstream(path) << text;
     const Scene s = load_scene(path);
-    const TableCache cache(dir.path().string(), true);
+    const TableCache cache(dir.path().string());
     TableSpec spec;
     spec.encoding = "coverage";
     const double spread = 2 * std::tan(22 * M_PI / 360.0) / 40;
@@ -539,7 +539,7 @@ SceneLattices levels_for(const test::TempDir& dir, const std::string& scene, dou
     const std::string path = (dir.path() / "near-and-far.json").string();
     std::ofstream(path) << scene;
     const Scene s = load_scene(path);
-    const TableCache cache(dir.path().string(), true);
+    const TableCache cache(dir.path().string());
     TableSpec spec;
     spec.encoding = "coverage";
     return scene_lattices(s, cache, spec, false,

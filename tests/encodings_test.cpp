@@ -240,7 +240,7 @@ const Scene& tori_scene() {
 // An image of s through `candidates` lattices.
 Image8 render_candidates(const Scene& s) {
     test::TempDir dir;
-    const TableCache cache(dir.path().string(), true);
+    const TableCache cache(dir.path().string());
     TableSpec spec;
     spec.encoding = "candidates";
     const SceneLattices l = scene_lattices(s, cache, spec, false);
@@ -383,7 +383,7 @@ TEST(EncodingCandidates, BuildsStopAtTheirMemoryBudget) {
 
 TEST(EncodingCandidates, PlatesRenderAsExact) {
     test::TempDir dir;
-    const TableCache cache(dir.path().string(), true);
+    const TableCache cache(dir.path().string());
     TableSpec spec;
     spec.encoding = "candidates";
     for (const char* plate : {"plate2-thistle", "plate4-fuzzy-sphere-1000"}) {

@@ -174,9 +174,10 @@ std::string read_error(const std::string& path) {
 TEST(ImagePng, MissingFile) {
     TempDir dir;
     EXPECT_EQ(read_error(dir.file("none.png")),
-              dir.file("none.png") + ": cannot read: No such file or directory");
+              dir.file("none.png") + ": cannot open PNG file: No such file or directory");
     EXPECT_EQ(read_error(dir.path().string()),
-              dir.path().string() + ": cannot read: Is a directory");
+              dir.path().string() + ": cannot open PNG file: it is a directory");
+    EXPECT_EQ(read_error("/dev/zero"), "/dev/zero: cannot open PNG file: it is a device, not a regular file");
 }
 
 TEST(ImagePng, NotAPng) {

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <vector>
 
@@ -113,8 +114,20 @@ bool ref_hit(const RefMesh& m, V o, V d, R tmin, R tmax, R& t, int& tri, R& bu, 
     return found;
 }
 
+// The unit shading normal of triangle `tri` at barycentrics (u, v), in world coordinates.
+using NormalAt = std::function<V(int tri, R u, R v)>;
+
+// Per-vertex normals blended, or flat faces (each triangle's own normal) when empty.
+NormalAt vertex_normals(const RefMesh& m, std::vector<V> normals) {
+    return [&m, normals = std::move(normals)](int tri, R u, R v) {
+        const auto& k = m.tri[tri];
+        if (normals.empty()) return unit(crossv(m.p[k[1]] - m.p[k[0]], m.p[k[2]] - m.p[k[0]]));
+        return unit((1 - u - v) * normals[k[0]] + u * normals[k[1]] + v * normals[k[2]]);
+    };
+}
+
 // The documented shading rule with the scene below: material m, ground z = 0 of material g.
-Image8 reference_image(const RefMesh& m, const std::vector<V>& normals, int w, int h) {
+Image8 reference_image(const RefMesh& m, const NormalAt& normal_at, int w, int h) {
     const V eye{3.2L, -4.5L, 2.6L}, look{0, 0, 0.6L}, up{0, 0, 1};
     const V W = unit(look - eye), U = unit(crossv(W, up)), Vv = crossv(U, W);
     const R th = std::tan(30.0L * M_PIl / 360), aspect = R(w) / h;
@@ -141,8 +154,7 @@ Image8 reference_image(const RefMesh& m, const std::vector<V>& normals, int w, i
                 V col = col_g;
                 R ks = 0.1L;
                 if (on_mesh) {
-                    const auto& k = m.tri[tri];
-                    n = unit((1 - bu - bv) * normals[k[0]] + bu * normals[k[1]] + bv * normals[k[2]]);
+                    n = normal_at(tri, bu, bv);
                     col = col_m;
                     ks = 0.5L;
                 }
@@ -168,20 +180,20 @@ Image8 reference_image(const RefMesh& m, const std::vector<V>& normals, int w, i
     return img;
 }
 
-// Assimp reads vertices as floats: the reference traces the same rounded vertices.
+// Vertices are read as floats: the reference traces the same rounded vertices.
 RefMesh float_vertices(RefMesh m) {
     for (V& p : m.p) p = {R(float(p.x)), R(float(p.y)), R(float(p.z))};
     return m;
 }
 
-std::string scene_json(const std::string& file) {
+std::string scene_json(const std::string& file, const std::string& mesh_fields = "") {
     return R"({
   "camera": {"eye": [3.2, -4.5, 2.6], "look_at": [0, 0, 0.6], "fov_y_deg": 30, "width": 160, "height": 120},
   "background": [0.1, 0.1, 0.2], "ambient": 1,
   "lights": [{"position": [4, -3, 6], "intensity": 0.8}, {"position": [-5, -4, 3], "intensity": 0.4}],
   "materials": {"m": {"color": [0.9, 0.6, 0.3], "ka": 0.1, "kd": 0.7, "ks": 0.5, "shininess": 20},
                 "g": {"color": [0.5, 0.6, 0.5], "ka": 0.1, "kd": 0.7, "ks": 0.1, "shininess": 20}},
-  "objects": [{"type": "mesh", "file": ")" + file + R"(", "material": "m"},
+  "objects": [{"type": "mesh", "file": ")" + file + R"(", "material": "m")" + mesh_fields + R"(},
               {"type": "halfspace", "normal": [0, 0, 1], "material": "g"}]})";
 }
 
@@ -205,25 +217,75 @@ TEST(Mesh, ObjWithNormalsMatchesBruteForceTracer) {
     const Image8 got = render_image(RenderScene(s), {}).display;
     std::vector<V> n;
     for (const V& x : m.n) n.push_back(unit(x));
-    expect_close(got, reference_image(float_vertices(m), n, 160, 120));
+    const RefMesh f = float_vertices(m);
+    expect_close(got, reference_image(f, vertex_normals(f, n), 160, 120));
 }
 
-TEST(Mesh, PlyWithoutNormalsUsesAreaWeightedNormals) {
+// Without normals in the file the faces are flat; with "smooth": true each vertex normal is the
+// sum of its faces' cross products.
+TEST(Mesh, PlyWithoutNormalsIsFlatUnlessSmooth) {
     const test::TempDir dir;
     const RefMesh m = torus_mesh(40, 20);
     test::spit(dir.file("torus.ply"), to_ply(m));
-    const std::string scene_path = dir.file("scene.json");
-    test::spit(scene_path, scene_json("torus.ply"));
-    const Scene s = load_scene(scene_path);
-    const Image8 got = render_image(RenderScene(s), {}).display;
-    // The documented rule: each vertex normal is the sum of its faces' cross products.
+    test::spit(dir.file("flat.json"), scene_json("torus.ply"));
+    test::spit(dir.file("smooth.json"), scene_json("torus.ply", R"(, "smooth": true)"));
+    const Image8 flat = render_image(RenderScene(load_scene(dir.file("flat.json"))), {}).display;
+    const Image8 smooth = render_image(RenderScene(load_scene(dir.file("smooth.json"))), {}).display;
     std::vector<V> n(m.p.size());
     for (const auto& t : m.tri) {
         const V f = crossv(m.p[t[1]] - m.p[t[0]], m.p[t[2]] - m.p[t[0]]);
         for (int k : t) n[k] = n[k] + f;
     }
     for (V& x : n) x = unit(x);
-    expect_close(got, reference_image(float_vertices(m), n, 160, 120));
+    const RefMesh f = float_vertices(m);
+    expect_close(flat, reference_image(f, vertex_normals(f, {}), 160, 120));
+    expect_close(smooth, reference_image(f, vertex_normals(f, n), 160, 120));
+    EXPECT_LT(compare_images(flat, smooth).psnr_db, 40.0);  // the two rules differ visibly
+}
+
+// Two objects in one OBJ over the same vertices, the first with normals and the second without,
+// under a non-uniform scale: the first is smooth (its unit normals blended in the mesh's own
+// coordinates, then carried by the inverse transpose), the second flat, as documented.
+TEST(Mesh, PerObjectNormalsUnderANonUniformScale) {
+    const test::TempDir dir;
+    const RefMesh m = torus_mesh(40, 20);
+    std::ostringstream o;
+    o.precision(17);
+    o << "o smooth\n";
+    for (const V& p : m.p) o << "v " << double(p.x) << ' ' << double(p.y) << ' ' << double(p.z) << '\n';
+    for (const V& n : m.n) o << "vn " << double(n.x) << ' ' << double(n.y) << ' ' << double(n.z) << '\n';
+    const std::size_t half = m.tri.size() / 2;
+    for (std::size_t t = 0; t < m.tri.size(); ++t) {
+        if (t == half) o << "o flat\n";
+        o << 'f';
+        for (int k : m.tri[t]) o << ' ' << k + 1 << (t < half ? "//" + std::to_string(k + 1) : "");
+        o << '\n';
+    }
+    test::spit(dir.file("two.obj"), o.str());
+    test::spit(dir.file("scene.json"),
+               scene_json("two.obj", R"(, "transform": [{"scale": [1.3, 0.8, 1.1]}, {"translate": [0.1, 0, -0.2]}])"));
+    const Scene scene = load_scene(dir.file("scene.json"));
+    const auto& mesh = dynamic_cast<const TriangleMeshShape&>(*scene.objects[0].shape);
+    for (const std::size_t t : {std::size_t{0}, half - 1, half, m.tri.size() - 1}) {
+        const Vec3 n = mesh.shading_normal(t, 0.2, 0.3), f = mesh.face_normal(t);
+        if (t < half)
+            EXPECT_GT(length(n - f), 1e-3) << "triangle " << t << " of the object with normals";
+        else
+            EXPECT_EQ(n, f) << "triangle " << t << " of the object without normals";
+    }
+    const Image8 got = render_image(RenderScene(scene), {}).display;
+
+    const V s{1.3L, 0.8L, 1.1L}, shift{0.1L, 0, -0.2L};
+    RefMesh world = float_vertices(m);
+    for (V& p : world.p) p = V{s.x * p.x, s.y * p.y, s.z * p.z} + shift;
+    const NormalAt normal_at = [&](int tri, R u, R v) {
+        const auto& k = world.tri[tri];
+        if (std::size_t(tri) >= half) return unit(crossv(world.p[k[1]] - world.p[k[0]], world.p[k[2]] - world.p[k[0]]));
+        const V a = unit(m.n[k[0]]), b = unit(m.n[k[1]]), c = unit(m.n[k[2]]);
+        const V blend = (1 - u - v) * a + u * b + v * c;
+        return unit(V{blend.x / s.x, blend.y / s.y, blend.z / s.z});
+    };
+    expect_close(got, reference_image(world, normal_at, 160, 120));
 }
 
 // A closed box mesh with per-face normals (so 24 vertices: closed by position, not by index).

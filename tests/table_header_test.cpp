@@ -152,7 +152,7 @@ TEST(TableCacheTest, StaleTemporariesAreRemoved) {
     const auto long_ago = std::filesystem::file_time_type::clock::now() - std::chrono::hours(2);
     std::filesystem::last_write_time(old_one, long_ago);
     std::filesystem::last_write_time(other, long_ago);
-    const TableCache cache(dir.path().string(), true);
+    const TableCache cache(dir.path().string());
     EXPECT_FALSE(std::filesystem::exists(old_one));
     EXPECT_TRUE(std::filesystem::exists(fresh));
     EXPECT_TRUE(std::filesystem::exists(other));  // not ours

@@ -74,8 +74,7 @@ int run_rasterize(const RasterizeArgs& a) {
     agree_on_scene(a.scene);
     dist::mark(dist::Step::kLoaded);
     if (path.empty()) {
-        const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir,
-                               !a.lattice_dir.empty(), true);
+        const TableCache cache(a.lattice_dir.empty() ? default_cache_dir() : a.lattice_dir, true);
         path = cache.path_for(*plan);
     }
     const ThreadLimit limit(a.threads);

@@ -45,14 +45,27 @@ nlohmann::json matrix(const Transform& xf) {
     return rows;
 }
 
-// Mesh files are named relative to the scene file: keep them found from the output's folder.
+// The folder a file named on the command line is in: "." for a bare name ("placed.json"), whose
+// parent_path() is empty and has no absolute form.
+fs::path folder_of(const std::string& file) {
+    const fs::path parent = fs::path(file).parent_path();
+    return parent.empty() ? fs::path(".") : parent;
+}
+
+// Mesh files are named relative to the scene file: keep them found from the output's folder
+// (by their absolute path when no relative one leads there).
 void move_mesh_paths(nlohmann::json& j, const fs::path& from, const fs::path& to) {
     if (j.is_array()) {
         for (auto& x : j) move_mesh_paths(x, from, to);
     } else if (j.is_object()) {
         if (j.value("type", "") == "mesh" && j.contains("file") && j["file"].is_string()) {
             const fs::path f = j["file"].get<std::string>();
-            if (f.is_relative()) j["file"] = fs::relative(fs::absolute(from / f), fs::absolute(to)).string();
+            if (f.is_relative()) {
+                std::error_code ec;
+                const fs::path target = fs::absolute(from / f, ec).lexically_normal();
+                const fs::path moved = fs::relative(target, fs::absolute(to, ec), ec);
+                j["file"] = (ec || moved.empty() ? target : moved).string();
+            }
         }
         for (auto& [k, v] : j.items()) move_mesh_paths(v, from, to);
     }
@@ -78,7 +91,7 @@ int run_scatter(const ScatterArgs& a) {
     for (std::size_t i = g.first; i < g.first + g.count; ++i)
         objects.push_back({{"type", "instance"}, {"primitive", primitive}, {"material", material},
                            {"transform", matrix(s.objects[i].xf)}});
-    move_mesh_paths(doc, fs::path(a.scene).parent_path(), fs::path(a.output).parent_path());
+    move_mesh_paths(doc, folder_of(a.scene), folder_of(a.output));
     write_json_file(a.output, doc);
     std::printf("%s: %zu instances of '%s'\n", a.output.c_str(), g.count, primitive.c_str());
     return 0;

@@ -81,16 +81,16 @@ int run(int argc, char** argv) {
         std::fprintf(stderr, "lattice: %s\n", e.what());
         return fail(e.exit_code());
     } catch (const lat::dist::JobInputError& e) {
-        if (e.print_here()) std::fprintf(stderr, "lattice: error: %s\n", e.what());
+        if (e.print_here()) std::fprintf(stderr, "lattice: error: %s\n", lat::message_line(e.what()).c_str());
         return 2;
     } catch (const lat::InputError& e) {
-        std::fprintf(stderr, "lattice: error: %s\n", e.what());
+        std::fprintf(stderr, "lattice: error: %s\n", lat::message_line(e.what()).c_str());
         return fail(2);
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr, "lattice: error: out of memory\n");
         return fail(3);
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "lattice: internal error: %s\n", e.what());
+        std::fprintf(stderr, "lattice: internal error: %s\n", lat::message_line(e.what()).c_str());
         return fail(1);
     }
     return 2;

@@ -24,13 +24,13 @@ bool intersect_triangle(const Ray& r, Vec3 a, Vec3 b, Vec3 c, double& t, double&
 }
 
 TriangleMeshShape::TriangleMeshShape(std::vector<Vec3> positions, std::vector<Triangle> triangles,
-                                     std::vector<Vec3> normals)
+                                     std::vector<Vec3> normals, bool smooth)
     : positions_(std::move(positions)), triangles_(std::move(triangles)),
       normals_(std::move(normals)) {
     for (const Triangle& t : triangles_)
         for (const std::uint32_t k : t) bounds_ = merge(bounds_, positions_[k]);
     check_closed();
-    compute_normals();
+    compute_normals(smooth);
     bvh_ = MeshBvh(positions_, triangles_);
 }
 
@@ -69,20 +69,25 @@ void TriangleMeshShape::check_closed() {
     flip_ = volume < 0;
 }
 
-// Area-weighted: the unnormalised cross product of each face adds to its three vertices.
-void TriangleMeshShape::compute_normals() {
-    const bool given = normals_.size() == positions_.size();
-    if (!given) normals_.assign(positions_.size(), Vec3{});
-    if (!given)
-        for (std::size_t i = 0; i < triangles_.size(); ++i) {
-            const Triangle& t = triangles_[i];
+// The file's normals made unit (zero stays zero: none). With `smooth`, a vertex without one
+// gets the area-weighted average: the unnormalised cross product of each face adds to its
+// three corners.
+void TriangleMeshShape::compute_normals(bool smooth) {
+    if (normals_.size() != positions_.size()) normals_.assign(smooth ? positions_.size() : 0, Vec3{});
+    if (smooth) {
+        std::vector<bool> given(normals_.size());
+        for (std::size_t k = 0; k < normals_.size(); ++k) given[k] = normals_[k] != Vec3{};
+        for (const Triangle& t : triangles_) {
             const Vec3 n = cross(positions_[t[1]] - positions_[t[0]], positions_[t[2]] - positions_[t[0]]);
-            for (const std::uint32_t k : t) normals_[k] += flip_ ? -n : n;
+            for (const std::uint32_t k : t)
+                if (!given[k]) normals_[k] += flip_ ? -n : n;
         }
+    }
     for (Vec3& n : normals_) {
         const double len = length(n);
-        n = len > 0 && std::isfinite(len) ? n / len : Vec3{};  // zero: fall back to the face
+        n = len > 0 && std::isfinite(len) ? n / len : Vec3{};
     }
+    if (std::all_of(normals_.begin(), normals_.end(), [](Vec3 n) { return n == Vec3{}; })) normals_.clear();
 }
 
 Vec3 TriangleMeshShape::face_normal(std::size_t tri) const {
@@ -96,7 +101,10 @@ Vec3 TriangleMeshShape::face_normal(std::size_t tri) const {
 Vec3 TriangleMeshShape::shading_normal(std::size_t tri, double u, double v) const {
     const Triangle& t = triangles_[tri];
     const Vec3 f = face_normal(tri);
-    Vec3 n = (1 - u - v) * normals_[t[0]] + u * normals_[t[1]] + v * normals_[t[2]];
+    if (normals_.empty()) return f;
+    const Vec3 a = normals_[t[0]], b = normals_[t[1]], c = normals_[t[2]];
+    if (a == Vec3{} || b == Vec3{} || c == Vec3{}) return f;
+    Vec3 n = (1 - u - v) * a + u * b + v * c;
     const double len = length(n);
     if (!(len > 1e-12)) return f;
     n = n / len;

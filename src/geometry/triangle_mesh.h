@@ -1,7 +1,8 @@
 #pragma once
-// A triangle mesh as a shape: traced exactly in double precision (Moller-Trumbore), shaded
-// smoothly with vertex normals (the file's, or area-weighted averages of the faces around each
-// vertex). Each triangle is one primitive, so the accelerator holds them one by one. A closed
+// A triangle mesh as a shape: traced exactly in double precision (Moller-Trumbore), shaded with
+// the file's vertex normals where a triangle has them at all three corners and with its face
+// normal elsewhere, so that creases stay sharp unless the file (or `smooth`: area-weighted
+// averages of the faces around each vertex) says otherwise. Each triangle is one primitive, so the accelerator holds them one by one. A closed
 // mesh (every edge shared by exactly two triangles, consistently oriented) is also a solid for
 // CSG, inside by ray parity; an open one is only a surface.
 #include <array>
@@ -22,15 +23,17 @@ bool intersect_triangle(const Ray& r, Vec3 a, Vec3 b, Vec3 c, double& t, double&
 class TriangleMeshShape final : public Shape {
 public:
     using Triangle = std::array<std::uint32_t, 3>;
-    // Inputs must be valid (finite, indices in range: io/mesh_file.h checks files); `normals`
-    // per vertex, or empty to compute them.
+    // Inputs must be valid (finite, indices in range: io/mesh_file.h checks files). `normals`:
+    // per vertex, zero where there is none, or empty for none at all. `smooth`: vertices without
+    // a normal get the area-weighted average of the faces that share them (by index).
     TriangleMeshShape(std::vector<Vec3> positions, std::vector<Triangle> triangles,
-                      std::vector<Vec3> normals = {});
+                      std::vector<Vec3> normals = {}, bool smooth = false);
 
     bool closed() const { return closed_; }
     const std::vector<Vec3>& positions() const { return positions_; }
     const std::vector<Triangle>& triangles() const { return triangles_; }
-    // The unit face normal (outward for a closed mesh) and the smooth normal at (u, v).
+    // The unit face normal (outward for a closed mesh) and the shading normal at (u, v): the
+    // blend of the three vertex normals, or the face normal where a corner has none.
     Vec3 face_normal(std::size_t tri) const;
     Vec3 shading_normal(std::size_t tri, double u, double v) const;
 
@@ -56,13 +59,13 @@ public:
 private:
     std::vector<Vec3> positions_;
     std::vector<Triangle> triangles_;
-    std::vector<Vec3> normals_;  // unit, per vertex
+    std::vector<Vec3> normals_;  // unit or zero (none), per vertex; empty: all none
     Bounds3 bounds_;
     MeshBvh bvh_;
     bool closed_ = false;
     bool flip_ = false;  // closed and wound inwards: face normals are turned to point out
 
-    void compute_normals();
+    void compute_normals(bool smooth);
     void check_closed();
 };
 

@@ -19,6 +19,7 @@
 #include "io/image.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/file.h"
 
 namespace lat {
 
@@ -27,6 +28,8 @@ namespace {
 // Largest PNG we read: 2^28 pixels (768 MB as 8-bit RGB), each side at most 2^20.
 constexpr std::uint32_t kMaxPngSide = 1u << 20;
 constexpr std::uint64_t kMaxPngPixels = std::uint64_t{1} << 28;
+// Files beyond 4 GiB: even 2^28 16-bit RGBA pixels stored raw take 2 GiB.
+constexpr std::uint64_t kMaxPngFileBytes = std::uint64_t{4} << 30;
 
 // Shared by libpng's callbacks and us; a plain struct, since callbacks run between setjmp and
 // longjmp.
@@ -184,8 +187,10 @@ void write_png(const std::string& path, const Image8& img) {
 }
 
 Image8 read_png(const std::string& path) {
-    std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+    InputFile input(path, "PNG file", kMaxPngFileBytes);
+    std::unique_ptr<std::FILE, FileCloser> file(::fdopen(input.fd(), "rb"));
     if (!file) throw_read_error(path, "cannot read: " + std::string(std::strerror(errno)));
+    input.release();  // the FILE owns it now
     png_byte signature[8] = {};
     const std::size_t got = std::fread(signature, 1, sizeof signature, file.get());
     if (std::ferror(file.get())) {

@@ -17,6 +17,7 @@
 #include "util/atomic_file.h"
 #include "util/big_buffer.h"
 #include "util/error.h"
+#include "util/file.h"
 #include "util/hash.h"
 
 namespace lat {
@@ -188,42 +189,25 @@ void write_table_file(const std::string& path, const TableHeader& h0,
 }
 
 TableHeader read_table_header(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY);
-    if (fd < 0) throw InputError(path + ": cannot open lattice table: " + std::strerror(errno));
-    struct stat st {};
+    InputFile file(path, "lattice table", kMaxTableFileBytes);
     std::uint8_t buf[kTableHeaderBytes] = {};
-    const bool ok = ::fstat(fd, &st) == 0;
-    const ssize_t got = ::pread(fd, buf, sizeof buf, 0);
-    if (!ok || got < 0) {
-        ::close(fd);
+    if (::pread(file.fd(), buf, sizeof buf, 0) < 0)
         throw InputError(path + ": cannot read lattice table");
-    }
     std::uint64_t checksum, meta;
-    TableHeader h;
-    try {
-        h = decode_header(buf, static_cast<std::size_t>(st.st_size), path, checksum, meta);
-    } catch (...) {
-        ::close(fd);
-        throw;
-    }
+    TableHeader h = decode_header(buf, static_cast<std::size_t>(file.size()), path, checksum, meta);
     h.metadata.resize(meta);
-    const ssize_t m = ::pread(fd, h.metadata.data(), meta, static_cast<off_t>(kTableHeaderBytes + h.payload_bytes));
-    ::close(fd);
+    const ssize_t m = ::pread(file.fd(), h.metadata.data(), meta,
+                              static_cast<off_t>(kTableHeaderBytes + h.payload_bytes));
     if (m != static_cast<ssize_t>(meta)) throw InputError(path + ": cannot read lattice table metadata");
     return h;
 }
 
 LoadedTable load_table_file(const std::string& path, const TableHeader* expected,
                             const Shape* primitive) {
-    const int fd = ::open(path.c_str(), O_RDONLY);
-    if (fd < 0) throw InputError(path + ": cannot open lattice table: " + std::strerror(errno));
-    struct stat st {};
-    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        ::close(fd);
-        throw InputError(path + ": cannot open lattice table: not a regular file");
-    }
+    InputFile file(path, "lattice table", kMaxTableFileBytes);
+    const int fd = file.release();
     auto m = std::make_shared<Mapping>();
-    m->size = static_cast<std::size_t>(st.st_size);
+    m->size = static_cast<std::size_t>(file.size());
     if (m->size >= Mapping::kCopyAbove) {
         const bool ok = read_whole(fd, *m);
         const int err = errno;

@@ -39,6 +39,9 @@ struct TableHeader {
 
 inline constexpr std::uint32_t kTableFormatVersion = 1;
 inline constexpr std::size_t kTableHeaderBytes = 128;
+// Larger files are refused before reading: the largest tables the renderer builds are a few
+// GB, and a table is held in memory whole.
+inline constexpr std::uint64_t kMaxTableFileBytes = std::uint64_t{64} << 30;
 
 // Writes atomically (temporary file + rename); throws InputError naming the path.
 void write_table_file(const std::string& path, const TableHeader& h,

@@ -102,7 +102,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
                 std::optional<TableCache> cache;
                 if (filtering->policy != LatticePolicy::kFootprint)
                     cache.emplace(settings.lattice_dir.empty() ? default_cache_dir() : settings.lattice_dir,
-                                  !settings.lattice_dir.empty(), opt.across_ranks);
+                                  opt.across_ranks);
                 // Sub-rays read no table: the lattice box at sigma^-1 = 1 frames their culling.
                 const TableSpec spec = cache ? settings.spec : TableSpec{1, std::string(coverage_encoding().name), {}};
                 r.lattices = scene_lattices(scene, cache ? &*cache : nullptr, spec,

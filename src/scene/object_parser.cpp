@@ -140,8 +140,8 @@ ObjectParser::Leaf ObjectParser::parse_leaf(const JsonValue& v, const std::strin
         return placed(make_algebraic(parse_quartic_polynomial(v), Bounds3::infinite()));
     }
     if (type == "mesh") {
-        keys({"file"});
-        return {mesh(v.at("file")), Transform{}, -1};
+        keys({"file", "smooth"});
+        return {mesh(v), Transform{}, -1};
     }
     if (type == "instance") {
         keys({"primitive"});
@@ -213,17 +213,20 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
     return csg.add_leaf({leaf.shape, placed, mat, leaf.primitive});
 }
 
-std::shared_ptr<const TriangleMeshShape> ObjectParser::mesh(const JsonValue& file) const {
+std::shared_ptr<const TriangleMeshShape> ObjectParser::mesh(const JsonValue& object) const {
+    const JsonValue file = object.at("file");
+    const bool smooth = object.has("smooth") && object.at("smooth").boolean();
     const std::filesystem::path name(file.string());
     const std::string path = name.is_absolute() || file.file().empty()
                                  ? name.string()
                                  : (std::filesystem::path(file.file()).parent_path() / name).string();
-    if (auto it = meshes_.find(path); it != meshes_.end()) return it->second;
+    const std::string key = (smooth ? "smooth:" : "file:") + path;
+    if (auto it = meshes_.find(key); it != meshes_.end()) return it->second;
     try {
         MeshData m = read_mesh_file(path);
         auto shape = std::make_shared<const TriangleMeshShape>(
-            std::move(m.positions), std::move(m.triangles), std::move(m.normals));
-        meshes_[path] = shape;
+            std::move(m.positions), std::move(m.triangles), std::move(m.normals), smooth);
+        meshes_[key] = shape;
         return shape;
     } catch (const InputError& e) {
         file.fail(e.what());

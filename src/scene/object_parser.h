@@ -27,14 +27,15 @@ public:
     std::shared_ptr<const Shape> parse_shape(const JsonValue& v) const;
     // The index of the material named by v.
     std::uint32_t material_index(const JsonValue& v) const { return material(v); }
-    // The mesh named by a "file" field, relative to the scene file's directory.
-    std::shared_ptr<const TriangleMeshShape> mesh(const JsonValue& file) const;
+    // The mesh of a mesh object: its "file" (relative to the scene file's directory), shaded as
+    // its "smooth" says.
+    std::shared_ptr<const TriangleMeshShape> mesh(const JsonValue& object) const;
 
 private:
     const std::map<std::string, std::uint32_t>& materials_;
     const std::vector<Primitive>& primitives_;
 
-    // Meshes by resolved path, read once per scene however often they are used.
+    // Meshes by resolved path (and smoothing), read once per scene however often they are used.
     mutable std::map<std::string, std::shared_ptr<const TriangleMeshShape>> meshes_;
 
     std::uint32_t material(const JsonValue& v) const;

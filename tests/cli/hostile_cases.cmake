@@ -68,6 +68,42 @@ elseif(CASE STREQUAL "sigint")
     endif()
   endforeach()
   expect_only()
+elseif(CASE STREQUAL "special_paths")
+  # A FIFO, a device or a directory where a file is expected is refused before anything
+  # blocks on it or reads without end: as the scene, a mesh, a PNG, a table.
+  execute_process(COMMAND mkfifo ${WORK}/fifo.json ${WORK}/fifo.obj RESULT_VARIABLE made)
+  if(NOT made EQUAL 0)
+    message(FATAL_ERROR "mkfifo failed")
+  endif()
+  run(2 "fifo.json: cannot open scene file: it is a FIFO, not a regular file"
+      ${LATTICE} render -q ${WORK}/fifo.json -o ${WORK}/x.png)
+  run(2 "/dev/zero: cannot open scene file: it is a device, not a regular file"
+      ${LATTICE} render -q /dev/zero -o ${WORK}/x.png)
+  run(2 "fifo.json: cannot open PNG file: it is a FIFO" ${LATTICE} compare ${WORK}/fifo.json ${WORK}/fifo.json)
+  run(2 "fifo.json: cannot open lattice table: it is a FIFO" ${LATTICE} inspect ${WORK}/fifo.json)
+  foreach(mesh fifo.obj /dev/zero ${WORK})
+    file(WRITE ${WORK}/scene.json "{\"camera\": {\"eye\": [0, -5, 0], \"look_at\": [0, 0, 0], "
+         "\"fov_y_deg\": 30, \"width\": 8, \"height\": 8}, \"materials\": {\"a\": {}},\n"
+         "\"objects\": [{\"type\": \"mesh\", \"file\": \"${mesh}\", \"material\": \"a\"}]}\n")
+    run(2 "scene.json: objects\\[0\\]\\.file: .*: cannot open mesh file: it is a (FIFO|device|directory)"
+        ${LATTICE} render -q ${WORK}/scene.json -o ${WORK}/x.png)
+  endforeach()
+  # An OBJ's material files are never opened: a FIFO named by mtllib is no matter.
+  file(WRITE ${WORK}/tri.obj "mtllib fifo.obj\nusemtl x\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n")
+  file(READ ${WORK}/scene.json text)
+  string(REPLACE "${WORK}" "tri.obj" text "${text}")
+  file(WRITE ${WORK}/scene.json "${text}")
+  run(0 "" ${LATTICE} render -q ${WORK}/scene.json -o ${WORK}/x.png)
+elseif(CASE STREQUAL "scatter_bare_output")
+  # `lattice scatter SCENE -o placed.json`, a bare name in the working directory, with a mesh in
+  # the scene: the mesh path is rewritten relative to the output and the result renders.
+  execute_process(COMMAND ${LATTICE} scatter ${DATA}/scatter-mesh-good.json -o placed.json
+                  WORKING_DIRECTORY ${WORK} RESULT_VARIABLE code ERROR_VARIABLE err)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "scatter -o placed.json: exit code ${code}\n${err}")
+  endif()
+  run(0 "" ${LATTICE} render -q ${WORK}/placed.json -o ${WORK}/x.png)
+  expect_only(placed.json x.png)
 else()
   message(FATAL_ERROR "unknown case ${CASE}")
 endif()

@@ -25,29 +25,26 @@ std::string default_cache_dir() {
     return ".lattice-cache";
 }
 
-TableCache::TableCache(const std::string& dir, bool explicit_dir, bool across_ranks)
+TableCache::TableCache(const std::string& dir, bool across_ranks)
     : dir_(dir), across_ranks_(across_ranks && dist::distributed()) {
     if (!across_ranks_) {
-        open_dir(explicit_dir);
+        open_dir();
         remove_stale_temporaries();
         return;
     }
-    // Rank 0 first, so that only it creates a missing default directory.
+    // Rank 0 first, so that only it creates a missing directory.
     dist::on_root([&] {
-        open_dir(explicit_dir);
+        open_dir();
         remove_stale_temporaries();
     });
     dist::agree([&] {
-        if (!dist::is_root()) open_dir(explicit_dir);
+        if (!dist::is_root()) open_dir();
     });
 }
 
-void TableCache::open_dir(bool explicit_dir) const {
+void TableCache::open_dir() const {
     struct stat st {};
     if (::stat(dir_.c_str(), &st) != 0) {
-        if (explicit_dir)
-            throw InputError(dir_ +
-                             ": lattice cache directory does not exist: " + std::strerror(errno));
         std::error_code ec;
         std::filesystem::create_directories(dir_, ec);
         if (ec)

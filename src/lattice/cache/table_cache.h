@@ -15,12 +15,12 @@ std::string default_cache_dir();
 
 class TableCache {
 public:
-    // An explicit directory must exist and be writable; the default one is created.
+    // The directory (given or the default) is created when missing and must be writable.
     // across_ranks (collective, in an MPI job): every rank opens the cache and gets the same
     // tables in the same order; a missing table is built once, by all ranks together
     // (rasterized across them, encoded and written by rank 0), and every rank then maps the
     // file, so the directory must be one that all ranks share.
-    TableCache(const std::string& dir, bool explicit_dir, bool across_ranks = false);
+    explicit TableCache(const std::string& dir, bool across_ranks = false);
 
     const std::string& dir() const { return dir_; }
     std::string path_for(const TablePlan& plan) const;
@@ -46,7 +46,7 @@ private:
     std::string dir_;
     bool across_ranks_ = false;
 
-    void open_dir(bool explicit_dir) const;
+    void open_dir() const;
     void remove_stale_temporaries() const;
     void load(const TablePlan& plan, Entry& e) const;
 };
