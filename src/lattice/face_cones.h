@@ -47,6 +47,14 @@ std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double gro
 void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& u0, int& u1,
                      int& v0, int& v1);
 
+// The rows of face f that can hold exits of segments from p that meet the sphere s: [v0, v1],
+// false when none. A superset of the rows where cone_row finds an interval (padded far beyond
+// its rounding), found without visiting them: a sphere wholly behind p's plane parallel to the
+// face is never met on the way to it, and a sphere wholly in front of it casts an ellipse,
+// whose rows are the roots of a quadratic. A sphere that straddles that plane gets every row.
+// The one exit it may drop is p itself (p on the face, the sphere off its plane).
+bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0, int& v1);
+
 // Row v of face f: the u-interval of exits q whose segment from p can meet the sphere s, i.e.
 // q inside the cone from p around the sphere. Conservative (padded against rounding); false
 // for an empty interval.
@@ -81,9 +89,11 @@ inline bool cone_row(const Vec3& p, const PartSphere& s, const FaceLayout& f, in
 // visit(k, q) with k the point's index in the face and q its lattice coordinates.
 template <class Visit>
 void for_each_exit_in_cone(const Vec3& p, const PartSphere& ps, const FaceLayout& fl, Visit&& visit) {
-    int u0, u1, v0, v1;
+    int u0, u1, v0, v1, c0, c1;
+    if (!cone_rows(p, ps, fl, c0, c1)) return;
     const Vec3 rr{ps.r, ps.r, ps.r};
     projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
+    v0 = std::max(v0, c0), v1 = std::min(v1, c1);
     for (int v = v0; v <= v1; ++v) {
         double ulo, uhi;
         if (!cone_row(p, ps, fl, v, ulo, uhi)) continue;
