@@ -58,14 +58,14 @@ bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0,
     const double wax = s.c[ax] - p[ax], wva = s.c[va] - p[va];
     const double margin = 1e-6 * (s.r + std::abs(wax) + std::abs(wva)) + 1e-9;
     // p in the face's plane: segments in that plane meet only a sphere that reaches it (else
-    // cone_row finds p itself alone, which pairs with nothing).
+    // ConeRows finds p itself alone, which pairs with nothing).
     if (da == 0) return std::abs(wax) <= s.r + margin;
     const double ahead = da > 0 ? wax : -wax;  // how far the centre lies towards the face
     if (ahead + s.r < -margin) return false;    // wholly behind
     if (ahead - s.r <= margin) return true;     // straddles: the whole face
     // Exits at row offset dv = v - p_v meet the cone where
     // (r^2 - wax^2) dv^2 + 2 da wax wva dv + (r^2 - wva^2) da^2 >= 0 (the row's discriminant
-    // in cone_row over |w|^2 - r^2); with |wax| > r the leading coefficient is negative.
+    // in ConeRows::row over |w|^2 - r^2); with |wax| > r the leading coefficient is negative.
     const double a2 = s.r * s.r - wax * wax;
     const double h = std::abs(da) * s.r * std::sqrt(wax * wax + wva * wva - s.r * s.r);
     const double b = -da * wax * wva;
