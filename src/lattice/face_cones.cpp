@@ -34,15 +34,21 @@ void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& 
                va = static_cast<std::size_t>(f.va);
     const double num = f.level - p[ax];
     if (num == 0) return;
+    // A corner's projection along u (v) depends on its coordinates along the face's axis and
+    // u (v) alone: the eight corners give two scales and four values each way.
+    const double den[2] = {b.lo[ax] - p[ax], b.hi[ax] - p[ax]};
+    if (den[0] * num <= 0 || den[1] * num <= 0) return;
     double umin = kInfinity, umax = -kInfinity, vmin = kInfinity, vmax = -kInfinity;
-    for (int k = 0; k < 8; ++k) {
-        const Vec3 c = b.corner(k);
-        const double den = c[ax] - p[ax];
-        if (den * num <= 0) return;
-        const double s = num / den;
-        const double u = p[ua] + s * (c[ua] - p[ua]), v = p[va] + s * (c[va] - p[va]);
-        umin = std::min(umin, u), umax = std::max(umax, u);
-        vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+    for (const double d : den) {
+        const double s = num / d;
+        for (const double cu : {b.lo[ua], b.hi[ua]}) {
+            const double u = p[ua] + s * (cu - p[ua]);
+            umin = std::min(umin, u), umax = std::max(umax, u);
+        }
+        for (const double cv : {b.lo[va], b.hi[va]}) {
+            const double v = p[va] + s * (cv - p[va]);
+            vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+        }
     }
     const double eps = 1e-9;
     u0 = static_cast<int>(std::ceil(std::max(umin - eps, double(u0))));
