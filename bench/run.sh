@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # make bench: runs every bench/*_bench program, writes bench/results/<name>.json (Google
 # Benchmark's JSON) and bench/results/summary.md (a readable table of all of them), then the
-# rasterize, encodings, complexity, independent-tracer and modes benchmarks through the lattice command
+# encodings, complexity, independent-tracer and modes benchmarks through the lattice command
 # (and docs/images/complexity.png).
 set -euo pipefail
 build=${1:-build}
@@ -14,7 +14,7 @@ for exe in "$build"/bin/*_bench; do
   "$exe" --benchmark_out="$out/$name.json" --benchmark_out_format=json \
          --benchmark_counters_tabular=true
 done
-echo "== rasterize (pairs/s of the whole lattice rasterize command)"
+echo "== rasterize (pairs/s of the whole lattice rasterize command; its table joins the summary)"
 python3 "$here/rasterize.py" "$build/bin/lattice" "$out" > "$out/rasterize.md"
 echo "== encodings (through the lattice command)"
 python3 "$here/encodings.py" "$build/bin/lattice" "$out" > "$out/encodings.md"
@@ -36,7 +36,8 @@ fi
 # (pyenv, a virtualenv) comes first in PATH.
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 "$py" "$here/plot_complexity.py" "$out/complexity.json" "$here/../docs/images/complexity.png"
-{ python3 "$here/summarize.py" "$out"; cat "$out/rasterize.md" "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/modes.md" "$out/scatter.md" "$out/distributed.md"; } > "$out/summary.md"
+{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/modes.md" "$out/scatter.md" "$out/distributed.md"; } > "$out/summary.md"
 echo
+cat "$out/rasterize.md" >> "$out/summary.md"
 cat "$out/summary.md"
 echo "results: $out"
