@@ -14,6 +14,8 @@ for exe in "$build"/bin/*_bench; do
   "$exe" --benchmark_out="$out/$name.json" --benchmark_out_format=json \
          --benchmark_counters_tabular=true
 done
+echo "== rasterize (pairs/s of the whole lattice rasterize command; its table joins the summary)"
+python3 "$here/rasterize.py" "$build/bin/lattice" "$out" > "$out/rasterize.md"
 echo "== encodings (through the lattice command)"
 python3 "$here/encodings.py" "$build/bin/lattice" "$out" > "$out/encodings.md"
 echo "== complexity (exact against lattice mode as the primitive grows; docs/complexity.md)"
@@ -38,5 +40,6 @@ py=/usr/bin/python3; [ -x "$py" ] || py=python3
 "$py" "$here/plot_complexity.py" "$out/complexity.json" "$here/../docs/images/complexity.png"
 { python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/modes.md" "$out/samplers.md" "$out/scatter.md" "$out/distributed.md"; } > "$out/summary.md"
 echo
+cat "$out/rasterize.md" >> "$out/summary.md"
 cat "$out/summary.md"
 echo "results: $out"

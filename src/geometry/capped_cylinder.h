@@ -5,6 +5,8 @@ namespace lat {
 
 struct RayQuad;
 struct QuadCrossings;
+struct RayFan;
+struct FanHits;
 
 // A finite cylinder of radius r whose axis runs from a to b, with flat ends.
 // Crossing::part: 0 the side, 1 the end at a, 2 the end at b.
@@ -29,6 +31,9 @@ public:
     // and their tmax narrowed to them; and the lanes in `live` that occluded() blocks.
     unsigned intersect_quad(RayQuad& q, unsigned live, QuadCrossings& hits) const;
     unsigned occluded_quad(const RayQuad& q, unsigned live) const;
+    // Two rays from one origin at once (geometry/ray_fan.h): the lanes (bits 0, 1) that
+    // intersect() finds a crossing for, and their crossings in out, as the scalar test's.
+    unsigned intersect_fan(const RayFan& f, FanHits& out) const;
 
 private:
     Vec3 a_, b_, axis_;  // axis_ is the unit vector from a to b

@@ -55,6 +55,12 @@ public:
         if (found) hit.part = static_cast<std::uint32_t>(i << 2) | hit.part;
         return found;
     }
+    // Part i against two rays from one origin (geometry/ray_fan.h): the lanes (bits 0, 1) that
+    // intersect_primitive finds a crossing for, with the part's own surface number in out.part.
+    unsigned intersect_fan(std::size_t i, const RayFan& f, FanHits& out) const {
+        return i < sphere_parts_.size() ? sphere_parts_[i].intersect_fan(f, out)
+                                        : cyl_parts_[i - sphere_parts_.size()].intersect_fan(f, out);
+    }
     void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
     void primitive_spans(std::size_t i, const Ray& r, SpanList& out) const override;
     // Spheres are capsules; so is the flat-ended cylinder's rim, within r of its axis segment.

@@ -5,6 +5,8 @@ namespace lat {
 
 struct RayQuad;
 struct QuadCrossings;
+struct RayFan;
+struct FanHits;
 
 class SphereShape final : public Shape {
 public:
@@ -29,6 +31,9 @@ public:
     // and their tmax narrowed to them; and the lanes in `live` that occluded() blocks.
     unsigned intersect_quad(RayQuad& q, unsigned live, QuadCrossings& hits) const;
     unsigned occluded_quad(const RayQuad& q, unsigned live) const;
+    // Two rays from one origin at once (geometry/ray_fan.h): the lanes (bits 0, 1) that
+    // intersect() finds a crossing for, and their crossings in out, as the scalar test's.
+    unsigned intersect_fan(const RayFan& f, FanHits& out) const;
 
 private:
     Vec3 c_;

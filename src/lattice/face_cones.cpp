@@ -34,21 +34,55 @@ void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& 
                va = static_cast<std::size_t>(f.va);
     const double num = f.level - p[ax];
     if (num == 0) return;
+    // A corner's projection along u (v) depends on its coordinates along the face's axis and
+    // u (v) alone: the eight corners give two scales and four values each way.
+    const double den[2] = {b.lo[ax] - p[ax], b.hi[ax] - p[ax]};
+    if (den[0] * num <= 0 || den[1] * num <= 0) return;
     double umin = kInfinity, umax = -kInfinity, vmin = kInfinity, vmax = -kInfinity;
-    for (int k = 0; k < 8; ++k) {
-        const Vec3 c = b.corner(k);
-        const double den = c[ax] - p[ax];
-        if (den * num <= 0) return;
-        const double s = num / den;
-        const double u = p[ua] + s * (c[ua] - p[ua]), v = p[va] + s * (c[va] - p[va]);
-        umin = std::min(umin, u), umax = std::max(umax, u);
-        vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+    for (const double d : den) {
+        const double s = num / d;
+        for (const double cu : {b.lo[ua], b.hi[ua]}) {
+            const double u = p[ua] + s * (cu - p[ua]);
+            umin = std::min(umin, u), umax = std::max(umax, u);
+        }
+        for (const double cv : {b.lo[va], b.hi[va]}) {
+            const double v = p[va] + s * (cv - p[va]);
+            vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+        }
     }
     const double eps = 1e-9;
     u0 = static_cast<int>(std::ceil(std::max(umin - eps, double(u0))));
     u1 = static_cast<int>(std::floor(std::min(umax + eps, double(u1))));
     v0 = static_cast<int>(std::ceil(std::max(vmin - eps, double(v0))));
     v1 = static_cast<int>(std::floor(std::min(vmax + eps, double(v1))));
+}
+
+bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0, int& v1) {
+    v0 = 0, v1 = f.nv - 1;
+    const auto ax = static_cast<std::size_t>(f.axis), va = static_cast<std::size_t>(f.va);
+    const double da = f.level - p[ax];
+    const double wax = s.c[ax] - p[ax], wva = s.c[va] - p[va];
+    const double margin = 1e-6 * (s.r + std::abs(wax) + std::abs(wva)) + 1e-9;
+    // p in the face's plane: segments in that plane meet only a sphere that reaches it (else
+    // ConeRows finds p itself alone, which pairs with nothing).
+    if (da == 0) return std::abs(wax) <= s.r + margin;
+    const double ahead = da > 0 ? wax : -wax;  // how far the centre lies towards the face
+    if (ahead + s.r < -margin) return false;    // wholly behind
+    if (ahead - s.r <= margin) return true;     // straddles: the whole face
+    // Exits at row offset dv = v - p_v meet the cone where
+    // (r^2 - wax^2) dv^2 + 2 da wax wva dv + (r^2 - wva^2) da^2 >= 0 (the row's discriminant
+    // in ConeRows::row over |w|^2 - r^2); with |wax| > r the leading coefficient is negative.
+    const double a2 = s.r * s.r - wax * wax;
+    const double h = std::abs(da) * s.r * std::sqrt(wax * wax + wva * wva - s.r * s.r);
+    const double b = -da * wax * wva;
+    const double r0 = (b + h) / a2, r1 = (b - h) / a2;  // r0 <= r1 since a2 < 0
+    const double pad = 1e-6 * (1 + std::abs(r0) + std::abs(r1) + std::abs(da));
+    const double lo = p[va] + r0 - pad, hi = p[va] + r1 + pad;
+    // Clamp in double first: the rows may lie far off the face.
+    if (!(lo <= v1) || !(hi >= v0)) return false;
+    v0 = static_cast<int>(std::ceil(std::max(lo, double(v0))));
+    v1 = static_cast<int>(std::floor(std::min(hi, double(v1))));
+    return v0 <= v1;
 }
 
 std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double grow, double rel_pad) {

@@ -47,46 +47,73 @@ std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double gro
 void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& u0, int& u1,
                      int& v0, int& v1);
 
-// Row v of face f: the u-interval of exits q whose segment from p can meet the sphere s, i.e.
-// q inside the cone from p around the sphere. Conservative (padded against rounding); false
-// for an empty interval.
+// The rows of face f that can hold exits of segments from p that meet the sphere s: [v0, v1],
+// false when none. A superset of the rows where ConeRows::row finds an interval (padded far beyond
+// its rounding), found without visiting them: a sphere wholly behind p's plane parallel to the
+// face is never met on the way to it, and a sphere wholly in front of it casts an ellipse,
+// whose rows are the roots of a quadratic. A sphere that straddles that plane gets every row.
+// The one exit it may drop is p itself (p on the face, the sphere off its plane).
+bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0, int& v1);
+
+// The cone from p around the sphere s, cut by the rows of face f: row(v) is the u-interval of
+// exits q whose segment from p can meet the sphere, i.e. q inside the cone. Conservative
+// (padded against rounding); false for an empty interval. What does not depend on the row is
+// worked out once (the same operations on the same values: the same intervals).
 // (Inline: the rasterizer's hottest culling step.)
-inline bool cone_row(const Vec3& p, const PartSphere& s, const FaceLayout& f, int v, double& ulo,
-                     double& uhi) {
-    const auto ax = static_cast<std::size_t>(f.axis), ua = static_cast<std::size_t>(f.ua),
-               va = static_cast<std::size_t>(f.va);
-    const Vec3 w = s.c - p;
-    const double k = length_squared(w) - s.r * s.r;
-    const double da = f.level - p[ax], dv = v - p[va];
-    const double alpha = da * w[ax] + dv * w[va], beta = w[ua];
-    const double gamma = da * da + dv * dv;
-    // g(u') = (alpha + beta u')^2 - k (gamma + u'^2) >= 0 with alpha + beta u' >= 0, u' = u - p_u.
-    const double A = beta * beta - k, B = alpha * beta, C = alpha * alpha - k * gamma;
-    if (k <= 0 || A >= 0) {  // p inside the sphere, or the cone opens along u: the whole row
-        ulo = -kInfinity, uhi = kInfinity;
+class ConeRows {
+public:
+    ConeRows(const Vec3& p, const PartSphere& s, const FaceLayout& f)
+        : ua_(static_cast<std::size_t>(f.ua)), va_(static_cast<std::size_t>(f.va)), p_(p), w_(s.c - p) {
+        const auto ax = static_cast<std::size_t>(f.axis);
+        k_ = length_squared(w_) - s.r * s.r;
+        da_ = f.level - p[ax];
+        alpha0_ = da_ * w_[ax];
+        beta_ = w_[ua_];
+        da2_ = da_ * da_;
+        A_ = beta_ * beta_ - k_;
+        whole_ = k_ <= 0 || A_ >= 0;  // p inside the sphere, or the cone opens along u
+    }
+    bool row(int v, double& ulo, double& uhi) const {
+        if (whole_) {
+            ulo = -kInfinity, uhi = kInfinity;
+            return true;
+        }
+        const double dv = v - p_[va_];
+        const double alpha = alpha0_ + dv * w_[va_];
+        const double gamma = da2_ + dv * dv;
+        // g(u') = (alpha + beta u')^2 - k (gamma + u'^2) >= 0 with alpha + beta u' >= 0, u' = u - p_u.
+        const double B = alpha * beta_, C = alpha * alpha - k_ * gamma;
+        const double disc = B * B - A_ * C;
+        if (disc < 0) return false;
+        const double sq = std::sqrt(disc);
+        const double r0 = (-B + sq) / A_, r1 = (-B - sq) / A_;  // r0 <= r1 since A < 0
+        if (alpha + beta_ * 0.5 * (r0 + r1) < 0) return false;  // the cone's far nappe
+        const double pad = 1e-7 * (1 + std::abs(r0) + std::abs(r1));
+        ulo = p_[ua_] + r0 - pad;
+        uhi = p_[ua_] + r1 + pad;
         return true;
     }
-    const double disc = B * B - A * C;
-    if (disc < 0) return false;
-    const double sq = std::sqrt(disc);
-    const double r0 = (-B + sq) / A, r1 = (-B - sq) / A;  // r0 <= r1 since A < 0
-    if (alpha + beta * 0.5 * (r0 + r1) < 0) return false;  // the cone's far nappe
-    const double pad = 1e-7 * (1 + std::abs(r0) + std::abs(r1));
-    ulo = p[ua] + r0 - pad;
-    uhi = p[ua] + r1 + pad;
-    return true;
-}
+
+private:
+    std::size_t ua_, va_;
+    Vec3 p_, w_;
+    double k_, da_, alpha0_, beta_, da2_, A_;
+    bool whole_;
+};
 
 // Every canonical exit point of face fl inside the cone from p around the sphere ps: calls
 // visit(k, q) with k the point's index in the face and q its lattice coordinates.
 template <class Visit>
 void for_each_exit_in_cone(const Vec3& p, const PartSphere& ps, const FaceLayout& fl, Visit&& visit) {
-    int u0, u1, v0, v1;
+    int u0, u1, v0, v1, c0, c1;
+    if (!cone_rows(p, ps, fl, c0, c1)) return;
     const Vec3 rr{ps.r, ps.r, ps.r};
     projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
+    v0 = std::max(v0, c0), v1 = std::min(v1, c1);
+    const ConeRows cone(p, ps, fl);
     for (int v = v0; v <= v1; ++v) {
         double ulo, uhi;
-        if (!cone_row(p, ps, fl, v, ulo, uhi)) continue;
+        if (!cone.row(v, ulo, uhi)) continue;
         // Clamp in double first: the interval may be unbounded or huge.
         const int ub = static_cast<int>(std::ceil(std::max(ulo, double(u0))));
         const int ue = static_cast<int>(std::floor(std::min(uhi, double(u1))));

@@ -7,12 +7,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 #include "dist/deal.h"
 #include "dist/job.h"
 #include "dist/message.h"
 #include "dist/timeline.h"
 #include "geometry/chain.h"
+#include "geometry/ray_fan.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/face_cones.h"
 #include "lattice/octahedral.h"
@@ -76,6 +78,11 @@ struct Scratch {
     std::vector<std::uint32_t> tested;  // generation of the last part tested at each point
     std::uint32_t generation = 0;
     std::vector<std::size_t> touched;  // face points with a hit, to emit and reset
+    struct Exit {
+        std::size_t k;
+        Vec3 q;
+    };
+    std::vector<Exit> batch;  // exits in the cones of one part, to test against it
     HitArena arena;
 };
 
@@ -159,29 +166,69 @@ private:
         }
     }
 
-    // The closest hit of every segment from p to face fl, culled per part by its cones.
+    // The closest hit of every segment from p to face fl, culled per part by its cones: the
+    // exits in any cone of a part are gathered (each once), then tested against it.
     template <class S>
     void trace_face(const S& shape, const Vec3& p, const FaceLayout& fl, Scratch& s, Counts& cnt) const {
         std::uint32_t last_part = ~0u;
+        s.batch.clear();
         for (const PartSphere& ps : spheres_) {
             if (ps.part != last_part) {
+                test_batch(shape, p, last_part, s, cnt);
                 last_part = ps.part;
-                ++s.generation;  // marks "tested for this part" in s.tested
+                ++s.generation;  // marks "gathered for this part" in s.tested
             }
             for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
                 if (s.tested[k] == s.generation) return;
                 s.tested[k] = s.generation;
-                const Ray r{p * h_, (q - p) * h_};
-                Crossing c;
-                ++cnt.tests;
-                const double tmax = std::min(s.best_t[k], 1.0 + 1e-12);
-                if (shape.intersect_primitive(ps.part, r, 0.0, tmax, c)) {
-                    if (s.best_t[k] == kInfinity) s.touched.push_back(k);
-                    s.best_t[k] = c.t;
-                    s.best_c[k] = c;
-                }
+                s.batch.push_back({k, q});
             });
         }
+        test_batch(shape, p, last_part, s, cnt);
+    }
+
+    // Each gathered exit's segment from p against the part, keeping the closest hit (ties to
+    // the earlier part: only a crossing before the best so far counts). Every exit appears
+    // once, so the order of the tests does not matter.
+    template <class S>
+    void test_batch(const S& shape, const Vec3& p, std::uint32_t part, Scratch& s, Counts& cnt) const {
+        cnt.tests += s.batch.size();
+        const auto keep = [&](std::size_t k, const Crossing& c) {
+            if (s.best_t[k] == kInfinity) s.touched.push_back(k);
+            s.best_t[k] = c.t;
+            s.best_c[k] = c;
+        };
+        std::size_t i = 0;
+        if constexpr (std::is_same_v<S, ChainShape>) {
+            // Two segments at a time (geometry/ray_fan.h), each lane as the scalar test.
+            RayFan f;
+            f.o = p * h_;
+            f.tmin = _mm_setzero_pd();
+            for (; i + 1 < s.batch.size(); i += 2) {
+                const Scratch::Exit& e0 = s.batch[i];
+                const Scratch::Exit& e1 = s.batch[i + 1];
+                const Vec3 d0 = (e0.q - p) * h_, d1 = (e1.q - p) * h_;
+                f.d = {_mm_set_pd(d1.x, d0.x), _mm_set_pd(d1.y, d0.y), _mm_set_pd(d1.z, d0.z)};
+                f.tmax = _mm_set_pd(std::min(s.best_t[e1.k], 1.0 + 1e-12), std::min(s.best_t[e0.k], 1.0 + 1e-12));
+                FanHits out;
+                const unsigned m = shape.intersect_fan(part, f, out);
+                if (m == 0) continue;
+                alignas(16) double t[2], sub[2];
+                _mm_store_pd(t, out.t);
+                _mm_store_pd(sub, out.part);
+                for (unsigned j = 0; j < 2; ++j)
+                    if (m >> j & 1)
+                        keep(s.batch[i + j].k, Crossing(t[j], part << 2 | static_cast<std::uint32_t>(sub[j]), 0));
+            }
+        }
+        for (; i < s.batch.size(); ++i) {
+            const Scratch::Exit& e = s.batch[i];
+            const Ray r{p * h_, (e.q - p) * h_};
+            Crossing c;
+            const double tmax = std::min(s.best_t[e.k], 1.0 + 1e-12);
+            if (shape.intersect_primitive(part, r, 0.0, tmax, c)) keep(e.k, c);
+        }
+        s.batch.clear();
     }
 
     template <class S>
