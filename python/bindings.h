@@ -12,10 +12,9 @@ namespace lat::py {
 namespace pyb = pybind11;
 
 void bind_images(pyb::module_& m);  // to_srgb8, compare
-void bind_scene(pyb::module_& m);   // Scene, load
+void bind_scene(pyb::module_& m);   // Scene, load, scatters
 void bind_render(pyb::module_& m);  // render, render_options
 void bind_tables(pyb::module_& m);  // rasterize, open_table, Table
-void bind_scatter(pyb::module_& m); // scatter placements
 
 // Held (without the GIL) by whatever sets the thread limit, signal handlers or progress sink,
 // which belong to the process: renders, rasterizations and certifications run one at a time.

@@ -25,5 +25,4 @@ PYBIND11_MODULE(lattice, m) {
     lat::py::bind_scene(m);
     lat::py::bind_render(m);
     lat::py::bind_tables(m);
-    lat::py::bind_scatter(m);
 }

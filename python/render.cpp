@@ -9,6 +9,7 @@
 #include <set>
 
 #include "bindings.h"
+#include "options.h"
 #include "render/render_request.h"
 #include "scene_object.h"
 #include "util/error.h"
@@ -23,34 +24,6 @@ const OptionEntry<RenderRequest>* find_option(const std::string& python_name) {
     for (const OptionEntry<RenderRequest>& e : render_option_entries())
         if (!e.command_line_only && e.python_name() == python_name) return &e;
     return nullptr;
-}
-
-void require(const std::string& problem) {
-    if (!problem.empty()) throw InputError(problem);
-}
-
-// Sets one option from a Python value, checked as the command line checks its text.
-void set_option(RenderRequest& r, const OptionEntry<RenderRequest>& e, const pyb::handle& value) {
-    const std::string name = e.python_name();
-    const OptionField field = e.field(r);
-    const bool is_int = pyb::isinstance<pyb::int_>(value) && !pyb::isinstance<pyb::bool_>(value);
-    if (int* const* p = std::get_if<int*>(&field)) {
-        if (!is_int) throw pyb::type_error(name + ": expected an integer");
-        const long long v = value.cast<long long>();
-        require(check_option_value(name, e.check, v));
-        **p = static_cast<int>(v);
-    } else if (double* const* d = std::get_if<double*>(&field)) {
-        if (!is_int && !pyb::isinstance<pyb::float_>(value)) throw pyb::type_error(name + ": expected a number");
-        const double v = value.cast<double>();
-        require(check_option_value(name, e.check, v));
-        **d = v;
-    } else {
-        if (!pyb::isinstance<pyb::str>(value)) throw pyb::type_error(name + ": expected a string");
-        const std::string v = value.cast<std::string>();
-        require(check_option_value(name, e.check, v));
-        if (std::string* const* s = std::get_if<std::string*>(&field)) **s = v;
-        if (const ChoiceSetter* set = std::get_if<ChoiceSetter>(&field)) (*set)(v);
-    }
 }
 
 std::string option_list() {

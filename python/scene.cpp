@@ -1,8 +1,10 @@
-// lattice.Scene and lattice.load: scenes through the same loader, and the same checks, as files.
+// lattice.Scene, lattice.load and lattice.scatters: scenes through the same loader, and the same
+// checks, as files; their scatters' placements as arrays.
 #include <chrono>
 #include <pybind11/stl.h>
 
 #include "bindings.h"
+#include "scene/scatter.h"
 #include "scene/scene_loader.h"
 #include "scene_object.h"
 
@@ -42,6 +44,39 @@ pyb::dict camera_dict(const Camera& c) {
 void set_camera(PyScene& s, const pyb::dict& d) {
     const nlohmann::json j = nlohmann::json::parse(json_text(d));
     s.scene.camera = parse_camera(JsonValue(j, "camera", s.scene.file));
+}
+
+// Each scatter's instances: where they stand, their frames and sizes.
+pyb::list scatters(const PyScene& s) {
+    pyb::list out;
+    for (const ScatterGroup& g : s.scene.scatters) {
+        const auto n = static_cast<pyb::ssize_t>(g.count);
+        pyb::array_t<double> roots({n, pyb::ssize_t{3}}), frames({n, pyb::ssize_t{3}, pyb::ssize_t{3}}), scales(n);
+        double *r = roots.mutable_data(), *f = frames.mutable_data(), *sc = scales.mutable_data();
+        std::string primitive;
+        for (std::size_t i = 0; i < g.count; ++i) {
+            const SceneObject& o = s.scene.objects[g.first + i];
+            const Primitive& prim = s.scene.primitives[static_cast<std::size_t>(o.primitive)];
+            primitive = prim.name;
+            const Mat3& m = o.xf.forward().m;
+            const double scale = std::cbrt(std::abs(determinant(m)));
+            const Vec3 root = o.xf.point(primitive_root(prim));
+            for (int c = 0; c < 3; ++c) {
+                r[3 * i + c] = root[c];
+                for (int k = 0; k < 3; ++k) f[9 * i + 3 * c + k] = m.r[c][k] / scale;
+            }
+            sc[i] = scale;
+        }
+        pyb::dict d;
+        d["name"] = g.name;
+        d["object"] = g.json_index;
+        d["primitive"] = primitive;
+        d["roots"] = roots;
+        d["frames"] = frames;
+        d["scales"] = scales;
+        out.append(d);
+    }
+    return out;
 }
 
 }  // namespace
@@ -91,6 +126,11 @@ e.g. "scene: objects[3].transform: ...".)")
             return s;
         },
         pyb::arg("path"), "Loads a scene file (JSON), as `lattice render` does; InputError names the place");
+    m.def("scatters", &scatters, pyb::arg("scene"), R"(The scene's scatter objects' instances as arrays.
+
+A list, one dict per scatter: name, object (its index in the file's objects), primitive,
+roots (N x 3: where each instance's root, the bottom centre of its lattice box, stands),
+frames (N x 3 x 3: the instance's axes as columns, unit length), scales (N).)");
 }
 
 }  // namespace lat::py

@@ -9,13 +9,13 @@
 #include <set>
 
 #include "bindings.h"
+#include "options.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/cache/table_build.h"
 #include "lattice/cache/table_cache.h"
 #include "lattice/certify.h"
 #include "lattice/table_file.h"
 #include "render/render_request.h"
-#include "scene/scatter.h"
 #include "scene/scene_loader.h"
 #include "scene/table_metadata.h"
 #include "scene_object.h"
@@ -172,17 +172,7 @@ TableSpec table_spec(const pyb::kwargs& kw) {
             if (e.python_name() == name) entry = &e;
         if (!entry) throw pyb::type_error("rasterize() got an unexpected option '" + name + "'");
         if (value.is_none()) continue;
-        const OptionField field = entry->field(spec);
-        std::variant<long long, double, std::string> v;
-        if (std::get_if<int*>(&field)) v = value.cast<long long>();
-        else if (std::get_if<double*>(&field)) v = value.cast<double>();
-        else v = value.cast<std::string>();
-        if (const std::string problem = check_option_value(name, entry->check, v); !problem.empty())
-            throw InputError(problem);
-        if (int* const* i = std::get_if<int*>(&field)) **i = static_cast<int>(std::get<long long>(v));
-        if (double* const* d = std::get_if<double*>(&field)) **d = std::get<double>(v);
-        if (std::string* const* s = std::get_if<std::string*>(&field)) **s = std::get<std::string>(v);
-        if (const ChoiceSetter* set = std::get_if<ChoiceSetter>(&field)) (*set)(std::get<std::string>(v));
+        set_option(spec, *entry, value);
     }
     return spec;
 }
@@ -240,39 +230,6 @@ face, and a point with itself, are misses. Ids that are not boundary points rais
         .def("__repr__", [](const PyTable& t) { return "<lattice.Table " + t.path + ": " + t.header.describe() + ">"; });
 }
 
-// Each scatter's instances: where they stand, their frames and sizes.
-pyb::list scatters(const PyScene& s) {
-    pyb::list out;
-    for (const ScatterGroup& g : s.scene.scatters) {
-        const auto n = static_cast<pyb::ssize_t>(g.count);
-        pyb::array_t<double> roots({n, pyb::ssize_t{3}}), frames({n, pyb::ssize_t{3}, pyb::ssize_t{3}}), scales(n);
-        double *r = roots.mutable_data(), *f = frames.mutable_data(), *sc = scales.mutable_data();
-        std::string primitive;
-        for (std::size_t i = 0; i < g.count; ++i) {
-            const SceneObject& o = s.scene.objects[g.first + i];
-            const Primitive& prim = s.scene.primitives[static_cast<std::size_t>(o.primitive)];
-            primitive = prim.name;
-            const Mat3& m = o.xf.forward().m;
-            const double scale = std::cbrt(std::abs(determinant(m)));
-            const Vec3 root = o.xf.point(primitive_root(prim));
-            for (int c = 0; c < 3; ++c) {
-                r[3 * i + c] = root[c];
-                for (int k = 0; k < 3; ++k) f[9 * i + 3 * c + k] = m.r[c][k] / scale;
-            }
-            sc[i] = scale;
-        }
-        pyb::dict d;
-        d["name"] = g.name;
-        d["object"] = g.json_index;
-        d["primitive"] = primitive;
-        d["roots"] = roots;
-        d["frames"] = frames;
-        d["scales"] = scales;
-        out.append(d);
-    }
-    return out;
-}
-
 }  // namespace
 
 void bind_tables(pyb::module_& m) {
@@ -284,14 +241,6 @@ void bind_tables(pyb::module_& m) {
 
 Table options as keywords: sigma_inv, encoding, max_point_error, max_normal_error,
 dense_normals. output: the file (default: the render cache, where render finds it).)");
-}
-
-void bind_scatter(pyb::module_& m) {
-    m.def("scatters", &scatters, pyb::arg("scene"), R"(The scene's scatter objects' instances as arrays.
-
-A list, one dict per scatter: name, object (its index in the file's objects), primitive,
-roots (N x 3: where each instance's root, the bottom centre of its lattice box, stands),
-frames (N x 3 x 3: the instance's axes as columns, unit length), scales (N).)");
 }
 
 }  // namespace lat::py

@@ -40,6 +40,20 @@ def test_image_equals_command_line(cli, scene_file, tmp_path, plate4, options):
     assert stats["primary_rays"] == 64 * 64 * options.get("spp", 1)
 
 
+def test_clipped_samples_give_the_command_lines_png(cli, scene_file, tmp_path):
+    """With bright lights many samples pass 1: the PNG averages clamped samples, which the mean
+    radiance cannot give back, so to_srgb8 must use the render's own 8-bit image."""
+    d = plate4_dict()
+    for light in d["lights"]:
+        light["intensity"] = [3 * c for c in light["intensity"]]
+    path = scene_file(d)
+    img, _ = lattice.render(lattice.load(path), spp=4)
+    expected = cli_png(cli, path, tmp_path / "cli.png", "--spp", "4")
+    naive = np.round(np.clip(img.astype(np.float64), 0, 1) * 255).astype(np.uint8)
+    assert not np.array_equal(naive, expected)  # the case this test is for does arise
+    assert np.array_equal(lattice.to_srgb8(img), expected)
+
+
 def test_stats_have_the_command_lines_fields(cli, scene_file, tmp_path, plate4):
     path = scene_file(plate4)
     cli("render", path, "-o", tmp_path / "a.png", "-q", "--mode", "exact", "--footprint", "on",
