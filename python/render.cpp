@@ -53,8 +53,9 @@ RenderRequest read_options(const PyScene& s, const pyb::kwargs& kw, pyb::object&
     return r;
 }
 
-// For the render: lattice's flag-setting SIGINT and SIGTERM handlers in place of Python's (whose
-// handler cannot run while the render holds no GIL), Python's back afterwards.
+// For the render: lattice's flag-setting SIGINT and SIGTERM handlers, which the tiles poll, in
+// place of Python's (whose Python-level handler would run only once the render returned);
+// Python's back afterwards. A signal then raises KeyboardInterrupt (SystemExit for SIGTERM).
 class SignalsDuringRender {
 public:
     SignalsDuringRender() {
