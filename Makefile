@@ -18,10 +18,11 @@ FUZZ_SECONDS ?= 60
 FUZZ_HARNESSES := $(patsubst fuzz/%_fuzz.cpp,%,$(wildcard fuzz/*_fuzz.cpp))
 
 # g++ brings libasan and libubsan (through libgcc-12-dev). Open MPI: `lattice` under mpirun
-# (docs/distributed.md); the build works without it too.
+# (docs/distributed.md); the build works without it too. The Python module (docs/python.md):
+# pybind11 and numpy for Debian's python3, pytest for its tests.
 PACKAGES := cmake make g++ pkg-config libembree-dev libtbb-dev libpng-dev nlohmann-json3-dev \
             libcli11-dev libopenexr-dev libgtest-dev libgmock-dev libbenchmark-dev python3 \
-            libopenmpi-dev openmpi-bin
+            libopenmpi-dev openmpi-bin python3-dev pybind11-dev python3-numpy python3-pytest
 # Only `make bench` plots (bench/plot_complexity.py): a target-specific value, inherited by its
 # prerequisites (build -> configure -> deps), so `make test` and `make demo` do not install it.
 bench: PACKAGES += python3-matplotlib

@@ -34,11 +34,17 @@ if command -v mpirun > /dev/null && "$build/bin/lattice" --version | grep -q "wi
 else
   echo "(skipped: the build did not find MPI)" > "$out/distributed.md"
 fi
+echo "== Python module: table lookups over arrays against a loop of single lookups (docs/python.md)"
+if [ -d "$build/python" ]; then
+  /usr/bin/python3 "$here/python_lookup.py" "$build" "$out" > "$out/python_lookup.md"
+else
+  echo "(skipped: the build has no Python module)" > "$out/python_lookup.md"
+fi
 # matplotlib is Debian's python3-matplotlib: plot with Debian's python3 even when another one
 # (pyenv, a virtualenv) comes first in PATH.
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 "$py" "$here/plot_complexity.py" "$out/complexity.json" "$here/../docs/images/complexity.png"
-{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/modes.md" "$out/samplers.md" "$out/scatter.md" "$out/distributed.md"; } > "$out/summary.md"
+{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/modes.md" "$out/samplers.md" "$out/scatter.md" "$out/distributed.md" "$out/python_lookup.md"; } > "$out/summary.md"
 echo
 cat "$out/rasterize.md" >> "$out/summary.md"
 cat "$out/summary.md"

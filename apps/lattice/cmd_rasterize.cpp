@@ -25,16 +25,6 @@ struct RasterizeArgs {
     bool quiet = false;
 };
 
-const Primitive& find_primitive(const Scene& scene, const RasterizeArgs& a) {
-    std::string known;
-    for (const Primitive& p : scene.primitives) {
-        if (p.name == a.primitive) return p;
-        known += (known.empty() ? "" : ", ") + p.name;
-    }
-    throw InputError(a.scene + ": no primitive named '" + a.primitive + "'" +
-                     (known.empty() ? " (the scene defines none)" : " (it has: " + known + ")"));
-}
-
 // One rank's share of a rasterization spread across an MPI job.
 struct RankShare {
     int rank = 0;
@@ -69,7 +59,7 @@ int run_rasterize(const RasterizeArgs& a) {
     std::string path = a.output;
     dist::agree([&] {
         scene = load_scene(a.scene);
-        plan = plan_table(find_primitive(scene, a), a.spec, a.scene);
+        plan = plan_table(find_primitive(scene, a.primitive), a.spec, a.scene);
     });
     agree_on_scene(a.scene);
     dist::mark(dist::Step::kLoaded);

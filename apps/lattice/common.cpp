@@ -24,28 +24,42 @@ const std::map<std::string, LatticeFilter>& lattice_filters() {
     return filters;
 }
 
+namespace {
+
+// What an entry's field is, as a CLI11 option: a flag, a choice handed to a setter, or a value.
+template <class Target>
+CLI::Option* add_field(CLI::App& app, const OptionEntry<Target>& e, Target& target) {
+    const OptionField field = e.field(target);
+    if (bool* const* flag = std::get_if<bool*>(&field)) return app.add_flag(e.names, **flag, e.help);
+    if (const ChoiceSetter* set = std::get_if<ChoiceSetter>(&field))
+        return app.add_option_function<std::string>(e.names, *set, e.help);
+    return std::visit(
+        [&](auto value) -> CLI::Option* {
+            if constexpr (std::is_pointer_v<decltype(value)>) return app.add_option(e.names, *value, e.help);
+            return nullptr;  // handled above
+        },
+        field);
+}
+
+}  // namespace
+
+template <class Target>
+void add_entries(CLI::App& app, const std::vector<OptionEntry<Target>>& entries, Target& target) {
+    for (const OptionEntry<Target>& e : entries) {
+        CLI::Option* o = add_field(app, e, target);
+        if (e.required) o->required();
+        if (e.check.range) o->check(CLI::Range(e.check.range->first, e.check.range->second));
+        if (e.check.positive) o->check(CLI::PositiveNumber);
+        if (!e.check.choices.empty()) o->check(CLI::IsMember(e.check.choices));
+        if (e.check.text) o->check(e.check.text);
+        if (e.show_default) o->capture_default_str();
+    }
+}
+template void add_entries(CLI::App&, const std::vector<OptionEntry<TableSpec>>&, TableSpec&);
+template void add_entries(CLI::App&, const std::vector<OptionEntry<RenderRequest>>&, RenderRequest&);
+
 void add_table_options(CLI::App& app, TableSpec& spec) {
-    // Its range is checked where the table is planned (plan_table), the one place for it.
-    app.add_option("--sigma-inv", spec.sigma_inv,
-                   "Refine the lattice K times: K x the cells at sigma / K, same box (1 to " +
-                       std::to_string(kMaxSigmaInv) + ")");
-    std::string names;
-    for (const Encoding* e : encodings()) names += (names.empty() ? "" : ", ") + std::string(e->name);
-    app.add_option("--encoding", spec.encoding, "Lattice table encoding: " + names);
-    app.add_option("--max-point-error", spec.options.max_point_error,
-                   "Quantising encodings: largest point error, in units of sigma")
-        ->check(CLI::PositiveNumber);
-    app.add_option("--max-normal-error", spec.options.max_normal_error_deg,
-                   "Quantising encodings: largest normal error, in degrees")
-        ->check(CLI::PositiveNumber);
-    std::map<std::string, DenseNormals> normals;
-    for (const auto& [name, value] : kDenseNormalNames) normals.emplace(name, value);
-    app.add_option_function<std::string>(
-           "--dense-normals",
-           [&spec, normals](const std::string& name) { spec.options.normals = normals.at(name); },
-           "dense: normals as octahedral codes (oct), as the part hit, re-evaluated (part), or "
-           "whichever is smaller (auto; octahedral where parts are quartics)")
-        ->check(CLI::IsMember(normals));
+    add_entries(app, table_option_entries(), spec);
 }
 
 void agree_on_scene(const std::string& scene_file) {
@@ -53,14 +67,6 @@ void agree_on_scene(const std::string& scene_file) {
     std::string bytes;
     dist::agree([&] { bytes = read_text_file(scene_file, "scene file"); });
     dist::agree_on(hash_bytes(bytes.data(), bytes.size()), scene_file + ": the scene file");
-}
-
-nlohmann::json timeline_json(const dist::Timeline& t) {
-    nlohmann::json j = nlohmann::json::object();
-    for (int s = 0; s < static_cast<int>(dist::Step::kCount); ++s)
-        if (const double ms = t[static_cast<std::size_t>(s)]; ms > 0)
-            j[std::string(dist::step_name(static_cast<dist::Step>(s)))] = ms;
-    return j;
 }
 
 void write_json_file(const std::string& path, const nlohmann::json& j) {

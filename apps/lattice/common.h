@@ -4,19 +4,21 @@
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 
+#include <vector>
+
 #include "lattice/filtered_shape.h"
-#include "dist/timeline.h"
+#include "render/render_request.h"  // OptionEntry, timeline_json
 #include "util/threads.h"  // ThreadLimit, for the commands
 
 namespace CLI {
 class App;
 }
 
-namespace lat {
-struct TableSpec;
-}
-
 namespace lat::cli {
+
+// Adds the options of a table (render/render_request.h) to a command, writing into target.
+template <class Target>
+void add_entries(CLI::App& app, const std::vector<OptionEntry<Target>>& entries, Target& target);
 
 // --sigma-inv, --encoding and the encodings' error targets, shared by render and rasterize.
 void add_table_options(CLI::App& app, TableSpec& spec);
@@ -26,9 +28,6 @@ const std::map<std::string, LatticeFilter>& lattice_filters();
 
 // Collective in an MPI job: every rank must have read the same scene file (dist::agree_on).
 void agree_on_scene(const std::string& scene_file);
-
-// A rank's timeline (dist/timeline.h) for --stats: {"loaded": ms, ...}, the steps it reached.
-nlohmann::json timeline_json(const dist::Timeline& t);
 
 // Writes JSON atomically (temporary + rename); throws InputError naming the path.
 void write_json_file(const std::string& path, const nlohmann::json& j);

@@ -16,6 +16,8 @@ constexpr int kMaxImageSide = 32768;
 // 8192 x 8192: the float and 8-bit buffers of the largest image take about 1 GB.
 constexpr std::int64_t kMaxImagePixels = std::int64_t{1} << 26;
 
+}  // namespace
+
 Camera parse_camera(const JsonValue& v) {
     v.allow_keys({"eye", "look_at", "up", "fov_y_deg", "width", "height"});
     Camera c;
@@ -43,6 +45,8 @@ Camera parse_camera(const JsonValue& v) {
         v.at("up").fail("up is parallel to the viewing direction");
     return c;
 }
+
+namespace {
 
 Material parse_material(const JsonValue& v, const std::string& name) {
     v.allow_keys({"color", "ka", "kd", "ks", "shininess"});
@@ -239,6 +243,16 @@ Scene load_scene_text(const std::string& text, const std::string& file) {
     }
     load_objects(root.at("objects"), parser, s);
     return s;
+}
+
+const Primitive& find_primitive(const Scene& scene, const std::string& name) {
+    std::string known;
+    for (const Primitive& p : scene.primitives) {
+        if (p.name == name) return p;
+        known += (known.empty() ? "" : ", ") + p.name;
+    }
+    throw InputError(scene.file + ": no primitive named '" + name + "'" +
+                     (known.empty() ? " (the scene defines none)" : " (it has: " + known + ")"));
 }
 
 Scene load_scene(const std::string& path) {

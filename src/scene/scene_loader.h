@@ -11,7 +11,13 @@ namespace lat {
 Scene load_scene(const std::string& path);
 Scene load_scene_text(const std::string& text, const std::string& file);
 
-// Parts of the loader that other readers (e.g. Table 1 files) reuse.
+// The scene's primitive of that name; throws InputError naming the scene file and the names it
+// has.
+const Primitive& find_primitive(const Scene& scene, const std::string& name);
+
+// Parts of the loader that other readers (e.g. Table 1 files, the Python module's camera edits)
+// reuse.
+Camera parse_camera(const JsonValue& v);
 Transform parse_transform(const JsonValue& v);
 // Throws InputError at v unless t and its inverse are finite (composing finite transforms, e.g.
 // down a CSG tree, can overflow).

@@ -4,8 +4,25 @@
 
 #include <chrono>
 #include <cstdio>
+#include <mutex>
 
 namespace lat {
+namespace {
+
+std::mutex g_sink_mutex;
+ProgressSink g_sink;
+
+ProgressSink current_sink() {
+    const std::lock_guard lock(g_sink_mutex);
+    return g_sink;
+}
+
+}  // namespace
+
+void set_progress_sink(ProgressSink sink) {
+    const std::lock_guard lock(g_sink_mutex);
+    g_sink = std::move(sink);
+}
 
 bool ProgressBar::stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
 
@@ -30,6 +47,10 @@ void ProgressBar::finish() {
 
 void ProgressBar::draw(bool final) const {
     const double frac = final ? 1.0 : static_cast<double>(done_.load()) / static_cast<double>(total_);
+    if (const ProgressSink sink = current_sink()) {
+        sink(label_, frac);
+        return;
+    }
     constexpr int kWidth = 40;
     const int filled = static_cast<int>(frac * kWidth);
     char bar[kWidth + 1];

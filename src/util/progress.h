@@ -3,10 +3,17 @@
 // not a terminal.
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <thread>
 
 namespace lat {
+
+// Where enabled bars report instead of stderr, for a program that embeds the renderer (the Python
+// module's progress callback): called from a bar's own thread about ten times a second with its
+// label and the share done, 0..1, and once with 1 when it finishes. Empty: stderr.
+using ProgressSink = std::function<void(const std::string& label, double done)>;
+void set_progress_sink(ProgressSink sink);
 
 class ProgressBar {
 public:
