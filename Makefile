@@ -35,7 +35,7 @@ SANITIZER_ENV := ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:check_initia
   LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitizers/lsan.supp:print_suppressions=0 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
-.PHONY: all deps fuzz-deps configure build demo test test-sanitize fuzz bench clean format
+.PHONY: all deps fuzz-deps configure build python-module demo test test-sanitize fuzz bench clean format
 
 all: build
 
@@ -65,12 +65,21 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-demo: build
+# The Python module installed where Debian's python3 finds it (under /usr/local), so that
+# `python3 -c "import lattice"` works after `make demo` or `make test` (docs/python.md); without
+# root it stays in the build tree (PYTHONPATH=$(BUILD_DIR)/python).
+python-module: build
+	@if [ -d $(BUILD_DIR)/python ]; then \
+	  if [ "$$(id -u)" = 0 ]; then cmake --install $(BUILD_DIR) --component python > /dev/null; \
+	  else echo "note: not root: the Python module stays in $(BUILD_DIR)/python (PYTHONPATH)"; fi; \
+	fi
+
+demo: python-module
 	@mkdir -p $(dir $(DEMO_OUT))
 	@$(BUILD_DIR)/bin/lattice render $(DEMO_SCENE) $(DEMO_FLAGS) -o $(DEMO_OUT)
 	@echo "demo image: $(abspath $(DEMO_OUT))"
 
-test: build
+test: python-module
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
 # ASan + UBSan over the unit, CLI and corpus-replay tests (no benchmarks).
