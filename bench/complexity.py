@@ -13,8 +13,8 @@ command itself:
   4. takes lattice visits from render --stats (lattice_visits; bench/lattice_visits splits
      them by kind) and estimates the CPU time per visit as (lattice ms - ms of the scene without its
      instances) x threads / visits: everything the instances add, Embree traversal included.
-Then the same for issue 9's check class (complexity_scenes.CHECKS: 400 instances on a ball),
-with the issue's target ratio for each. Writes OUT/complexity.json and prints a Markdown
+Then the same for the costly-primitive check class (complexity_scenes.CHECKS: 400 instances on a ball),
+with the target ratio for each. Writes OUT/complexity.json and prints a Markdown
 summary.
 
 Usage: complexity.py LATTICE_BIN OUT_DIR [--work DIR] [--size N] [--runs N] [--threads N]

@@ -12,7 +12,7 @@ covers about as many pixels as the hair and the lattice's cost per visit stays c
   csg1, 4, 12    CSG of tori stretched along the column: one torus, a 4-leaf unit (a torus
                  minus a torus, union the intersection of two tori), three such units
 
-Besides, the class of scene issue 9 is checked on (its own scenes are not ours to see):
+Besides, the class of scene the costly-primitive comparison is made on:
 several hundred instances on a ball, here 400 placed evenly (a Fibonacci spiral), each turned
 at random about the ball's normal, filling most of the frame, so that the instances, not the
 ball and floor, take most of the time. Two primitives, as the issue describes them:
@@ -123,7 +123,7 @@ PRIMITIVES.update({k: ((lambda s=s, n=n, r=r, k=k: tuft(s, n, r, seed=len(k))), 
 PRIMITIVES.update({f"csg{q}": ((lambda q=q: csg(q)), q) for q in (1, 4, 12)})
 
 
-# name -> (primitive, parts or leaves, issue 9's target: exact / lattice at least this).
+# name -> (primitive, parts or leaves, the target: exact / lattice at least this).
 CHECKS = {"ball-csg7": (ball_csg, 7, 5.0),
           "ball-tuft216": ((lambda: tuft(24, 5, 0.15, seed=7)), 216, 2.0)}
 BALL_RADIUS, BALL_INSTANCES = 40.0, 400
@@ -166,7 +166,7 @@ def ball_scene(name, size):
     s["objects"] = [ball, floor] + [
         {"type": "instance", "primitive": name, "transform": m, "material": "fur"}
         for m in ball_transforms(BALL_INSTANCES)]
-    s["description"] = (f"issue 9's check class: {BALL_INSTANCES} instances of {name} "
+    s["description"] = (f"the costly-primitive check class: {BALL_INSTANCES} instances of {name} "
                         f"({CHECKS[name][1]} parts or quartic leaves) on a ball; "
                         "bench/complexity_scenes.py")
     return s

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""MPI benchmark (issue 14), through the lattice command on this machine's 2 cores:
+"""MPI benchmark, through the lattice command on this machine's 2 cores:
 
 1. overhead: 2 ranks x 1 thread (mpirun) against 1 rank x 2 threads (a plain run), interleaved
    A B A B ..., best of RUNS, for Plate 5 at 4 spp (exact and lattice mode, the table cached
@@ -151,7 +151,7 @@ def main(lattice, out, mpirun):
             big.unlink(missing_ok=True)
 
     (out / "distributed-runs.txt").write_text("\n".join(json.dumps(r, sort_keys=True) for r in raw) + "\n")
-    print("## MPI: 2 ranks x 1 thread against 1 rank x 2 threads (issue 14)\n")
+    print("## MPI: 2 ranks x 1 thread against 1 rank x 2 threads\n")
     print(f"Best of {RUNS}, interleaved; `mpirun -q -n 2 --bind-to none ... --threads 1` against a plain run "
           "with `--threads 2`. Time is `render_ms` (tiles dealt, rendered and gathered) or rasterize + "
           "encode seconds; CPU is the CPU time of every thread of every rank over the render (or the table's "

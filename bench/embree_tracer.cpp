@@ -1,6 +1,6 @@
 // embree_tracer SCENE.json -o OUT.png [--threads N] [--geometry user|native] [--packets] [--rounds R]
 // An independent Embree tracer for "lattice-reference/1" scenes (hairs of balls and cylinders,
-// spheres, half-spaces): the yardstick of issue 9's "exact mode at most the time of an
+// spheres, half-spaces): the yardstick of "exact mode at most the time of an
 // independent Embree tracer on the same machine" (bench/embree_tracer.py, docs/complexity.md).
 // It reads the scene with the reference tracer's parser (tests/reference) and shares no code
 // with src/ but the PNG writer: geometry, Embree set-up, traversal and shading are its own,

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Exact mode against an independent Embree tracer (issue 9: "exact mode is at most the time of
+"""Exact mode against an independent Embree tracer ("exact mode is at most the time of
 an independent Embree tracer on the same machine"; docs/complexity.md).
 
 bench/embree_tracer.cpp reads reference scenes with the reference tracer's parser and renders
@@ -10,7 +10,7 @@ by round (exact mode, then each tracer) at 2 threads; the median render time is 
 each tracer's PSNR against exact mode (the same picture: user geometry gives images identical to
 exact mode's, native differs by float rounding).
 
-Scenes: Plates 4 and 5; issue 9's ball of 400 tufts of 216 parts, and the same ball and floor
+Scenes: Plates 4 and 5; the costly-primitive ball of 400 tufts of 216 parts, and the same ball and floor
 without instances (the scene around the instances, b in docs/complexity.md); the complexity
 benchmark's tuft2000 on Plate 4's placement. (CSG primitives are not in the reference format.)
 Writes RESULTS/embree_tracer.json and prints a Markdown summary.
@@ -42,7 +42,7 @@ def write_scenes(work):
              for n in ["plate4-fuzzy-sphere-1000", "plate5-fuzzy-sphere-5000"]}
     tuft_ball = complexity_scenes.scene("ball-tuft216", 512)
     base = dict(tuft_ball, primitives={}, objects=tuft_ball["objects"][:2],
-                description="issue 9's ball and floor without instances")
+                description="the costly-primitive ball and floor without instances")
     for name, s in [("ball-base", base), ("ball-tuft216", tuft_ball),
                     ("tuft2000", complexity_scenes.scene("tuft2000", 512))]:
         paths[name] = os.path.join(work, name + ".json")
@@ -89,7 +89,7 @@ def report(results):
     print("## Exact mode against an independent Embree tracer\n")
     print("512 x 512, 1 spp, 2 threads, median render time of interleaved rounds (each tracer's "
           "PSNR against exact mode in brackets); last column: exact mode's time over the fastest "
-          "tracer's (at most 1 meets issue 9's deliverable 4).\n")
+          "tracer's (at most 1: exact mode is at most the independent tracer's time).\n")
     print("| scene | exact mode | " + " | ".join(f"Embree, {g}" for g in TRACERS) +
           " | exact / fastest |")
     print("| --- | ---: | " + " | ".join("---:" for _ in TRACERS) + " | ---: |")

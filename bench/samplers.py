@@ -18,7 +18,7 @@ from modes import GENERATED, ROOT, SCENES, ground_truth, psnr, render, scene_pat
 SAMPLERS = ["grid", "sobol", "jitter"]
 SPP = [2, 4, 9, 16]
 GT_SPP = 256
-# The check: Plate 4, exact mode, 4 spp, the default sampler.
+# The target: Plate 4, exact mode, 4 spp, the default sampler.
 CHECK = ("plate4-fuzzy-sphere-1000", 4, 39.5)
 
 

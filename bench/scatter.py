@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Scatter benchmarks (issue 12), through the lattice command on 2 threads:
+"""Scatter benchmarks, through the lattice command on 2 threads:
 
 1. fur on a mesh: examples/furry-bunny.json (14,696 triangles, 20,000 hairs) at 512 x 512, in
    exact and lattice mode (the table built beforehand, so the lattice figure is rendering only);
@@ -56,7 +56,7 @@ def main(lattice, out):
         finally:
             big.unlink()
     (out / "scatter-runs.txt").write_text("\n".join(json.dumps(r, sort_keys=True) for r in raw) + "\n")
-    print("## Scatter (issue 12): fur on a mesh\n")
+    print("## Scatter: fur on a mesh\n")
     print("The Stanford bunny (14,696 triangles) under a scatter, 2 threads, median of 3 runs, "
           "times from `render --stats` in ms. `load` reads the scene and mesh and places the "
           "instances; `build` makes the Embree hierarchy (and, in lattice mode, opens the table).\n")

@@ -1,5 +1,5 @@
 // Scene files rendered: JSON text -> Scene -> RenderScene (Embree) -> a 4 x 3 image with one
-// light sample per pixel. The path of the SIGABRT in issue 11 (a non-finite ray handed to
+// light sample per pixel. The path of an old SIGABRT (a non-finite ray handed to
 // Embree), so it goes through the renderer as `lattice render` does. Slower than the `scene`
 // harness (an Embree device per input), so it stops at small scenes.
 #include <cstddef>

@@ -1,4 +1,4 @@
-// Coverage (issue 10): a prefiltered table's alpha for a pair is the share of the rays snapping
+// Coverage: a prefiltered table's alpha for a pair is the share of the rays snapping
 // to the pair that meet the primitive, checked against brute force (random rays, snapped by the
 // renderer's own LatticeFrame); and a primitive thinner than a cell, rendered through filtered
 // lattices at 1 sample per pixel, has the brightness of a supersampled exact render.

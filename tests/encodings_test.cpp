@@ -146,7 +146,7 @@ TEST(EncodingCandidates, ExactOnEveryPair) {
 }
 
 TEST(EncodingCandidates, OldMaskTablesStillOpen) {
-    // A CAND1 payload (part sets as 64-bit masks, before issue 9) made from a CAND2 one: the
+    // A CAND1 payload (part sets as 64-bit masks, an older layout) made from a CAND2 one: the
     // same header and pair sections, then one mask per set. Both answer every pair alike.
     const Built b = build("candidates", 1);
     const std::uint8_t* p = b.payload.data();

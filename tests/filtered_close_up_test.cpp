@@ -1,4 +1,4 @@
-// Filtered lattices answered from the primitive's own crossings (issue 10): with levels of
+// Filtered lattices answered from the primitive's own crossings: with levels of
 // detail, a primitive cheap to intersect answers each ray with the crossings of sub-rays
 // across its footprint (answered_by_primitive), not with its tables.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Tracing through partial hits (issue 10, render/layers.h): EmbreeAccel::intersect_layers finds
+// Tracing through partial hits (render/layers.h): EmbreeAccel::intersect_layers finds
 // the partial crossings in ray order, each object's once, stops where compositing stops without
 // changing what it composites, and sums shadow rays' transmittance; and the shading of a mean
 // of normals (phong_term's normal_length) keeps the light the specular lobe reflects and takes

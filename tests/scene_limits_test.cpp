@@ -1,4 +1,4 @@
-// Hostile scenes (issue 11): numbers beyond double range, deep nesting, overflowing transforms
+// Hostile scenes: numbers beyond double range, deep nesting, overflowing transforms
 // and coefficients, and sizes over the limits each give one InputError naming the file and the
 // place; an extreme quartic renders without handing a non-finite ray to Embree.
 #include <gtest/gtest.h>

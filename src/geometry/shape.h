@@ -107,7 +107,7 @@ struct Crossing {
     // where the coverage is their share; 0 otherwise. (In the padding, as coverage.)
     std::uint8_t sub_rays = 0;
     // The share of the rays around this one that meet the surface here (prefiltered lattices,
-    // issue 10: a partial hit lets the rest of the ray go on behind it); 1 for every exact shape.
+    // prefiltered lattices: a partial hit lets the rest of the ray go on behind it); 1 for every exact shape.
     // (In the padding after has_stored: a Crossing is no larger for it.)
     float coverage = 1.0f;
     SurfacePoint stored;  // when has_stored: in the coordinates of the shape that found it

@@ -1,5 +1,5 @@
 #pragma once
-// Coverage (issue 10): a lattice answers every ray that snaps to a pair (p_i, p_o) with that
+// Coverage: a lattice answers every ray that snaps to a pair (p_i, p_o) with that
 // pair's entry, so the entry should describe all those rays, not only the one through both grid
 // points. Per ordered pair this computes, from sub-rays parallel to the segment p_i p_o and
 // shifted over the face cell of p_i, the share alpha that meets the primitive and the mean of

@@ -87,7 +87,7 @@ struct CandidateList {
     std::span<const std::uint32_t> span() const { return {parts, static_cast<std::size_t>(count)}; }
 };
 
-// A prefiltered table's answer for a pair (issue 10, lattice/coverage.h): the share of the rays
+// A prefiltered table's answer for a pair (lattice/coverage.h): the share of the rays
 // snapping to it that meet the primitive, and their mean hit.
 struct CoverageHit {
     double alpha = 0;  // in (0, 1]

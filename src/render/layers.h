@@ -1,5 +1,5 @@
 #pragma once
-// Tracing through prefiltered lattices (issue 10): a lattice answers a ray with a sheet of
+// Tracing through prefiltered lattices: a lattice answers a ray with a sheet of
 // coverage alpha < 1 (SurfaceHit::alpha), so a ray is traced front to back: each surface met
 // adds alpha of its shade, weighted by what is still uncovered, and the ray goes on behind it.
 // Shadow rays likewise get the transmittance of what they cross instead of a yes/no. What is

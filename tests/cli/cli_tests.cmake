@@ -24,7 +24,7 @@ lattice_cli_error(degree_five ${BAD}/degree-five.json "objects\\[1\\]\\.polynomi
 lattice_cli_error(missing_sphere ${BAD}/missing-sphere.json "primitives\\.hair\\.cylinders\\[0\\]\\[1\\]: sphere index 5 does not exist")
 lattice_cli_error(impossible_size ${BAD}/impossible-size.json "camera\\.width: must be between 1 and 32768")
 lattice_cli_error(missing_scene ${BAD}/no-such-file.json "no-such-file.json: cannot open scene file: No such file or directory")
-# Hostile inputs (issue 11): one located message, exit 2, never a crash or a huge allocation.
+# Hostile inputs: one located message, exit 2, never a crash or a huge allocation.
 lattice_cli_error(huge_number ${BAD}/huge-number.json "huge-number.json:2:69: number 1e400 is out of the range of a double")
 lattice_cli_error(overflowing_transform ${BAD}/overflowing-transform.json "objects\\[1\\]\\.transform: the transform overflows")
 add_test(NAME cli.too_many_samples
@@ -119,7 +119,7 @@ if(Python3_Interpreter_FOUND)
             -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/complexity_scenes.cmake)
 endif()
 
-# Meshes and scatters (issue 12): bad files and bad parameters, one located line, exit 2.
+# Meshes and scatters: bad files and bad parameters, one located line, exit 2.
 lattice_cli_error(mesh_missing ${BAD}/mesh-missing.json "mesh-missing.json: objects\\[1\\]\\.file: .*no-such-mesh.obj: cannot open mesh file: No such file or directory")
 lattice_cli_error(mesh_no_triangles ${BAD}/mesh-no-triangles.json "objects\\[1\\]\\.file: .*no-triangles.obj: the mesh has no triangles")
 lattice_cli_error(mesh_huge_claim ${BAD}/mesh-huge-claim.json "objects\\[1\\]\\.file: .*huge-claim.ply: the file ends after 0 of 9999999 vertices")
@@ -141,7 +141,7 @@ add_test(NAME cli.scatter_command_unknown_name
           -DEXIT=2 "-DPATTERN=scatter-mesh-good.json: objects: no scatter is named 'fur'"
           -DNO_FILE=${CLI_OUT}/placed.json -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 
-# Table 2 (issue 13): the texture and particle modes' own errors, their options, and table2.
+# Table 2: the texture and particle modes' own errors, their options, and table2.
 add_test(NAME cli.texture_base_unmappable
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;texture;${BAD}/texture-halfspace-base.json;-o;${CLI_OUT}/tex.png"
           -DEXIT=2 "-DPATTERN=texture-halfspace-base.json: objects\\[0\\]: the instances grow from this object, and texture mode maps onto spheres, ellipsoids and triangle meshes only"
@@ -175,13 +175,13 @@ add_test(NAME cli.table2_runs
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/furred-sphere.json;-o;${CLI_OUT}/t2;--truth-spp;4;--spp;2;--encodings;hash14,dense;--lattice-dir;${CLI_OUT}/t2-cache;--texture-size;64"
           -DEXIT=0 "-DPATTERN=table2: lattice-dense" "-DSTDOUT_PATTERN=\\| lattice-coverage-smooth \\| 1 \\|.*Crops \\(`crops.png`\\)"
           -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
-# compare prints SSIM (issue 13), here of two of table2's images.
+# compare prints SSIM, here of two of table2's images.
 add_test(NAME cli.compare_prints_ssim
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;compare;${CLI_OUT}/t2/truth.png;${CLI_OUT}/t2/texture.png"
           -DEXIT=0 "-DSTDOUT_PATTERN=ssim: 0\\.[0-9][0-9][0-9][0-9]" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 set_tests_properties(cli.compare_prints_ssim PROPERTIES DEPENDS cli.table2_runs)
 
-# Under mpirun (issue 14), when the build found MPI: 2 ranks against 1 process, and errors.
+# Under mpirun, when the build found MPI: 2 ranks against 1 process, and errors.
 # Not in the sanitizer build: Open MPI is not instrumented, and LSan would report its
 # allocations that outlive MPI_Finalize.
 if(LATTICE_WITH_MPI AND MPIEXEC_EXECUTABLE AND NOT LATTICE_SANITIZE)

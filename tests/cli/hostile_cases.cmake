@@ -1,4 +1,4 @@
-# Hostile-input and interruption scenarios (issue 11) that need files generated or several
+# Hostile-input and interruption scenarios that need files generated or several
 # processes; -DCASE=... picks one.
 #   cmake -DLATTICE=path/to/lattice -DDATA=tests/data/bad -DWORK=dir -DCASE=name -P hostile_cases.cmake
 include(${CMAKE_CURRENT_LIST_DIR}/run.cmake)

@@ -54,7 +54,7 @@ elseif(CASE STREQUAL "unknown_primitive")
   run(2 "no primitive named 'fur' \\(it has: hair\\)"
       ${LATTICE} rasterize -q ${P3} --primitive fur -o ${WORK}/t.lht)
 elseif(CASE STREQUAL "candidates_any_parts")
-  # candidates has no part limit (issue 9): a 79-part chain renders as in exact mode.
+  # candidates has no part limit: a 79-part chain renders as in exact mode.
   run(0 "" ${LATTICE} rasterize -q ${LIMITS}/long-chain.json --primitive chain --encoding candidates -o ${WORK}/t.lht)
   run(0 "" ${LATTICE} render -q ${LIMITS}/long-chain.json --mode lattice --encoding candidates --lattice-dir ${WORK} -o ${WORK}/a.png)
   run(0 "" ${LATTICE} render -q ${LIMITS}/long-chain.json -o ${WORK}/b.png)

@@ -1,4 +1,4 @@
-# `lattice` under mpirun (issue 14): two ranks give the same bytes as one process, and an input
+# `lattice` under mpirun: two ranks give the same bytes as one process, and an input
 # error on any rank ends the job at once with one message and exit code 2.
 #   cmake -DLATTICE=path -DMPIEXEC=mpirun -DEXAMPLES=dir -DDATA=dir -DWORK=dir -DCASE=name -P mpi_cases.cmake
 include(${CMAKE_CURRENT_LIST_DIR}/run.cmake)

@@ -1,5 +1,5 @@
 #pragma once
-// `coverage`: a prefiltered table (issue 10). Per ordered pair of boundary points it keeps the
+// `coverage`: a prefiltered table. Per ordered pair of boundary points it keeps the
 // hit of the pair's own segment, as every table does (lookup: what point sampling, CSG, inside
 // tests and certification use), and the pair's coverage (lattice/coverage.h): the share of the
 // sub-rays snapping to the pair that meet the primitive and their mean hit, which filtered
