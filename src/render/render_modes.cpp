@@ -54,10 +54,10 @@ std::uint64_t instance_geometry_bytes(const Scene& scene) {
 // mode without footprint filtering (instances traced as they are).
 std::optional<LatticeFiltering> lattice_policy(const Scene& scene, RenderMode mode,
                                                const ModeSettings& settings) {
+    if (!answers_instances(mode, settings.footprint)) return std::nullopt;
     LatticeFiltering f = settings.filtering;
     switch (mode) {
         case RenderMode::kExact:
-            if (!settings.footprint) return std::nullopt;
             f.policy = LatticePolicy::kFootprint;
             f.filter = LatticeFilter::kSmooth;
             f.lod = true;
@@ -71,6 +71,11 @@ std::optional<LatticeFiltering> lattice_policy(const Scene& scene, RenderMode mo
 }
 
 }  // namespace
+
+bool answers_instances(RenderMode mode, bool footprint) {
+    return mode == RenderMode::kLattice || mode == RenderMode::kAuto ||
+           (mode == RenderMode::kExact && footprint);
+}
 
 std::span<const ModeDescription> render_modes() { return kModes; }
 
@@ -107,8 +112,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
                 const TableSpec spec = cache ? settings.spec : TableSpec{1, std::string(coverage_encoding().name), {}};
                 r.lattices = scene_lattices(scene, cache ? &*cache : nullptr, spec,
                                             settings.progress, *filtering);
-                opt.layered = filtering->policy == LatticePolicy::kFootprint ||
-                              filtering->filter != LatticeFilter::kNone;
+                opt.layered = filtering->filter != LatticeFilter::kNone;  // footprint: smooth
                 r.bytes_added += r.lattices.table_bytes;
             }
             RenderScene::InstanceShapeFn instance_shape;

@@ -66,6 +66,10 @@ struct ModeResult {
     SceneLattices lattices;  // lattice and auto modes, and exact mode's footprint filtering
 };
 
+// Whether the mode answers instances by lattices (tables or sub-rays: SceneLattices) rather
+// than tracing them as they are; footprint: exact mode's ModeSettings::footprint.
+bool answers_instances(RenderMode mode, bool footprint);
+
 ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSettings& settings);
 
 }  // namespace lat

@@ -268,8 +268,7 @@ RenderMode RenderRequest::render_mode() const { return modes_by_name().at(mode);
 LatticeFilter RenderRequest::lattice_filter() const { return filter_named(filter); }
 bool RenderRequest::footprint_on() const { return kOnOff.at(footprint); }
 bool RenderRequest::answers_instances() const {
-    const RenderMode m = render_mode();
-    return m == RenderMode::kLattice || m == RenderMode::kAuto || (m == RenderMode::kExact && footprint_on());
+    return lat::answers_instances(render_mode(), footprint_on());
 }
 
 template <class Target>

@@ -193,7 +193,7 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache* cache, con
     if (lod && !by_crossings) {
         const LevelCosts costs{scene, p, spec};
         const std::pair<int, int> wanted = lod_range(scene, prim, base, filtering.spread);
-        assert(cache);  // every policy but kSubRays reads tables
+        assert(cache);  // every policy but kFootprint reads tables
         const LevelChoice choice = choose_levels(costs, *cache, wanted, filtering);
         by_crossings = filtering.policy == LatticePolicy::kAuto && choice.over_budget && base.primitive;
         if (by_crossings) answer.why = "its finer levels are over --lod-budget";
@@ -201,7 +201,9 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache* cache, con
         const std::string note = levels_note(costs, wanted, choice, filtering, by_crossings);
         if (!note.empty()) out.notes.push_back(note);
     }
-    if (by_crossings && !instanced) return;  // only in CSG: its own shape, exact
+    // Footprint filtering leaves a primitive found only in CSG its own exact shape; auto mode
+    // gives it its table's point-sampled spans, as below.
+    if (sub_rays_everywhere && !instanced) return;
     const double exact_width =
         by_crossings ? sub_ray_bounds(scene, prim, base, filtering.spread, out) : 0;
     answer.by = by_crossings ? AnsweredBy::kSubRayCrossings : AnsweredBy::kFilteredTables;
@@ -275,6 +277,8 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const 
                 used[static_cast<std::size_t>(p)] = csg_leaf[static_cast<std::size_t>(p)] = true;
     }
     const bool sub_rays = filtering.policy == LatticePolicy::kFootprint;
+    // (Footprint filtering sets the smooth filter and reads no table: its spec is only a frame.)
+    assert(!sub_rays || filtering.filter != LatticeFilter::kNone);
     if (!sub_rays && filtering.filter != LatticeFilter::kNone &&
         !find_encoding(spec.encoding).coverage)
         throw InputError("--filter: filtered lattices need a table encoding that stores coverage "
@@ -289,7 +293,7 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const 
         if (sub_rays && !p.lattice) {
             answer.by = AnsweredBy::kExact;
             answer.why = "it has no lattice box";
-        } else if (sub_rays || filtering.filter != LatticeFilter::kNone) {
+        } else if (filtering.filter != LatticeFilter::kNone) {
             filtered_lattice(scene, static_cast<int>(i), cache, spec, progress, filtering,
                              csg_leaf[i], instanced[i], out, answer);
         } else {
