@@ -429,7 +429,7 @@ void build_world(World& w) {
 // own part by up to ~1e-10 of the world ray's length, and a ray leaving it at a slant met that part
 // again (tuft2000: 0.8 % of the pixels lost a light). So 1e-7 of the point's largest coordinate
 // (plus 1), far above double rounding and far below any part. This is exact mode's own rule
-// (src/render/shading.cpp's shadow_epsilon), so the images' identity with exact mode is partly by
+// (src/render/core/shading.cpp's shadow_epsilon), so the images' identity with exact mode is partly by
 // construction: it checks the geometry and shading, not the choice of offset. Native hits'
 // distances are float, so 1e-3 there.
 double shadow_offset(const World& w, V p) {

@@ -16,8 +16,8 @@
 #include "lattice/cache/table_build.h"
 #include "lattice/cache/table_cache.h"
 #include "lattice/encoding.h"
-#include "render/renderer.h"
-#include "render/scene_lattices.h"
+#include "render/core/renderer.h"
+#include "render/modes/scene_lattices.h"
 #include "scene/scene_loader.h"
 
 namespace {

@@ -17,8 +17,8 @@
 #include <string>
 
 #include "io/image.h"
-#include "render/renderer.h"
-#include "render/scene_lattices.h"
+#include "render/core/renderer.h"
+#include "render/modes/scene_lattices.h"
 #include "scene/scene_loader.h"
 
 namespace {

@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "render/renderer.h"
+#include "render/core/renderer.h"
 #include "scene/scene_loader.h"
 
 namespace {

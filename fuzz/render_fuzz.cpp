@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "render/renderer.h"
+#include "render/core/renderer.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
 

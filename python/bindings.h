@@ -5,7 +5,7 @@
 #include <pybind11/pybind11.h>
 
 #include "io/image.h"
-#include "render/renderer.h"
+#include "render/core/renderer.h"
 
 namespace lat::py {
 

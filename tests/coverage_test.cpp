@@ -19,8 +19,8 @@
 #include "lattice/filtered_shape.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/rasterizer.h"
-#include "render/renderer.h"
-#include "render/scene_lattices.h"
+#include "render/core/renderer.h"
+#include "render/modes/scene_lattices.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 

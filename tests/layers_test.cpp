@@ -14,7 +14,7 @@
 
 #include "accel/embree_accel.h"
 #include "geometry/sub_rays.h"
-#include "render/shading.h"
+#include "render/core/shading.h"
 
 namespace lat {
 namespace {

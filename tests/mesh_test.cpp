@@ -13,7 +13,7 @@
 #include "input_error.h"
 #include "io/image_compare.h"
 #include "io/mesh_file.h"
-#include "render/renderer.h"
+#include "render/core/renderer.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 

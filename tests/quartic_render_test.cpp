@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "io/image_compare.h"
-#include "render/renderer.h"
+#include "render/core/renderer.h"
 #include "scene/scene_loader.h"
 
 namespace lat {

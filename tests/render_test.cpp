@@ -7,8 +7,8 @@
 
 #include <cmath>
 
-#include "render/camera.h"
-#include "render/renderer.h"
+#include "render/core/camera.h"
+#include "render/core/renderer.h"
 #include "scene/scene_loader.h"
 #include "test_paths.h"
 

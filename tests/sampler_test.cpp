@@ -1,4 +1,4 @@
-// The samplers of render/sampler.h: where their offsets fall (in the pixel, on the grid, in the
+// The samplers of render/core/sampler.h: where their offsets fall (in the pixel, on the grid, in the
 // elementary intervals), that images are the same bytes on any thread count, and that a few
 // samples of each come close to a many-sample truth.
 #include <gtest/gtest.h>
@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "io/image_compare.h"
-#include "render/camera.h"
-#include "render/renderer.h"
-#include "render/shading.h"
-#include "render/sampler.h"
+#include "render/core/camera.h"
+#include "render/core/renderer.h"
+#include "render/core/shading.h"
+#include "render/core/sampler.h"
 #include "scene/scene_loader.h"
 #include "test_paths.h"
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "input_error.h"
-#include "render/renderer.h"
+#include "render/core/renderer.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 #include "test_paths.h"

@@ -8,7 +8,7 @@
 
 #include "geometry/polynomial_parser.h"
 #include "input_error.h"
-#include "render/renderer.h"
+#include "render/core/renderer.h"
 #include "scene/object_parser.h"
 #include "scene/scene_loader.h"
 

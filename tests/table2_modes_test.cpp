@@ -8,9 +8,9 @@
 #include <cmath>
 #include <string>
 
-#include "render/particle_mode.h"
+#include "render/baselines/particle_mode.h"
 #include "render/render_modes.h"
-#include "render/texture_mode.h"
+#include "render/baselines/texture_mode.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 #include "util/error.h"

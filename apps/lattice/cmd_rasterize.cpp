@@ -6,8 +6,8 @@
 
 #include "commands.h"
 #include "common.h"
-#include "dist/job.h"
-#include "dist/timeline.h"
+#include "distributed/job.h"
+#include "distributed/timeline.h"
 #include "lattice/cache/table_build.h"
 #include "lattice/cache/table_cache.h"
 #include "scene/scene_loader.h"

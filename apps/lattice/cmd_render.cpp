@@ -7,8 +7,8 @@
 
 #include "commands.h"
 #include "common.h"
-#include "dist/job.h"
-#include "dist/timeline.h"
+#include "distributed/job.h"
+#include "distributed/timeline.h"
 #include "io/image.h"
 #include "render/render_request.h"
 #include "scene/scene_loader.h"

@@ -18,7 +18,7 @@
 #include "io/image_compare.h"
 #include "lattice/encoding.h"
 #include "render/render_modes.h"
-#include "render/scene_parts.h"
+#include "render/baselines/scene_parts.h"
 #include "table2_images.h"
 #include "scene/scene_loader.h"
 #include "util/atomic_file.h"

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lattice/cache/table_spec.h"
-#include "dist/job.h"
+#include "distributed/job.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 #include "util/file.h"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "commands.h"
-#include "dist/job.h"
+#include "distributed/job.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 #include "util/hash.h"

@@ -9,10 +9,10 @@
 #include <cstring>
 #include <type_traits>
 
-#include "dist/deal.h"
-#include "dist/job.h"
-#include "dist/message.h"
-#include "dist/timeline.h"
+#include "distributed/deal.h"
+#include "distributed/job.h"
+#include "distributed/message.h"
+#include "distributed/timeline.h"
 #include "geometry/chain.h"
 #include "geometry/ray_fan.h"
 #include "lattice/boundary_grid.h"

@@ -18,7 +18,7 @@ struct RasterizeOptions {
     // Trace only every n-th entry point (to estimate a table's size before building it).
     std::uint32_t entry_stride = 1;
     // Collective: the blocks of entry points are dealt across the ranks of the MPI job
-    // (dist/deal.h) and the hits gathered on rank 0, whose result is then the same as a single
+    // (distributed/deal.h) and the hits gathered on rank 0, whose result is then the same as a single
     // process's; the other ranks' results hold the counts of their own blocks, and no hits.
     bool across_ranks = false;
 };

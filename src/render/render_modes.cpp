@@ -6,11 +6,11 @@
 #include <optional>
 #include <cmath>
 
-#include "dist/timeline.h"
+#include "distributed/timeline.h"
 #include "geometry/chain.h"
 #include "lattice/encoding.h"
-#include "render/camera.h"
-#include "render/scene_parts.h"
+#include "render/core/camera.h"
+#include "render/baselines/scene_parts.h"
 
 namespace lat {
 namespace {

@@ -10,10 +10,10 @@
 
 #include "accel/embree_accel.h"
 #include "lattice/cache/table_spec.h"
-#include "render/particle_mode.h"
-#include "render/renderer.h"
-#include "render/scene_lattices.h"
-#include "render/texture_mode.h"
+#include "render/baselines/particle_mode.h"
+#include "render/core/renderer.h"
+#include "render/modes/scene_lattices.h"
+#include "render/baselines/texture_mode.h"
 
 namespace lat {
 

@@ -12,10 +12,10 @@
 #include <variant>
 #include <vector>
 
-#include "dist/timeline.h"
+#include "distributed/timeline.h"
 #include "lattice/cache/table_spec.h"
 #include "render/render_modes.h"
-#include "render/scene_lattices.h"
+#include "render/modes/scene_lattices.h"
 
 namespace lat {
 

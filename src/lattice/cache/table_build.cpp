@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "dist/job.h"
-#include "dist/timeline.h"
+#include "distributed/job.h"
+#include "distributed/timeline.h"
 #include "lattice/boundary_grid.h"
 #include "util/error.h"
 #include "util/memory.h"

@@ -11,7 +11,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "dist/job.h"
+#include "distributed/job.h"
 #include "lattice/cache/table_build.h"
 #include "util/error.h"
 

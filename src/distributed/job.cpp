@@ -1,10 +1,10 @@
-#include "dist/job.h"
+#include "distributed/job.h"
 
 #include <algorithm>
 #include <cstring>
 
-#include "dist/timeline.h"
-#include "dist/transport.h"
+#include "distributed/timeline.h"
+#include "distributed/transport.h"
 #include "util/hash.h"
 #include "util/threads.h"
 

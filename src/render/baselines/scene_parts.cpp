@@ -1,4 +1,4 @@
-#include "render/scene_parts.h"
+#include "render/baselines/scene_parts.h"
 
 namespace lat {
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-// Where the texture mode's texels lie on a base surface (render/texture_mode.h): a layout of
+// Where the texture mode's texels lie on a base surface (render/baselines/texture_mode.h): a layout of
 // texels over the surface, the surface points inside each texel (for baking) and the texels
 // around a surface point with their bilinear weights (for lookups). Everything is in the base
 // object's own coordinates.

@@ -10,7 +10,7 @@
 #include <cstdlib>
 #include <ctime>
 
-#include "dist/transport.h"
+#include "distributed/transport.h"
 
 namespace lat::dist::transport {
 namespace {

@@ -21,7 +21,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "render/renderer.h"
+#include "render/core/renderer.h"
 #include "scene/scene.h"
 
 namespace lat {

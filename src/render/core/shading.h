@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "render/render_scene.h"
+#include "render/core/render_scene.h"
 
 namespace lat {
 

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "dist/transport.h"
+#include "distributed/transport.h"
 
 namespace lat::dist::transport {
 

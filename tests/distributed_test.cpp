@@ -1,4 +1,4 @@
-// src/dist's pieces that do not need a second rank: reading another rank's messages without
+// src/distributed's pieces that do not need a second rank: reading another rank's messages without
 // trusting them, and the thread limit a rank widens while the others of its node sleep.
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <cstring>
 #include <vector>
 
-#include "dist/message.h"
+#include "distributed/message.h"
 #include "util/threads.h"
 
 namespace lat {

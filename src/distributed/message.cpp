@@ -1,4 +1,4 @@
-#include "dist/message.h"
+#include "distributed/message.h"
 
 namespace lat::dist {
 

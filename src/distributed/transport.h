@@ -1,6 +1,6 @@
 #pragma once
-// The few message-passing primitives src/dist is built on: MPI when the build found it
-// (transport_mpi.cpp), one process otherwise (transport_local.cpp). Internal to src/dist; the
+// The few message-passing primitives src/distributed is built on: MPI when the build found it
+// (transport_mpi.cpp), one process otherwise (transport_local.cpp). Internal to src/distributed; the
 // rest of the code uses dist/job.h and dist/deal.h.
 //
 // Every wait polls with short sleeps instead of spinning the way blocking MPI calls do, so a

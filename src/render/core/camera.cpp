@@ -1,4 +1,4 @@
-#include "render/camera.h"
+#include "render/core/camera.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "dist/timeline.h"
+#include "distributed/timeline.h"
 
 #include <chrono>
 

@@ -1,4 +1,4 @@
-#include "dist/deal.h"
+#include "distributed/deal.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -10,9 +10,9 @@
 #include <deque>
 #include <mutex>
 
-#include "dist/job.h"
-#include "dist/timeline.h"
-#include "dist/transport.h"
+#include "distributed/job.h"
+#include "distributed/timeline.h"
+#include "distributed/transport.h"
 #include "util/progress.h"
 #include "util/threads.h"
 

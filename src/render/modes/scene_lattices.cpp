@@ -1,4 +1,4 @@
-#include "render/scene_lattices.h"
+#include "render/modes/scene_lattices.h"
 
 #include <algorithm>
 #include <cassert>

@@ -1,4 +1,4 @@
-#include "render/shading.h"
+#include "render/core/shading.h"
 
 #include <cmath>
 

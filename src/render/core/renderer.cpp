@@ -1,4 +1,4 @@
-#include "render/renderer.h"
+#include "render/core/renderer.h"
 
 #include <atomic>
 #include <cassert>
@@ -7,13 +7,13 @@
 #include <cstring>
 #include <span>
 
-#include "dist/deal.h"
-#include "dist/job.h"
-#include "dist/message.h"
-#include "dist/timeline.h"
-#include "render/camera.h"
+#include "distributed/deal.h"
+#include "distributed/job.h"
+#include "distributed/message.h"
+#include "distributed/timeline.h"
+#include "render/core/camera.h"
 #include "render/layers.h"
-#include "render/shading.h"
+#include "render/core/shading.h"
 #include "util/error.h"
 #include "util/interrupt.h"
 #include "util/memory.h"

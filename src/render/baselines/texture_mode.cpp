@@ -1,4 +1,4 @@
-#include "render/texture_mode.h"
+#include "render/baselines/texture_mode.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -7,9 +7,9 @@
 #include <cmath>
 #include <map>
 
-#include "render/render_scene.h"
-#include "render/scene_parts.h"
-#include "render/shading.h"
+#include "render/core/render_scene.h"
+#include "render/baselines/scene_parts.h"
+#include "render/core/shading.h"
 #include "scene/scatter.h"
 #include "util/error.h"
 #include "util/progress.h"

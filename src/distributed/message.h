@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "dist/deal.h"
+#include "distributed/deal.h"
 
 namespace lat::dist {
 

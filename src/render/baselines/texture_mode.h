@@ -9,7 +9,7 @@
 //   line through each root along the instance's up axis meets nearest to the root (median over
 //   up to 1,024 instances spread over the list). Scatter roots lie on their surface, so a
 //   scatter's "on" object is found at distance zero. Spheres, ellipsoids and triangle meshes
-//   can be mapped (render/texture_atlas.h: an equirectangular map, or per-triangle texel grids
+//   can be mapped (render/baselines/texture_atlas.h: an equirectangular map, or per-triangle texel grids
 //   for meshes, which have no parametrisation); any other base is refused, and so is fur
 //   standing apart from the base (one base a scene).
 // - Baking: each texel is sampled on an s x s grid; at each sample a ray comes down the
@@ -27,8 +27,8 @@
 #include <memory>
 #include <vector>
 
-#include "render/renderer.h"
-#include "render/texture_atlas.h"
+#include "render/core/renderer.h"
+#include "render/baselines/texture_atlas.h"
 #include "scene/scene.h"
 
 namespace lat {

@@ -1,6 +1,6 @@
 #pragma once
 // The job a `lattice` process belongs to: itself alone, or one rank of an MPI job when mpirun
-// or srun started it (and the build found MPI). All of MPI lives in src/dist; the rest of the
+// or srun started it (and the build found MPI). All of MPI lives in src/distributed; the rest of the
 // code asks which rank it is and uses the collective steps below and in dist/deal.h, which are
 // plain calls in a single process. "Collective" means every rank of the job makes the call,
 // in the same order.

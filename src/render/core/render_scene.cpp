@@ -1,4 +1,4 @@
-#include "render/render_scene.h"
+#include "render/core/render_scene.h"
 
 #include <cassert>
 

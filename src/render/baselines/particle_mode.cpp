@@ -1,4 +1,4 @@
-#include "render/particle_mode.h"
+#include "render/baselines/particle_mode.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -10,11 +10,11 @@
 #include <limits>
 
 #include "geometry/chain.h"
-#include "render/camera.h"
-#include "render/sampler.h"
-#include "render/render_scene.h"
-#include "render/scene_parts.h"
-#include "render/shading.h"
+#include "render/core/camera.h"
+#include "render/core/sampler.h"
+#include "render/core/render_scene.h"
+#include "render/baselines/scene_parts.h"
+#include "render/core/shading.h"
 #include "util/error.h"
 #include "util/interrupt.h"
 #include "util/progress.h"

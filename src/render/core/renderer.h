@@ -8,15 +8,15 @@
 #include <string_view>
 #include <vector>
 
-#include "dist/timeline.h"
+#include "distributed/timeline.h"
 #include "io/image.h"
-#include "render/render_scene.h"
-#include "render/sampler.h"
-#include "render/shading.h"
+#include "render/core/render_scene.h"
+#include "render/core/sampler.h"
+#include "render/core/shading.h"
 
 namespace lat {
 
-// Radiance seen along a ray at a hit, in place of shade() (render/shading.h): how a mode that
+// Radiance seen along a ray at a hit, in place of shade() (render/core/shading.h): how a mode that
 // changes surfaces, not geometry, shades them (e.g. the texture mode's baked maps).
 using SurfaceShader = std::function<Vec3(const Ray&, const SurfaceHit&, ShadeState&)>;
 
@@ -27,7 +27,7 @@ struct RenderOptions {
     bool layered = false;
     bool progress = false;
     SurfaceShader shader;  // empty: shade()
-    // Collective: the tiles are dealt across the ranks of the MPI job (dist/deal.h) and the
+    // Collective: the tiles are dealt across the ranks of the MPI job (distributed/deal.h) and the
     // image is gathered on rank 0; the other ranks return their share of the figures only.
     bool across_ranks = false;
 };

@@ -1,4 +1,4 @@
-#include "render/texture_atlas.h"
+#include "render/baselines/texture_atlas.h"
 
 #include <algorithm>
 #include <cassert>

@@ -1,4 +1,4 @@
-#include "render/sampler.h"
+#include "render/core/sampler.h"
 
 #include <algorithm>
 #include <array>
