@@ -16,7 +16,7 @@
 #include "lattice/cache/table_build.h"
 #include "lattice/cache/table_cache.h"
 #include "lattice/encoding.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "render/modes/scene_lattices.h"
 #include "scene/scene_loader.h"
 
@@ -240,7 +240,7 @@ void BM_Render(benchmark::State& state, const std::string& plate, bool lattice) 
     std::uint64_t rays = 0;
     for (auto _ : state) {
         lat::RenderOutput out;
-        arena.execute([&] { out = lat::render_image(rs, {}); });
+        arena.execute([&] { out = lat::render_exact(rs, {}); });
         rays += out.stats.primary_rays + out.stats.shadow_rays;
     }
     state.counters["rays_per_s"] = benchmark::Counter(static_cast<double>(rays), benchmark::Counter::kIsRate);

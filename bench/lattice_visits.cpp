@@ -17,7 +17,7 @@
 #include <string>
 
 #include "io/image.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "render/modes/scene_lattices.h"
 #include "scene/scene_loader.h"
 
@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
             wrapped.push_back(s ? std::make_shared<CountingShape>(s, counts) : nullptr);
         const lat::RenderScene rs(
             scene, [&wrapped](int p) { return wrapped[static_cast<std::size_t>(p)]; });
-        const lat::RenderOutput out = lat::render_image(rs, {});
+        const lat::RenderOutput out = lat::render_exact(rs, {});
         if (!output.empty()) lat::write_png(output, out.display);
         std::printf(
             "{\"encoding\": \"%s\", \"tables_built\": %d, \"primary_rays\": %llu, "

@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "scene/scene_loader.h"
 
 namespace {
@@ -40,7 +40,7 @@ void BM_RenderExact(benchmark::State& state, const std::string& plate) {
     std::uint64_t rays = 0;
     for (auto _ : state) {
         lat::RenderOutput out;
-        arena.execute([&] { out = lat::render_image(*p.rs, {}); });
+        arena.execute([&] { out = lat::render_exact(*p.rs, {}); });
         rays += out.stats.primary_rays + out.stats.shadow_rays;
         benchmark::DoNotOptimize(out.display.rgb.data());
     }

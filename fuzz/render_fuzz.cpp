@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
 
@@ -18,7 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         scene.camera.width = 4;  // the geometry is what is fuzzed, not the image size
         scene.camera.height = 3;
         const lat::RenderScene rs(scene);
-        (void)lat::render_image(rs, {});
+        (void)lat::render_exact(rs, {});
     } catch (const lat::InputError&) {
     }
     return 0;

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "input_error.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 #include "util/atomic_file.h"
@@ -130,7 +130,7 @@ TEST(Interrupt, RenderStopsAtTheNextTile) {
     const RenderScene rs(s);
     std::raise(SIGINT);
     try {
-        render_image(rs, {});
+        render_exact(rs, {});
         ADD_FAILURE() << "the render finished after SIGINT";
     } catch (const Interrupted& e) {
         EXPECT_EQ(e.exit_code(), 130);

@@ -19,7 +19,7 @@
 #include "lattice/filtered_shape.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/rasterizer.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "render/modes/scene_lattices.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
@@ -378,7 +378,7 @@ TEST(Coverage, AThinPrimitiveHasTheRightBrightness) {
     const Scene s = load_scene(path);
     RenderOptions gt;
     gt.spp = 64;
-    const double exact = mean_brightness(render_image(RenderScene(s), gt).display);
+    const double exact = mean_brightness(render_exact(RenderScene(s), gt).display);
     ASSERT_GT(exact, 2.0);
     const TableCache cache(dir.path().string());
     TableSpec spec;
@@ -386,14 +386,13 @@ TEST(Coverage, AThinPrimitiveHasTheRightBrightness) {
     for (const LatticeFilter f : {LatticeFilter::kBox, LatticeFilter::kSmooth}) {
         const SceneLattices l = scene_lattices(s, cache, spec, false, {f, false, 0});
         const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
-        RenderOptions opt;
-        opt.layered = true;
-        const double filtered = mean_brightness(render_image(rs, opt).display);
+        const RenderOptions opt;
+        const double filtered = mean_brightness(render_layered(rs, opt).display);
         EXPECT_NEAR(filtered / exact, 1.0, 0.02) << "filter " << int(f);
         // Partial hits composited in ray order: the same bytes on one thread.
         Image8 one;
-        tbb::task_arena(1).execute([&] { one = render_image(rs, opt).display; });
-        EXPECT_EQ(one.rgb, render_image(rs, opt).display.rgb);
+        tbb::task_arena(1).execute([&] { one = render_layered(rs, opt).display; });
+        EXPECT_EQ(one.rgb, render_layered(rs, opt).display.rgb);
     }
 }
 
@@ -429,12 +428,11 @@ Image8 render_filtered(const std::string& text) {
     const double spread = 2 * std::tan(22 * M_PI / 360.0) / 40;
     const SceneLattices l = scene_lattices(s, cache, spec, false, {LatticeFilter::kSmooth, true, spread});
     const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
-    RenderOptions opt;
-    opt.layered = true;
-    const Image8 image = render_image(rs, opt).display;
+    const RenderOptions opt;
+    const Image8 image = render_layered(rs, opt).display;
     // The same bytes on one thread (the directions across are per ray, not per thread).
     Image8 one;
-    tbb::task_arena(1).execute([&] { one = render_image(rs, opt).display; });
+    tbb::task_arena(1).execute([&] { one = render_layered(rs, opt).display; });
     EXPECT_EQ(one.rgb, image.rgb);
     return image;
 }

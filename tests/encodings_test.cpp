@@ -14,7 +14,7 @@
 #include "lattice/encoding.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/rasterizer.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "render/modes/scene_lattices.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
@@ -245,7 +245,7 @@ Image8 render_candidates(const Scene& s) {
     spec.encoding = "candidates";
     const SceneLattices l = scene_lattices(s, cache, spec, false);
     const RenderScene lattice(s, [&](int i) { return l.shapes[static_cast<std::size_t>(i)]; });
-    return render_image(lattice, {}).display;
+    return render_exact(lattice, {}).display;
 }
 
 // A primitive that counts how it is asked: with some leaves switched off (pieces_spans), or
@@ -323,7 +323,7 @@ TEST(EncodingCandidates, CsgPrimitivesListTheirLeaves) {
 TEST(EncodingCandidates, CsgPrimitivesRenderAsExact) {
     const Scene& s = tori_scene();
     const ImageDiffStats d =
-        compare_images(render_image(RenderScene(s), {}).display, render_candidates(s));
+        compare_images(render_exact(RenderScene(s), {}).display, render_candidates(s));
     EXPECT_EQ(d.max_abs_error, 0);
 }
 
@@ -336,7 +336,7 @@ TEST(EncodingCandidates, CsgPrimitivesAsCsgLeavesRenderAsExact) {
            "transform": [{"rotate": {"axis": [0, 1, 0], "angle_deg": 200}}, {"translate": [8, 0, 8]}]},
           {"type": "sphere", "center": [5, 4, 6], "radius": 2.2, "material": "cut"}]},
         {"type": "halfspace", "point": [0, 0, -6], "normal": [0, 0, 1], "material": "m"}])");
-    const Image8 exact = render_image(RenderScene(s), {}).display;
+    const Image8 exact = render_exact(RenderScene(s), {}).display;
     EXPECT_EQ(compare_images(exact, render_candidates(s)).max_abs_error, 0);
     std::size_t covered = 0;
     for (std::size_t i = 0; i + 2 < exact.rgb.size(); i += 3)
@@ -391,8 +391,8 @@ TEST(EncodingCandidates, PlatesRenderAsExact) {
         s.camera.width = s.camera.height = 160;
         const SceneLattices l = scene_lattices(s, cache, spec, false);
         const RenderScene lattice(s, [&](int i) { return l.shapes[static_cast<std::size_t>(i)]; });
-        const ImageDiffStats d = compare_images(render_image(RenderScene(s), {}).display,
-                                                render_image(lattice, {}).display);
+        const ImageDiffStats d = compare_images(render_exact(RenderScene(s), {}).display,
+                                                render_exact(lattice, {}).display);
         EXPECT_EQ(d.max_abs_error, 0) << plate;
     }
 }

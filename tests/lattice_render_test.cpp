@@ -5,7 +5,7 @@
 #include "io/image_compare.h"
 #include "lattice/encoding.h"
 #include "lattice/lattice_shape.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "render/modes/scene_lattices.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
@@ -25,7 +25,7 @@ Scene small(const char* name, int size) {
 }
 
 Image8 render_exact(const Scene& s) {
-    return render_image(RenderScene(s), {}).display;
+    return render_exact(RenderScene(s), {}).display;
 }
 
 Image8 render_lattice(const Scene& s, const TableCache& cache, int sigma_inv,
@@ -35,7 +35,7 @@ Image8 render_lattice(const Scene& s, const TableCache& cache, int sigma_inv,
     spec.encoding = encoding;
     const SceneLattices l = scene_lattices(s, cache, spec, false);
     const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
-    return render_image(rs, {}).display;
+    return render_exact(rs, {}).display;
 }
 
 class LatticeRender : public ::testing::Test {
@@ -62,14 +62,14 @@ TEST_F(LatticeRender, VisitsAreCounted) {
     // render --stats' lattice_visits: none in exact mode; in lattice mode the same count every
     // time, whichever threads rendered which tiles.
     const Scene s = small("plate4-fuzzy-sphere-1000", 48);
-    EXPECT_EQ(render_image(RenderScene(s), {}).stats.lattice_visits, 0u);
+    EXPECT_EQ(render_exact(RenderScene(s), {}).stats.count(stats::Counter::kLatticeVisits), 0u);
     TableSpec spec;
     spec.encoding = "dense";
     const SceneLattices l = scene_lattices(s, cache, spec, false);
     const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
-    const RenderStats a = render_image(rs, {}).stats, b = render_image(rs, {}).stats;
-    EXPECT_GT(a.lattice_visits, a.primary_rays / 4);
-    EXPECT_EQ(a.lattice_visits, b.lattice_visits);
+    const RenderStats a = render_exact(rs, {}).stats, b = render_exact(rs, {}).stats;
+    EXPECT_GT(a.count(stats::Counter::kLatticeVisits), a.primary_rays / 4);
+    EXPECT_EQ(a.count(stats::Counter::kLatticeVisits), b.count(stats::Counter::kLatticeVisits));
 }
 
 TEST_F(LatticeRender, CsgPrimitivesRasterizeToo) {
@@ -147,7 +147,7 @@ TEST_F(LatticeRender, CullingByThePrimitiveChangesNoPixel) {
             }
             auto render = [&](const std::vector<std::shared_ptr<const Shape>>& shapes) {
                 const RenderScene rs(s, [&](int p) { return shapes[static_cast<std::size_t>(p)]; });
-                return render_image(rs, {}).display;
+                return render_exact(rs, {}).display;
             };
             const Image8 reference = encoding == "candidates" ? render_exact(s) : render(boxed);
             EXPECT_EQ(compare_images(reference, render(culled)).max_abs_error, 0)
@@ -200,7 +200,7 @@ TEST_F(LatticeRender, TurnedInstancesAreCulledByTheirPlacedParts) {
         EXPECT_LT(culled_volume, limit * volume(xf.bounds(culled->bounds()))) << encoding;
         auto render = [&](const std::shared_ptr<const Shape>& shape) {
             const RenderScene rs(s, [&](int) { return shape; });
-            return render_image(rs, {}).display;
+            return render_exact(rs, {}).display;
         };
         const Image8 reference = encoding == "candidates" ? render_exact(s) : render(boxed);
         const Image8 image = render(culled);

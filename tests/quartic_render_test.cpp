@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "io/image_compare.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "scene/scene_loader.h"
 
 namespace lat {
@@ -11,7 +11,7 @@ namespace {
 
 Image8 render_text(const std::string& json) {
     const Scene s = load_scene_text(json, "test.json");
-    return render_image(RenderScene(s), {}).display;
+    return render_exact(RenderScene(s), {}).display;
 }
 
 std::string scene(const std::string& camera, const std::string& object) {

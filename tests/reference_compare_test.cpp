@@ -15,7 +15,7 @@
 #include "io/image_compare.h"
 #include "reference/reference_tracer.h"
 #include "render/core/render_scene.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 #include "test_paths.h"
@@ -55,7 +55,7 @@ Image8 project_render(const std::string& path, int w = 0, int h = 0) {
         scene.camera.height = h;
     }
     const RenderScene rs(scene);
-    return render_image(rs, RenderOptions{}).display;
+    return render_exact(rs, RenderOptions{}).display;
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "render/core/camera.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "scene/scene_loader.h"
 #include "test_paths.h"
 
@@ -71,7 +71,7 @@ Vec3 expected_pixel(const Scene& s, int i, int j) {
 TEST(Render, LitSphereMatchesTheShadingRule) {
     const Scene s = load_scene_text(kSphereScene, "sphere.json");
     const RenderScene rs(s);
-    const RenderOutput out = render_image(rs, {});
+    const RenderOutput out = render_exact(rs, {});
     int checked = 0;
     for (int j = 0; j < s.camera.height; ++j) {
         for (int i = 0; i < s.camera.width; ++i) {
@@ -91,7 +91,7 @@ TEST(Render, LitSphereMatchesTheShadingRule) {
 // every other light at every hit casts one. Counted by the reference rule, as above.
 TEST(Render, LightsThatAddNothingCastNoShadowRay) {
     const Scene s = load_scene_text(kSphereScene, "sphere.json");
-    const RenderOutput out = render_image(RenderScene(s), {});
+    const RenderOutput out = render_exact(RenderScene(s), {});
     std::uint64_t pairs = 0, adding = 0;
     for (int j = 0; j < s.camera.height; ++j)
         for (int i = 0; i < s.camera.width; ++i) {
@@ -118,7 +118,7 @@ Scene small_plate(const char* name, int size) {
 Image8 render_with_threads(const RenderScene& rs, int threads) {
     tbb::task_arena arena(threads);
     Image8 img;
-    arena.execute([&] { img = render_image(rs, {}).display; });
+    arena.execute([&] { img = render_exact(rs, {}).display; });
     return img;
 }
 
@@ -138,8 +138,8 @@ TEST(Render, InstancedAndFlattenedAgree) {
     inst.instancing = Instancing::kAlways;
     flat.instancing = Instancing::kNever;
     const RenderScene a(s, {}, inst), b(s, {}, flat);
-    const Image8 ia = render_image(a, {}).display;
-    EXPECT_EQ(ia.rgb, render_image(b, {}).display.rgb);
+    const Image8 ia = render_exact(a, {}).display;
+    EXPECT_EQ(ia.rgb, render_exact(b, {}).display.rgb);
     // Not two blank images: the thistle covers a good part of the frame, whose corner is
     // background.
     std::size_t covered = 0;
@@ -177,8 +177,8 @@ TEST(Render, TreesAsCsgLeavesShadeAsWrittenOut) {
     std::string inline_bite = bite;
     inline_bite.replace(inline_bite.find("[3.5, 3.5, 1.5]"), 15, "[0, 0, 0]");
     const Scene written = scene(inline_bite);
-    const Image8 a = render_image(RenderScene(nested), {}).display;
-    const Image8 b = render_image(RenderScene(written), {}).display;
+    const Image8 a = render_exact(RenderScene(nested), {}).display;
+    const Image8 b = render_exact(RenderScene(written), {}).display;
     int differ = 0;
     for (std::size_t i = 0; i < a.rgb.size(); ++i) differ += std::abs(a.rgb[i] - b.rgb[i]) > 1;
     EXPECT_EQ(differ, 0);
@@ -199,7 +199,7 @@ TEST(Render, SupersamplingAveragesAnEdge) {
     const RenderScene rs(s);
     RenderOptions opt;
     opt.spp = 64;
-    const RenderOutput out = render_image(rs, opt);
+    const RenderOutput out = render_exact(rs, opt);
     // Column 4 is centred on x = 0; an 8 x 8 stratified grid puts exactly half its samples on
     // each side.
     for (int j = 0; j < 9; ++j) {

@@ -12,7 +12,7 @@
 
 #include "io/image_compare.h"
 #include "render/core/camera.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "render/core/shading.h"
 #include "render/core/sampler.h"
 #include "scene/scene_loader.h"
@@ -156,11 +156,11 @@ TEST(Sampler, ImagesAreTheSameOnOneAndTwoThreads) {
         RenderOutput one, two;
         {
             tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-            one = render_image(rs, opt);
+            one = render_exact(rs, opt);
         }
         {
             tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
-            two = render_image(rs, opt);
+            two = render_exact(rs, opt);
         }
         EXPECT_EQ(one.radiance.rgb, two.radiance.rgb) << sampler_description(kind).name;
         EXPECT_EQ(one.display.rgb, two.display.rgb) << sampler_description(kind).name;
@@ -199,13 +199,13 @@ TEST(Sampler, FourSamplesComeCloseToTheTruth) {
     const Image8 truth = truth_image(rs, 16);
     constexpr double kMinPsnr = 26.0;  // the samplers 28.9-29.8 dB, the centre 22.5
     RenderOptions opt;
-    const RenderOutput centre = render_image(rs, opt);
+    const RenderOutput centre = render_exact(rs, opt);
     EXPECT_EQ(centre.stats.sampler, "centre");
     EXPECT_LT(compare_images(centre.display, truth).psnr_db, kMinPsnr);
     for (const SamplerKind kind : all_samplers()) {
         opt.spp = 4;
         opt.sampler = kind;
-        EXPECT_GT(compare_images(render_image(rs, opt).display, truth).psnr_db, kMinPsnr)
+        EXPECT_GT(compare_images(render_exact(rs, opt).display, truth).psnr_db, kMinPsnr)
             << sampler_description(kind).name;
     }
 }

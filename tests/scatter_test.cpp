@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "input_error.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 #include "test_paths.h"
@@ -192,12 +192,12 @@ TEST(Scatter, DeterministicForASeedAndAnyThreadCount) {
     tbb::task_arena(1).execute([&] {
         const Scene s = load(objs);
         h1 = placement_hash(s);
-        i1 = render_image(RenderScene(s), {}).display;
+        i1 = render_exact(RenderScene(s), {}).display;
     });
     tbb::task_arena(2).execute([&] {
         const Scene s = load(objs);
         h2 = placement_hash(s);
-        i2 = render_image(RenderScene(s), {}).display;
+        i2 = render_exact(RenderScene(s), {}).display;
     });
     EXPECT_EQ(h1, h2);
     EXPECT_EQ(i1.rgb, i2.rgb);
@@ -251,7 +251,7 @@ TEST(Scatter, CommandWritesExplicitInstancesThatRenderTheSameImage) {
     ASSERT_EQ(a.objects.size(), b.objects.size());
     EXPECT_TRUE(b.scatters.empty());
     EXPECT_EQ(placement_hash(a), placement_hash(b));  // the mesh path was moved to stay found
-    EXPECT_EQ(render_image(RenderScene(a), {}).display.rgb, render_image(RenderScene(b), {}).display.rgb);
+    EXPECT_EQ(render_exact(RenderScene(a), {}).display.rgb, render_exact(RenderScene(b), {}).display.rgb);
 }
 
 }  // namespace

@@ -8,7 +8,7 @@
 
 #include "geometry/polynomial_parser.h"
 #include "input_error.h"
-#include "render/core/renderer.h"
+#include "render/modes/integrators.h"
 #include "scene/object_parser.h"
 #include "scene/scene_loader.h"
 
@@ -134,7 +134,7 @@ TEST(SceneLimits, ExtremeQuarticRendersWithoutCrashing) {
         "polynomial": "(x^2+y^2+z^2)^2 - 1e308"}, {"type": "sphere", "radius": 1, "material": "m"})";
     const Scene s = load_scene_text(scene_with(obj), "scene.json");
     const RenderScene rs(s);
-    const RenderOutput out = render_image(rs, {});
+    const RenderOutput out = render_exact(rs, {});
     EXPECT_EQ(out.display.rgb.size(), 8u * 6u * 3u);
 }
 

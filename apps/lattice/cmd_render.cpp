@@ -39,7 +39,7 @@ void print_summary(const RenderRequest& a, const Scene& scene, const ModeResult&
                      lattices.paths.size(), lattices.paths.size() == 1 ? "" : "s",
                      human_bytes(static_cast<double>(lattices.table_bytes)).c_str(),
                      std::to_string(lattices.table_entries).c_str(), lattices.built,
-                     lattices.build_seconds, static_cast<unsigned long long>(st.lattice_visits));
+                     lattices.build_seconds, static_cast<unsigned long long>(st.count(stats::Counter::kLatticeVisits)));
     if (a.answers_instances() && lattices.answers.empty())
         std::fprintf(stderr, "lattice: note: the scene has no instances of a primitive: every object is traced exactly\n");
     for (const std::string& note : lattices.notes) std::fprintf(stderr, "lattice: note: %s\n", note.c_str());

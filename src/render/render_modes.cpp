@@ -10,6 +10,7 @@
 #include "geometry/chain.h"
 #include "lattice/encoding.h"
 #include "render/core/camera.h"
+#include "render/modes/integrators.h"
 #include "render/baselines/scene_parts.h"
 
 namespace lat {
@@ -112,7 +113,6 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
                 const TableSpec spec = cache ? settings.spec : TableSpec{1, std::string(coverage_encoding().name), {}};
                 r.lattices = scene_lattices(scene, cache ? &*cache : nullptr, spec,
                                             settings.progress, *filtering);
-                opt.layered = filtering->filter != LatticeFilter::kNone;  // footprint: smooth
                 r.bytes_added += r.lattices.table_bytes;
             }
             RenderScene::InstanceShapeFn instance_shape;
@@ -129,7 +129,10 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             r.build_ms = ms_since(t0);
             dist::mark(dist::Step::kAccel);
             if (settings.before_render) settings.before_render();
-            r.out = render_image(rs, opt);
+            // Partial hits are traced in layers, chosen here once: a filter makes them
+            // (footprint filtering's is smooth); point-sampled tables and exact shapes have none.
+            const bool layered = filtering && filtering->filter != LatticeFilter::kNone;
+            r.out = layered ? render_layered(rs, opt) : render_exact(rs, opt);
             break;
         }
         case RenderMode::kTexture: {

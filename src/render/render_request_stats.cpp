@@ -33,7 +33,7 @@ nlohmann::json answers_json(const RenderRequest& a, const SceneLattices& lattice
 }
 
 nlohmann::json rank_json(const RankStats& rs) {
-    return {{"rank", rs.rank},
+    nlohmann::json j{{"rank", rs.rank},
             {"host", rs.host},
             {"threads", rs.threads},
             {"tiles", rs.tiles},
@@ -43,9 +43,11 @@ nlohmann::json rank_json(const RankStats& rs) {
             {"cpu_ms", rs.cpu_ms},
             {"primary_rays", rs.primary_rays},
             {"shadow_rays", rs.shadow_rays},
-            {"lattice_visits", rs.lattice_visits},
             {"peak_memory_bytes", rs.peak_memory_bytes},
             {"timeline_ms", timeline_json(rs.timeline)}};
+    for (std::size_t c = 0; c < rs.counted.size(); ++c)
+        j[std::string(stats::counter_name(stats::Counter(c)))] = rs.counted[c];
+    return j;
 }
 
 }  // namespace
@@ -76,7 +78,7 @@ nlohmann::json render_stats_json(const RenderRequest& a, const Scene& scene, con
         j["table_bytes"] = lattices.table_bytes;
         j["table_entries"] = lattices.table_entries;
         j["table_files"] = lattices.paths;
-        j["table_visits"] = st.lattice_visits;
+        j["table_visits"] = st.count(stats::Counter::kLatticeVisits);
     }
     j["option_notes"] = a.notes;
     j["render_ms"] = st.render_ms;

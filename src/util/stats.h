@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string_view>
 
 namespace lat::stats {
 
@@ -16,8 +17,20 @@ enum class Counter : std::size_t {
     kCount
 };
 
+// Every counter's value at once: a thread's tally, or what a stretch of work added to them.
+using Tally = std::array<std::uint64_t, std::size_t(Counter::kCount)>;
+
+// The counter's name in reports (render --stats, per rank).
+constexpr std::string_view counter_name(Counter c) {
+    switch (c) {
+        case Counter::kLatticeVisits: return "lattice_visits";
+        case Counter::kCount: break;
+    }
+    return "";
+}
+
 namespace detail {
-inline constinit thread_local std::array<std::uint64_t, std::size_t(Counter::kCount)> t_tally{};
+inline constinit thread_local Tally t_tally{};
 }  // namespace detail
 
 inline void bump(Counter c) {
@@ -27,5 +40,7 @@ inline void bump(Counter c) {
 inline std::uint64_t this_thread(Counter c) {
     return detail::t_tally[std::size_t(c)];
 }
+// All of the calling thread's tallies so far.
+inline const Tally& this_thread() { return detail::t_tally; }
 
 }  // namespace lat::stats

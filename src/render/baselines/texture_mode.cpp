@@ -177,29 +177,44 @@ TextureMaps bake_texture(const Scene& scene, const TextureOptions& opt) {
     return maps;
 }
 
-RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const RenderOptions& opt) {
-    const Scene base_only = base_scene(scene);
-    const RenderScene rs(base_only);
-    if (!maps.atlas) return render_image(rs, opt);
-    // The base's index among the remaining objects: instances before it were removed.
-    std::uint32_t base_index = 0;
-    for (std::size_t i = 0; i < maps.base_object; ++i)
-        if (scene.objects[i].primitive < 0) ++base_index;
-    const SceneObject& base = scene.objects[maps.base_object];
-    const Material& fur = scene.materials[maps.fur_material];
+namespace {
 
-    RenderOptions o = opt;
-    o.shader = [&](const Ray& ray, const SurfaceHit& hit, ShadeState& state) {
-        if (hit.object != base_index) return shade(rs, ray, hit, state);
-        const Material& m = scene.materials[hit.material];
+// Exact shading, but at the base surface the bare base and the baked fur blended by coverage.
+class TextureIntegrator final : public Integrator {
+public:
+    TextureIntegrator(const Scene& scene, const TextureMaps& maps, const RenderScene& rs)
+        : scene_(scene), maps_(maps), rs_(rs) {
+        if (!maps.atlas) return;
+        // The base's index among the traced objects: instances before it were removed.
+        for (std::size_t i = 0; i < maps.base_object; ++i)
+            if (scene.objects[i].primitive < 0) ++base_index_;
+    }
+
+    Vec3 radiance(const Ray& ray, ShadeState& state) const override {
+        SurfaceHit hit;
+        if (!rs_.intersect(ray, 0.0, kInfinity, hit)) return rs_.scene().background;
+        if (!maps_.atlas || hit.object != base_index_) return shade(rs_, ray, hit, state);
+        return textured(ray, hit, state);
+    }
+
+private:
+    const Scene& scene_;  // with its instances
+    const TextureMaps& maps_;
+    const RenderScene& rs_;  // the scene without them
+    std::uint32_t base_index_ = 0;
+
+    Vec3 textured(const Ray& ray, const SurfaceHit& hit, ShadeState& state) const {
+        const SceneObject& base = scene_.objects[maps_.base_object];
+        const Material& fur = scene_.materials[maps_.fur_material];
+        const Material& m = scene_.materials[hit.material];
         const TextureMaps::Sample t =
-            maps.lookup(base.xf.inverse_point(hit.p), hit.part, to_object_normal(base, hit.n));
+            maps_.lookup(base.xf.inverse_point(hit.p), hit.part, to_object_normal(base, hit.n));
         const Vec3 v = normalize(-ray.d);
         const Vec3 n = dot(hit.n, v) < 0 ? -hit.n : hit.n;
         Vec3 nf = normalize(base.xf.normal(t.normal));
         if (dot(nf, v) < 0) nf = -nf;
-        Vec3 bare = m.ka * m.color * scene.ambient, furred = fur.ka * t.colour * scene.ambient;
-        const auto visible = hard_shadows(rs, hit.object, state);
+        Vec3 bare = m.ka * m.color * scene_.ambient, furred = fur.ka * t.colour * scene_.ambient;
+        const auto visible = hard_shadows(rs_, hit.object, state);
         // Both surfaces' terms: a light that adds to neither casts no shadow ray.
         struct Terms {
             Vec3 bare, furred;
@@ -213,10 +228,17 @@ RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const R
             bare += added.bare;
             furred += added.furred;
         };
-        for_each_light(rs, hit.p, state, terms, visible, lit);
+        for_each_light(rs_, hit.p, state, terms, visible, lit);
         return (1 - t.coverage) * bare + t.coverage * furred;
-    };
-    return render_image(rs, o);
+    }
+};
+
+}  // namespace
+
+RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const RenderOptions& opt) {
+    const Scene base_only = base_scene(scene);
+    const RenderScene rs(base_only);
+    return render_image(base_only.camera, TextureIntegrator(scene, maps, rs), opt);
 }
 
 }  // namespace lat

@@ -3,47 +3,26 @@
 // Every pixel depends only on its own coordinates, so images are bit-identical for any thread
 // and rank count.
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "distributed/timeline.h"
 #include "io/image.h"
-#include "render/core/render_scene.h"
+#include "render/core/integrator.h"
+#include "render/core/rank_stats.h"
 #include "render/core/sampler.h"
-#include "render/core/shading.h"
+#include "scene/scene.h"
+#include "util/stats.h"
 
 namespace lat {
-
-// Radiance seen along a ray at a hit, in place of shade() (render/core/shading.h): how a mode that
-// changes surfaces, not geometry, shades them (e.g. the texture mode's baked maps).
-using SurfaceShader = std::function<Vec3(const Ray&, const SurfaceHit&, ShadeState&)>;
 
 struct RenderOptions {
     int spp = 1;  // samples per pixel; 1 is the pixel centre
     SamplerKind sampler = kDefaultSampler;  // where the samples fall in the pixel
-    // Trace rays front to back through partial hits (prefiltered lattices, render/layers.h).
-    bool layered = false;
     bool progress = false;
-    SurfaceShader shader;  // empty: shade()
-    // Collective: the tiles are dealt across the ranks of the MPI job (distributed/deal.h) and the
-    // image is gathered on rank 0; the other ranks return their share of the figures only.
+    // Collective: the tiles are dealt across the ranks of the MPI job (distributed/deal.h) and
+    // the image is gathered on rank 0; the other ranks return their share of the figures only.
     bool across_ranks = false;
-};
-
-// One rank's share of a render spread across an MPI job.
-struct RankStats {
-    int rank = 0;
-    char host[64] = {};
-    int threads = 0;
-    std::uint32_t tiles = 0, chunks = 0;
-    double render_ms = 0;  // first tile dealt to last tile done here
-    double wait_ms = 0;    // threads' time waiting for tiles, summed
-    double cpu_ms = 0;     // the process's CPU time (all threads) over the render and gather
-    std::uint64_t primary_rays = 0, shadow_rays = 0, lattice_visits = 0;
-    std::uint64_t peak_memory_bytes = 0;
-    dist::Timeline timeline{};  // when each step ended here
 };
 
 struct RenderStats {
@@ -53,9 +32,12 @@ struct RenderStats {
     double cpu_ms = 0;  // CPU time of the render, all threads (across_ranks: all ranks')
     std::uint64_t primary_rays = 0;
     std::uint64_t shadow_rays = 0;
-    std::uint64_t lattice_visits = 0;  // stats::Counter::kLatticeVisits
+    // What the stats counters (util/stats.h) added over the render's tiles.
+    stats::Tally counted{};
     int threads = 0;  // across_ranks: summed over ranks; the counts too (on rank 0)
     std::vector<RankStats> ranks;  // across_ranks, on rank 0: one per rank
+
+    std::uint64_t count(stats::Counter c) const { return counted[std::size_t(c)]; }
 };
 
 struct RenderOutput {
@@ -70,7 +52,9 @@ constexpr std::uint64_t kMaxRenderSamples = std::uint64_t{1} << 32;
 // Throws InputError naming `file` (the scene) when width x height x spp is over the limit.
 void check_render_budget(const Camera& camera, int spp, const std::string& file);
 
-// Throws Interrupted (util/interrupt.h) when a signal arrives: it stops at the next pixel.
-RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt);
+// The camera's image, each sample's radiance from `integrator`. Throws Interrupted
+// (util/interrupt.h) when a signal arrives: it stops at the next pixel.
+RenderOutput render_image(const Camera& camera, const Integrator& integrator,
+                          const RenderOptions& opt);
 
 }  // namespace lat

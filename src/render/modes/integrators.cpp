@@ -1,0 +1,27 @@
+#include "render/modes/integrators.h"
+
+#include "render/core/camera.h"
+#include "render/layers.h"
+
+namespace lat {
+
+Vec3 ExactIntegrator::radiance(const Ray& ray, ShadeState& state) const {
+    SurfaceHit hit;
+    if (!rs_.intersect(ray, 0.0, kInfinity, hit)) return rs_.scene().background;
+    return shade(rs_, ray, hit, state);
+}
+
+Vec3 LayeredIntegrator::radiance(const Ray& ray, ShadeState& state) const {
+    return trace_layers(rs_, ray, spread_, state);
+}
+
+RenderOutput render_exact(const RenderScene& rs, const RenderOptions& opt) {
+    return render_image(rs.scene().camera, ExactIntegrator(rs), opt);
+}
+
+RenderOutput render_layered(const RenderScene& rs, const RenderOptions& opt) {
+    const Camera& camera = rs.scene().camera;
+    return render_image(camera, LayeredIntegrator(rs, sample_spread(camera, opt.spp)), opt);
+}
+
+}  // namespace lat
