@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
 #include <random>
 #include <vector>
 
 #include "geometry/chain.h"
 #include "io/image_compare.h"
 #include "lattice/encodings/candidates/candidates_table.h"
+#include "lattice/cache/table_cache.h"
 #include "lattice/certify.h"
 #include "lattice/encodings/dense/dense_table.h"
 #include "lattice/encoding.h"
@@ -143,45 +145,6 @@ TEST(EncodingCandidates, ExactOnEveryPair) {
     EXPECT_EQ(r.false_misses, 0u);
     EXPECT_LT(r.max_point_error, 1e-5);
     EXPECT_LT(double(b.payload.size()) / double(b.raster.hits), 2.0);
-}
-
-TEST(EncodingCandidates, OldMaskTablesStillOpen) {
-    // A CAND1 payload (part sets as 64-bit masks, an older layout) made from a CAND2 one: the
-    // same header and pair sections, then one mask per set. Both answer every pair alike.
-    const Built b = build("candidates", 1);
-    const std::uint8_t* p = b.payload.data();
-    std::uint32_t sets;
-    std::uint64_t list_total;
-    std::memcpy(&sets, p + 32, 4);
-    std::memcpy(&list_total, p + 40, 8);
-    auto pad8 = [](std::uint64_t n) { return (n + 7) / 8 * 8; };
-    const std::size_t prefix = b.payload.size() - pad8((sets + 1) * 4ull) - pad8(list_total * 4);
-    const auto* offsets = reinterpret_cast<const std::uint32_t*>(p + prefix);
-    const auto* parts = offsets + pad8((sets + 1) * 4ull) / 4;
-    ByteBuffer old(prefix + sets * 8ull);
-    std::memcpy(old.data(), p, prefix);
-    const std::uint64_t magic1 = 0x31444E4143'5441ull, zero = 0;
-    std::memcpy(old.data(), &magic1, 8);
-    std::memcpy(old.data() + 40, &zero, 8);
-    for (std::uint32_t i = 0; i < sets; ++i) {
-        std::uint64_t mask = 0;
-        for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) mask |= std::uint64_t{1} << parts[k];
-        std::memcpy(old.data() + prefix + i * 8ull, &mask, 8);
-    }
-    const CandidatesTable t1(old.data(), old.size(), b.table->entries(), b.ctx);
-    const BoundaryGrid grid(b.ctx.cells);
-    int answered = 0;
-    for (std::uint32_t x = 0; x < grid.count(); ++x)
-        for (std::uint32_t y = x; y < grid.count(); y += 3) {
-            CandidateList l1, l2;
-            const bool h1 = t1.candidates(x, y, l1), h2 = b.table->candidates(x, y, l2);
-            ASSERT_EQ(h1, h2) << x << " " << y;
-            if (!h1) continue;
-            ++answered;
-            ASSERT_EQ(std::vector<std::uint32_t>(l1.parts, l1.parts + l1.count),
-                      std::vector<std::uint32_t>(l2.parts, l2.parts + l2.count));
-        }
-    EXPECT_GT(answered, 1000);
 }
 
 TEST(EncodingCandidates, EveryPartARayMeetsIsACandidate) {
@@ -344,18 +307,39 @@ TEST(EncodingCandidates, CsgPrimitivesAsCsgLeavesRenderAsExact) {
     EXPECT_GT(covered, exact.rgb.size() / 3 / 10);
 }
 
-TEST(EncodingCandidates, OlderTablesOfCsgPrimitivesAreRefused) {
-    // CAND2 lists named primitives (a CSG is one): read as leaves they would drop surfaces.
-    Built b = build_for(tori_scene(), "candidates", 1);
-    const std::uint64_t magic2 = 0x32444E4143'5441ull;
-    std::memcpy(b.payload.data(), &magic2, 8);
-    EXPECT_THROW(CandidatesTable(b.payload.data(), b.payload.size(), b.table->entries(), b.ctx),
-                 std::runtime_error);
-    // A chain's CAND2 table (the same layout) still opens: its primitives are its pieces.
-    Built hair = build("candidates", 1);
-    std::memcpy(hair.payload.data(), &magic2, 8);
-    const CandidatesTable old(hair.payload.data(), hair.payload.size(), hair.table->entries(), hair.ctx);
-    EXPECT_EQ(old.pairs_stored(), static_cast<const CandidatesTable&>(*hair.table).pairs_stored());
+TEST(EncodingCandidates, OlderPayloadsAreRefusedCleanly) {
+    // CAND1 (part sets as 64-bit masks, a shorter payload) and CAND2 (lists of primitives) are
+    // no longer read: opened anyway, they throw, and never read past the payload.
+    Built b = build("candidates", 1);
+    for (const std::uint64_t old : {0x31444E4143'5441ull, 0x32444E4143'5441ull}) {
+        std::memcpy(b.payload.data(), &old, 8);
+        EXPECT_THROW(CandidatesTable(b.payload.data(), b.payload.size(), b.table->entries(), b.ctx),
+                     std::runtime_error);
+        EXPECT_THROW(CandidatesTable(b.payload.data(), 64, b.table->entries(), b.ctx),
+                     std::runtime_error);
+    }
+}
+
+TEST(EncodingCandidates, OlderCachedTablesAreRebuiltBeside) {
+    // Tables of those payloads were written under layout 1, which their fingerprint (and so
+    // their name in the cache) leaves out; today's layout is part of it. A cache holding one
+    // builds the table anew beside it and renders.
+    EXPECT_GT(find_encoding("candidates").layout, 1);
+    test::TempDir dir;
+    const TableCache cache(dir.path().string());
+    TableSpec spec;
+    spec.encoding = "candidates";
+    const Scene& s = hair_scene();
+    const TablePlan plan = plan_table(s.primitives.at(0), spec, s.file);
+    const std::string path = cache.get(plan, false).path;
+    // The file an older build left: the same table but for another fingerprint in its name.
+    const std::string old = path.substr(0, path.size() - 20) + "0123456789abcdef.lht";
+    std::filesystem::rename(path, old);
+    const TableCache::Entry again = cache.get(plan, false);
+    EXPECT_TRUE(again.built);
+    EXPECT_EQ(again.path, path);
+    ASSERT_TRUE(again.table);
+    EXPECT_TRUE(std::filesystem::exists(old));
 }
 
 TEST(EncodingCandidates, BuildsStopAtTheirMemoryBudget) {

@@ -21,12 +21,9 @@
 namespace lat {
 namespace {
 
-// Payload tags: "CAND1" stored part sets as 64-bit masks, "CAND2" as sorted index lists of
-// primitives (Shape::primitive_count), "CAND3" (the same layout) of pieces (Shape::piece_count).
-// The first two name the pieces of shapes that are the union of their primitives, not a CSG's
-// leaves: they open only for such shapes.
-constexpr std::uint64_t kMagicMasks = 0x31444E4143'5441ull;
-constexpr std::uint64_t kMagicPrimitives = 0x32444E4143'5441ull;
+// Payload tag "CAND3": part sets as sorted index lists of pieces (Shape::piece_count). The
+// tags before it (CAND1, CAND2) were written under another layout (Encoding::layout), so their
+// files have other names in the cache and are never opened: the table is built anew.
 constexpr std::uint64_t kMagic = 0x33444E4143'5441ull;
 
 struct Header {
@@ -34,13 +31,13 @@ struct Header {
     std::uint32_t points, set_bits;
     std::uint64_t domain, occupied;
     std::uint32_t sets, pad;
-    std::uint64_t list_total;  // CAND2: entries of all part lists together (0 in CAND1)
+    std::uint64_t list_total;  // entries of all part lists together
     std::uint64_t reserved[2];
 };
 static_assert(sizeof(Header) == 64);
 
 struct Sections {
-    std::uint64_t occ, counts, ids, sets, parts, total;  // CAND1: sets holds the masks
+    std::uint64_t occ, counts, ids, sets, parts, total;
 };
 
 std::uint64_t padded8(std::uint64_t bytes) { return (bytes + 7) / 8 * 8; }
@@ -52,12 +49,8 @@ Sections sections(const Header& h) {
     s.counts = s.occ + nwords * 8;
     s.ids = s.counts + padded8(RankIndex::count_entries(nwords) * 4);
     s.sets = s.ids + (words_for_bits(h.occupied * h.set_bits) + 1) * 8;
-    if (h.magic == kMagicMasks) {
-        s.parts = s.total = s.sets + static_cast<std::uint64_t>(h.sets) * 8;
-    } else {
-        s.parts = s.sets + padded8((static_cast<std::uint64_t>(h.sets) + 1) * 4);
-        s.total = s.parts + padded8(h.list_total * 4);
-    }
+    s.parts = s.sets + padded8((static_cast<std::uint64_t>(h.sets) + 1) * 4);
+    s.total = s.parts + padded8(h.list_total * 4);
     return s;
 }
 
@@ -317,16 +310,11 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
     if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
     Header h;
     std::memcpy(&h, payload, sizeof h);
-    if (h.magic != kMagic && h.magic != kMagicPrimitives && h.magic != kMagicMasks)
-        throw std::runtime_error("candidates: bad payload tag");
-    if (h.magic != kMagic && !ctx.primitive->pieces_are_union())
-        throw std::runtime_error(
-            "candidates: the table lists parts of an older kind for a CSG primitive (rebuild it)");
-    if (h.magic == kMagicPrimitives) h.magic = kMagic;  // the same layout
+    if (h.magic != kMagic) throw std::runtime_error("candidates: bad payload tag");
     points_ = h.points, set_bits_ = h.set_bits, sets_ = h.sets, occupied_ = h.occupied;
     if (points_ != grid_.count() || h.domain != std::uint64_t(points_) * (points_ + 1) / 2 ||
         set_bits_ > 32 || (sets_ > 1 && (1ull << set_bits_) < sets_) || occupied_ > h.domain ||
-        sets_ > occupied_ + 1 || (h.magic == kMagic && h.list_total > 0xFFFFFFFFull))
+        sets_ > occupied_ + 1 || h.list_total > 0xFFFFFFFFull)
         throw std::runtime_error("candidates: inconsistent layout");
     const Sections sec = sections(h);
     if (sec.total != size) throw std::runtime_error("candidates: payload size does not match its layout");
@@ -337,28 +325,9 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
         throw std::runtime_error("candidates: rank directory does not match its occupancy bits");
     rank_ = RankIndex(occ, counts);
     ids_ = reinterpret_cast<const std::uint64_t*>(payload + sec.ids);
-    if (h.magic == kMagicMasks) {
-        lists_from_masks(reinterpret_cast<const std::uint64_t*>(payload + sec.sets));
-    } else {
-        offsets_ = reinterpret_cast<const std::uint32_t*>(payload + sec.sets);
-        parts_ = reinterpret_cast<const std::uint32_t*>(payload + sec.parts);
-    }
-    check_lists(h.magic == kMagic ? h.list_total : converted_.size() - (sets_ + 1));
-}
-
-// CAND1: each 64-bit mask becomes the list of its set bits, kept in converted_ (offsets first,
-// then the parts) so that lookups read both formats alike.
-void CandidatesTable::lists_from_masks(const std::uint64_t* masks) {
-    std::vector<std::uint32_t> offsets{0}, parts;
-    for (std::uint32_t i = 0; i < sets_; ++i) {
-        for (std::uint64_t m = masks[i]; m; m &= m - 1)
-            parts.push_back(static_cast<std::uint32_t>(std::countr_zero(m)));
-        offsets.push_back(static_cast<std::uint32_t>(parts.size()));
-    }
-    converted_ = std::move(offsets);
-    converted_.insert(converted_.end(), parts.begin(), parts.end());
-    offsets_ = converted_.data();
-    parts_ = converted_.data() + sets_ + 1;
+    offsets_ = reinterpret_cast<const std::uint32_t*>(payload + sec.sets);
+    parts_ = reinterpret_cast<const std::uint32_t*>(payload + sec.parts);
+    check_lists(h.list_total);
 }
 
 // Every list lies within the index array, ascending, and names parts the primitive has.

@@ -6,11 +6,10 @@
 // capsules around cylinders, through bounding spheres for other shapes). The renderer then
 // intersects only those parts, exactly, with the real ray: images equal exact mode, and the
 // cost of a ray depends on how many parts lie near it, not on how many the primitive has.
-// Layout (payload tag CAND2): occupancy bits with a rank directory over the pairs, then per
+// Layout (payload tag CAND3): occupancy bits with a rank directory over the pairs, then per
 // occupied pair the id of its part set (bits chosen per table), then the distinct part sets,
 // each stored once as a sorted list of 32-bit part indices (an offset array into one index
-// array), so a primitive may have any number of parts. CAND1 payloads (sets as 64-bit masks,
-// primitives of at most 64 parts) still open: their sets are turned into lists at open.
+// array), so a primitive may have any number of parts.
 #include <cstdint>
 #include <vector>
 
@@ -50,7 +49,6 @@ private:
     // sets_ + 1 offsets: set i is parts_[offsets_[i], offsets_[i + 1]).
     const std::uint32_t* offsets_ = nullptr;
     const std::uint32_t* parts_ = nullptr;
-    std::vector<std::uint32_t> converted_;  // CAND1: the lists made from its masks
     std::uint32_t points_ = 0, set_bits_ = 0, sets_ = 0;
     std::uint64_t occupied_ = 0;
     std::uint64_t entries_;
@@ -58,7 +56,6 @@ private:
     TableContext ctx_;
     BoundaryGrid grid_;
 
-    void lists_from_masks(const std::uint64_t* masks);
     void check_lists(std::uint64_t total) const;
 };
 
