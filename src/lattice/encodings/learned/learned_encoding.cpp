@@ -6,8 +6,9 @@ namespace lat {
 extern const Encoding kLearnedEncoding;
 const Encoding kLearnedEncoding{
     .name = "learned",
-    .summary = "a distance field fitted to the hits, marched along the pair, plus exceptions "
-               "where it errs beyond the bounds",
+    // Experimental: the paper's section 5.2.2 measured; its lookups and builds are the slowest.
+    .summary = "experimental, section 5.2.2: a distance field fitted to the hits, marched along "
+               "the pair, plus exceptions where it errs beyond the bounds",
     .max_points = LearnedTable::kMaxPoints,
     // At the build's peak: the index of the hits by entry point (8 bytes per hit), the
     // exception list and the table (a few bytes per hit at most).
