@@ -27,23 +27,20 @@ struct ShadeState {
 // mode's baked surfaces, all use it.
 // normal_length: below 1, n stands for unit normals spread around it whose mean is that long
 // (prefiltered lattices' tables, SurfaceHit::normal_length; a sheet of sub-rays has its own
-// normals, SurfaceHit::normals, and shade_with takes the mean of their exact terms instead:
-// Plates 2 / 4 / 5 +0.76 / +0.47 / +0.85 dB over this model). The diffuse term is the mean of the
-// normals' clamped terms max(0, n_i.l), not the clamped term of their mean: n_i.l is taken as
-// normal with mean len n.l and variance (1 - len^2) / 3 (the variance of a spread of unit
-// vectors with mean length len, whatever the direction, for a spread symmetric about its
-// mean), whose clamped mean is closed-form (diffuse_mean). The clamped term of the mean was
-// too dark where the normals straddle the terminator (fur 0.2-0.5 of an 8-bit step on
-// average; 0.04 to 0.17 dB on six fur scenes). The specular lobe is widened as Toksvig's
-// filtering of normal maps widens it ("Mipmapping normal maps", 2005): for a mean normal of
-// length len the exponent s becomes s' = len s / (len + s (1 - len)), and the lobe is scaled
-// by (s' + 1) / (s + 1) so that the light it reflects stays the same (the integral of cos^s
-// over the sphere is 2 pi / (s + 1)). len is normal_length^kToksvigWidening: a lattice's mean
-// normal blends its pairs' mean normals, and a pair's own spread is lost (tables store its
-// mean as a unit vector), so the spread 1 - len is widened k times.
-// k tuned on Plate 4 (`--filter smooth`, 1 spp, PSNR against 256-spp exact; k = 1, 2, 4, 6,
-// 8, 12: 36.60, 36.84, 37.00, 37.04, 37.03, 36.98 dB; unfiltered lobe 35.89 dB), checked on
-// Plate 5 (k = 1, 4, 6, 8: 37.45, 38.07, 38.12, 38.09 dB; unfiltered 36.42 dB).
+// normals, SurfaceHit::normals, and shade_with takes the mean of their exact terms instead,
+// which is closer to exact than this model). The diffuse term is the mean of the normals'
+// clamped terms max(0, n_i.l), not the clamped term of their mean, which is too dark where the
+// normals straddle the terminator: n_i.l is taken as normal with mean len n.l and variance
+// (1 - len^2) / 3 (the variance of a spread of unit vectors with mean length len, whatever the
+// direction, for a spread symmetric about its mean), whose clamped mean is closed-form
+// (diffuse_mean). The specular lobe is widened as Toksvig's filtering of normal maps widens it
+// ("Mipmapping normal maps", 2005): for a mean normal of length len the exponent s becomes
+// s' = len s / (len + s (1 - len)), and the lobe is scaled by (s' + 1) / (s + 1) so that the
+// light it reflects stays the same (the integral of cos^s over the sphere is 2 pi / (s + 1)).
+// len is normal_length^kToksvigWidening: a lattice's mean normal blends its pairs' mean
+// normals, and a pair's own spread is lost (tables store its mean as a unit vector), so the
+// spread 1 - len is widened k times; k is the best of those tried on the fur plates
+// (bench/notes/shading-constants.md).
 inline constexpr double kToksvigWidening = 6;
 // E[max(0, X)] for X normal with mean len * nl and variance (1 - len^2) / 3 (see phong_term).
 inline double diffuse_mean(double nl, double len) {
