@@ -20,20 +20,17 @@ constexpr std::array<ModeDescription, 5> kModes{{
     {"exact", RenderMode::kExact,
      "full ray trace of every primitive (with --footprint on, instances by sub-rays across each "
      "pixel's footprint)",
-     "full ray trace", "high", "slow", "medium", true},
+     true},
     {"lattice", RenderMode::kLattice,
-     "every instance answered from its lattice tables (built on first use and cached)", "lattice",
-     "high", "moderate", "large", true},
+     "every instance answered from its lattice tables (built on first use and cached)", true},
     {"auto", RenderMode::kAuto,
      "per primitive: sub-rays across the footprint for one cheap to intersect, filtered tables "
      "for a costlier one; the summary line names each choice",
-     "lattice", "high", "moderate", "large", true},
+     true},
     {"texture", RenderMode::kTexture,
-     "instances replaced by colour, coverage and normal maps baked on the surface they grow from",
-     "texture mapping", "low", "very fast", "small"},
+     "instances replaced by colour, coverage and normal maps baked on the surface they grow from"},
     {"particles", RenderMode::kParticles,
-     "instances as streams of particles splatted in screen space (Kajiya-Kay, shadow maps)",
-     "particle system", "medium", "fast", "small"},
+     "instances as streams of particles splatted in screen space (Kajiya-Kay, shadow maps)"},
 }};
 
 // The instances' exact geometry: every used primitive's parts once, one transform each.

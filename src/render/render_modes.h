@@ -1,7 +1,7 @@
 #pragma once
-// The render modes, each one entry here: its name on the command line, what it is, the
-// column of the paper's Table 2 it stands for, and how a scene is rendered in it. `render`
-// and `table2` both go through render_in_mode, so a mode is never dispatched by name twice.
+// The render modes, each one entry here: its name on the command line, what it is, and how a
+// scene is rendered in it. `render` and `table2` both go through render_in_mode, so a mode is
+// never dispatched by name twice.
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -23,8 +23,6 @@ struct ModeDescription {
     std::string_view name;
     RenderMode mode;
     std::string_view help;
-    // The paper's Table 2 row for the technique: its name and its fidelity, speed and space.
-    std::string_view paper_technique, paper_fidelity, paper_speed, paper_space;
     // Whether its render is dealt across the ranks of an MPI job; a mode that is not renders
     // on rank 0 alone (docs/distributed.md).
     bool spreads_over_ranks = false;
