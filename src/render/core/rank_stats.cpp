@@ -51,8 +51,10 @@ void gather_tiles(const TileGrid& grid, const dist::DealReport& mine, std::span<
                             static_cast<std::size_t>(grid.tiles_y()));
     dist::mark_dealt(mine.chunks, dealt, dist::MessageReader({}, "tile list", 0));
     for (std::size_t r = 1; r < all.size(); ++r) {
-        dist::MessageReader in({all[r].data(), all[r].size()}, "tiles message", static_cast<int>(r));
-        const std::span<const std::uint8_t> list = in.take(in.read<std::uint64_t>(), sizeof(dist::Chunk));
+        dist::MessageReader in({all[r].data(), all[r].size()}, "tiles message",
+                               static_cast<int>(r));
+        const std::span<const std::uint8_t> list =
+            in.take(in.read<std::uint64_t>(), sizeof(dist::Chunk));
         std::vector<dist::Chunk> chunks(list.size() / sizeof(dist::Chunk));
         if (!list.empty()) std::memcpy(chunks.data(), list.data(), list.size());
         dist::mark_dealt(chunks, dealt, in);
