@@ -216,7 +216,7 @@ BENCHMARK_CAPTURE(BM_Blend, chained, true)->Arg(1)->Arg(2)->Arg(4)->ArgName("sig
 struct Prepared {
     lat::Scene scene;
     lat::SceneLattices lattices;
-    std::unique_ptr<lat::RenderScene> exact, lattice;
+    std::unique_ptr<lat::TracedScene> exact, lattice;
 };
 
 Prepared& prepared(const std::string& plate) {
@@ -227,15 +227,15 @@ Prepared& prepared(const std::string& plate) {
     p.scene = lat::load_scene(example(plate));
     const lat::TableCache tables(cache_dir(), true);
     p.lattices = lat::scene_lattices(p.scene, tables, {}, false);
-    p.exact = std::make_unique<lat::RenderScene>(p.scene);
-    p.lattice = std::make_unique<lat::RenderScene>(
+    p.exact = std::make_unique<lat::TracedScene>(p.scene);
+    p.lattice = std::make_unique<lat::TracedScene>(
         p.scene, [&p](int i) { return p.lattices.shapes[static_cast<std::size_t>(i)]; });
     return p;
 }
 
 void BM_Render(benchmark::State& state, const std::string& plate, bool lattice) {
     Prepared& p = prepared(plate);
-    const lat::RenderScene& rs = lattice ? *p.lattice : *p.exact;
+    const lat::TracedScene& rs = lattice ? *p.lattice : *p.exact;
     tbb::task_arena arena(static_cast<int>(state.range(0)));
     std::uint64_t rays = 0;
     for (auto _ : state) {

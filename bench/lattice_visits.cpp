@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
         std::vector<std::shared_ptr<const lat::Shape>> wrapped;
         for (const auto& s : lattices.shapes)
             wrapped.push_back(s ? std::make_shared<CountingShape>(s, counts) : nullptr);
-        const lat::RenderScene rs(
+        const lat::TracedScene rs(
             scene, [&wrapped](int p) { return wrapped[static_cast<std::size_t>(p)]; });
         const lat::RenderOutput out = lat::render_exact(rs, {});
         if (!output.empty()) lat::write_png(output, out.display);

@@ -19,7 +19,7 @@ const char* const kPlates[] = {"plate1-thistle-no-self-shading", "plate2-thistle
 
 struct Prepared {
     lat::Scene scene;
-    std::unique_ptr<lat::RenderScene> rs;
+    std::unique_ptr<lat::TracedScene> rs;
 };
 
 Prepared& prepared(const std::string& plate) {
@@ -29,7 +29,7 @@ Prepared& prepared(const std::string& plate) {
         Prepared p;
         p.scene = lat::load_scene(std::string(LATTICE_SOURCE_DIR) + "/examples/" + plate + ".json");
         it = cache.emplace(plate, std::move(p)).first;
-        it->second.rs = std::make_unique<lat::RenderScene>(it->second.scene);
+        it->second.rs = std::make_unique<lat::TracedScene>(it->second.scene);
     }
     return it->second;
 }

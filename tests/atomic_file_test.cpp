@@ -127,7 +127,7 @@ TEST(Interrupt, RenderStopsAtTheNextTile) {
         "fov_y_deg": 40, "width": 64, "height": 64},
         "materials": {"m": {}}, "objects": [{"type": "sphere", "radius": 1, "material": "m"}]})",
                                     "scene.json");
-    const RenderScene rs(s);
+    const TracedScene rs(s);
     std::raise(SIGINT);
     try {
         render_exact(rs, {});

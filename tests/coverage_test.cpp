@@ -378,14 +378,14 @@ TEST(Coverage, AThinPrimitiveHasTheRightBrightness) {
     const Scene s = load_scene(path);
     RenderOptions gt;
     gt.spp = 64;
-    const double exact = mean_brightness(render_exact(RenderScene(s), gt).display);
+    const double exact = mean_brightness(render_exact(TracedScene(s), gt).display);
     ASSERT_GT(exact, 2.0);
     const TableCache cache(dir.path().string());
     TableSpec spec;
     spec.encoding = "coverage";
     for (const LatticeFilter f : {LatticeFilter::kBox, LatticeFilter::kSmooth}) {
         const SceneLattices l = scene_lattices(s, cache, spec, false, {f, false, 0});
-        const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
+        const TracedScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
         const RenderOptions opt;
         const double filtered = mean_brightness(render_layered(rs, opt).display);
         EXPECT_NEAR(filtered / exact, 1.0, 0.02) << "filter " << int(f);
@@ -427,7 +427,7 @@ Image8 render_filtered(const std::string& text) {
     spec.encoding = "coverage";
     const double spread = 2 * std::tan(22 * M_PI / 360.0) / 40;
     const SceneLattices l = scene_lattices(s, cache, spec, false, {LatticeFilter::kSmooth, true, spread});
-    const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
+    const TracedScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
     const RenderOptions opt;
     const Image8 image = render_layered(rs, opt).display;
     // The same bytes on one thread (the directions across are per ray, not per thread).

@@ -207,7 +207,7 @@ Image8 render_candidates(const Scene& s) {
     TableSpec spec;
     spec.encoding = "candidates";
     const SceneLattices l = scene_lattices(s, cache, spec, false);
-    const RenderScene lattice(s, [&](int i) { return l.shapes[static_cast<std::size_t>(i)]; });
+    const TracedScene lattice(s, [&](int i) { return l.shapes[static_cast<std::size_t>(i)]; });
     return render_exact(lattice, {}).display;
 }
 
@@ -286,7 +286,7 @@ TEST(EncodingCandidates, CsgPrimitivesListTheirLeaves) {
 TEST(EncodingCandidates, CsgPrimitivesRenderAsExact) {
     const Scene& s = tori_scene();
     const ImageDiffStats d =
-        compare_images(render_exact(RenderScene(s), {}).display, render_candidates(s));
+        compare_images(render_exact(TracedScene(s), {}).display, render_candidates(s));
     EXPECT_EQ(d.max_abs_error, 0);
 }
 
@@ -299,7 +299,7 @@ TEST(EncodingCandidates, CsgPrimitivesAsCsgLeavesRenderAsExact) {
            "transform": [{"rotate": {"axis": [0, 1, 0], "angle_deg": 200}}, {"translate": [8, 0, 8]}]},
           {"type": "sphere", "center": [5, 4, 6], "radius": 2.2, "material": "cut"}]},
         {"type": "halfspace", "point": [0, 0, -6], "normal": [0, 0, 1], "material": "m"}])");
-    const Image8 exact = render_exact(RenderScene(s), {}).display;
+    const Image8 exact = render_exact(TracedScene(s), {}).display;
     EXPECT_EQ(compare_images(exact, render_candidates(s)).max_abs_error, 0);
     std::size_t covered = 0;
     for (std::size_t i = 0; i + 2 < exact.rgb.size(); i += 3)
@@ -374,8 +374,8 @@ TEST(EncodingCandidates, PlatesRenderAsExact) {
         Scene s = load_scene(test::source_path(std::string("examples/") + plate + ".json"));
         s.camera.width = s.camera.height = 160;
         const SceneLattices l = scene_lattices(s, cache, spec, false);
-        const RenderScene lattice(s, [&](int i) { return l.shapes[static_cast<std::size_t>(i)]; });
-        const ImageDiffStats d = compare_images(render_exact(RenderScene(s), {}).display,
+        const TracedScene lattice(s, [&](int i) { return l.shapes[static_cast<std::size_t>(i)]; });
+        const ImageDiffStats d = compare_images(render_exact(TracedScene(s), {}).display,
                                                 render_exact(lattice, {}).display);
         EXPECT_EQ(d.max_abs_error, 0) << plate;
     }

@@ -25,7 +25,7 @@ Scene small(const char* name, int size) {
 }
 
 Image8 render_exact(const Scene& s) {
-    return render_exact(RenderScene(s), {}).display;
+    return render_exact(TracedScene(s), {}).display;
 }
 
 Image8 render_lattice(const Scene& s, const TableCache& cache, int sigma_inv,
@@ -34,7 +34,7 @@ Image8 render_lattice(const Scene& s, const TableCache& cache, int sigma_inv,
     spec.sigma_inv = sigma_inv;
     spec.encoding = encoding;
     const SceneLattices l = scene_lattices(s, cache, spec, false);
-    const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
+    const TracedScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
     return render_exact(rs, {}).display;
 }
 
@@ -62,11 +62,11 @@ TEST_F(LatticeRender, VisitsAreCounted) {
     // render --stats' lattice_visits: none in exact mode; in lattice mode the same count every
     // time, whichever threads rendered which tiles.
     const Scene s = small("plate4-fuzzy-sphere-1000", 48);
-    EXPECT_EQ(render_exact(RenderScene(s), {}).stats.count(stats::Counter::kLatticeVisits), 0u);
+    EXPECT_EQ(render_exact(TracedScene(s), {}).stats.count(stats::Counter::kLatticeVisits), 0u);
     TableSpec spec;
     spec.encoding = "dense";
     const SceneLattices l = scene_lattices(s, cache, spec, false);
-    const RenderScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
+    const TracedScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
     const RenderStats a = render_exact(rs, {}).stats, b = render_exact(rs, {}).stats;
     EXPECT_GT(a.count(stats::Counter::kLatticeVisits), a.primary_rays / 4);
     EXPECT_EQ(a.count(stats::Counter::kLatticeVisits), b.count(stats::Counter::kLatticeVisits));
@@ -146,7 +146,7 @@ TEST_F(LatticeRender, CullingByThePrimitiveChangesNoPixel) {
                 }
             }
             auto render = [&](const std::vector<std::shared_ptr<const Shape>>& shapes) {
-                const RenderScene rs(s, [&](int p) { return shapes[static_cast<std::size_t>(p)]; });
+                const TracedScene rs(s, [&](int p) { return shapes[static_cast<std::size_t>(p)]; });
                 return render_exact(rs, {}).display;
             };
             const Image8 reference = encoding == "candidates" ? render_exact(s) : render(boxed);
@@ -199,7 +199,7 @@ TEST_F(LatticeRender, TurnedInstancesAreCulledByTheirPlacedParts) {
         const double limit = encoding == "candidates" ? 0.2 : 0.4;
         EXPECT_LT(culled_volume, limit * volume(xf.bounds(culled->bounds()))) << encoding;
         auto render = [&](const std::shared_ptr<const Shape>& shape) {
-            const RenderScene rs(s, [&](int) { return shape; });
+            const TracedScene rs(s, [&](int) { return shape; });
             return render_exact(rs, {}).display;
         };
         const Image8 reference = encoding == "candidates" ? render_exact(s) : render(boxed);

@@ -214,7 +214,7 @@ TEST(Mesh, ObjWithNormalsMatchesBruteForceTracer) {
     const std::string scene_path = dir.file("scene.json");
     test::spit(scene_path, scene_json("torus.obj"));  // relative to the scene file
     const Scene s = load_scene(scene_path);
-    const Image8 got = render_exact(RenderScene(s), {}).display;
+    const Image8 got = render_exact(TracedScene(s), {}).display;
     std::vector<V> n;
     for (const V& x : m.n) n.push_back(unit(x));
     const RefMesh f = float_vertices(m);
@@ -229,8 +229,8 @@ TEST(Mesh, PlyWithoutNormalsIsFlatUnlessSmooth) {
     test::spit(dir.file("torus.ply"), to_ply(m));
     test::spit(dir.file("flat.json"), scene_json("torus.ply"));
     test::spit(dir.file("smooth.json"), scene_json("torus.ply", R"(, "smooth": true)"));
-    const Image8 flat = render_exact(RenderScene(load_scene(dir.file("flat.json"))), {}).display;
-    const Image8 smooth = render_exact(RenderScene(load_scene(dir.file("smooth.json"))), {}).display;
+    const Image8 flat = render_exact(TracedScene(load_scene(dir.file("flat.json"))), {}).display;
+    const Image8 smooth = render_exact(TracedScene(load_scene(dir.file("smooth.json"))), {}).display;
     std::vector<V> n(m.p.size());
     for (const auto& t : m.tri) {
         const V f = crossv(m.p[t[1]] - m.p[t[0]], m.p[t[2]] - m.p[t[0]]);
@@ -273,7 +273,7 @@ TEST(Mesh, PerObjectNormalsUnderANonUniformScale) {
         else
             EXPECT_EQ(n, f) << "triangle " << t << " of the object without normals";
     }
-    const Image8 got = render_exact(RenderScene(scene), {}).display;
+    const Image8 got = render_exact(TracedScene(scene), {}).display;
 
     const V s{1.3L, 0.8L, 1.1L}, shift{0.1L, 0, -0.2L};
     RefMesh world = float_vertices(m);
@@ -320,8 +320,8 @@ TEST(Mesh, ClosedMeshIsACsgLeafLikeTheSameSolidOfHalfspaces) {
     test::spit(dir.file("mesh.json"), scene(box));
     test::spit(dir.file("exact.json"), scene(halfspaces));
     const Scene a = load_scene(dir.file("mesh.json")), b = load_scene(dir.file("exact.json"));
-    const Image8 ia = render_exact(RenderScene(a), {}).display;
-    const Image8 ib = render_exact(RenderScene(b), {}).display;
+    const Image8 ia = render_exact(TracedScene(a), {}).display;
+    const Image8 ib = render_exact(TracedScene(b), {}).display;
     const ImageDiffStats st = compare_images(ia, ib);
     EXPECT_GE(st.psnr_db, 40.0);
     EXPECT_LT(st.share_over_8, 0.005);

@@ -11,7 +11,7 @@ namespace {
 
 Image8 render_text(const std::string& json) {
     const Scene s = load_scene_text(json, "test.json");
-    return render_exact(RenderScene(s), {}).display;
+    return render_exact(TracedScene(s), {}).display;
 }
 
 std::string scene(const std::string& camera, const std::string& object) {

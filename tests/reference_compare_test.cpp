@@ -14,7 +14,7 @@
 #include "io/image.h"
 #include "io/image_compare.h"
 #include "reference/reference_tracer.h"
-#include "render/core/render_scene.h"
+#include "render/core/traced_scene.h"
 #include "render/modes/integrators.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
@@ -54,7 +54,7 @@ Image8 project_render(const std::string& path, int w = 0, int h = 0) {
         scene.camera.width = w;
         scene.camera.height = h;
     }
-    const RenderScene rs(scene);
+    const TracedScene rs(scene);
     return render_exact(rs, RenderOptions{}).display;
 }
 

@@ -70,7 +70,7 @@ Vec3 expected_pixel(const Scene& s, int i, int j) {
 
 TEST(Render, LitSphereMatchesTheShadingRule) {
     const Scene s = load_scene_text(kSphereScene, "sphere.json");
-    const RenderScene rs(s);
+    const TracedScene rs(s);
     const RenderOutput out = render_exact(rs, {});
     int checked = 0;
     for (int j = 0; j < s.camera.height; ++j) {
@@ -91,7 +91,7 @@ TEST(Render, LitSphereMatchesTheShadingRule) {
 // every other light at every hit casts one. Counted by the reference rule, as above.
 TEST(Render, LightsThatAddNothingCastNoShadowRay) {
     const Scene s = load_scene_text(kSphereScene, "sphere.json");
-    const RenderOutput out = render_exact(RenderScene(s), {});
+    const RenderOutput out = render_exact(TracedScene(s), {});
     std::uint64_t pairs = 0, adding = 0;
     for (int j = 0; j < s.camera.height; ++j)
         for (int i = 0; i < s.camera.width; ++i) {
@@ -115,7 +115,7 @@ Scene small_plate(const char* name, int size) {
     return s;
 }
 
-Image8 render_with_threads(const RenderScene& rs, int threads) {
+Image8 render_with_threads(const TracedScene& rs, int threads) {
     tbb::task_arena arena(threads);
     Image8 img;
     arena.execute([&] { img = render_exact(rs, {}).display; });
@@ -124,7 +124,7 @@ Image8 render_with_threads(const RenderScene& rs, int threads) {
 
 TEST(Render, IdenticalBytesForAnyThreadCount) {
     const Scene s = small_plate("plate4-fuzzy-sphere-1000.json", 96);
-    const RenderScene rs(s);
+    const TracedScene rs(s);
     const Image8 one = render_with_threads(rs, 1);
     const Image8 two = render_with_threads(rs, 2);
     const Image8 four = render_with_threads(rs, 4);
@@ -137,7 +137,7 @@ TEST(Render, InstancedAndFlattenedAgree) {
     AccelOptions inst, flat;
     inst.instancing = Instancing::kAlways;
     flat.instancing = Instancing::kNever;
-    const RenderScene a(s, {}, inst), b(s, {}, flat);
+    const TracedScene a(s, {}, inst), b(s, {}, flat);
     const Image8 ia = render_exact(a, {}).display;
     EXPECT_EQ(ia.rgb, render_exact(b, {}).display.rgb);
     // Not two blank images: the thistle covers a good part of the frame, whose corner is
@@ -177,8 +177,8 @@ TEST(Render, TreesAsCsgLeavesShadeAsWrittenOut) {
     std::string inline_bite = bite;
     inline_bite.replace(inline_bite.find("[3.5, 3.5, 1.5]"), 15, "[0, 0, 0]");
     const Scene written = scene(inline_bite);
-    const Image8 a = render_exact(RenderScene(nested), {}).display;
-    const Image8 b = render_exact(RenderScene(written), {}).display;
+    const Image8 a = render_exact(TracedScene(nested), {}).display;
+    const Image8 b = render_exact(TracedScene(written), {}).display;
     int differ = 0;
     for (std::size_t i = 0; i < a.rgb.size(); ++i) differ += std::abs(a.rgb[i] - b.rgb[i]) > 1;
     EXPECT_EQ(differ, 0);
@@ -196,7 +196,7 @@ TEST(Render, SupersamplingAveragesAnEdge) {
                    {"type": "halfspace", "normal": [0, -1, 0]},
                    {"type": "halfspace", "normal": [-1, 0, 0]}]}]})";
     const Scene s = load_scene_text(scene, "edge.json");
-    const RenderScene rs(s);
+    const TracedScene rs(s);
     RenderOptions opt;
     opt.spp = 64;
     const RenderOutput out = render_exact(rs, opt);

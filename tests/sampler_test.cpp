@@ -148,7 +148,7 @@ Scene small_plate4(int size) {
 
 TEST(Sampler, ImagesAreTheSameOnOneAndTwoThreads) {
     const Scene s = small_plate4(24);
-    const RenderScene rs(s);
+    const TracedScene rs(s);
     for (const SamplerKind kind : all_samplers()) {
         RenderOptions opt;
         opt.spp = 4;
@@ -170,7 +170,7 @@ TEST(Sampler, ImagesAreTheSameOnOneAndTwoThreads) {
 
 // The pixels' mean of n x n samples at the cells' centres, traced here rather than through
 // render_image and its samplers, so that a broken sampler cannot break its own truth.
-Image8 truth_image(const RenderScene& rs, int n) {
+Image8 truth_image(const TracedScene& rs, int n) {
     const Scene& s = rs.scene();
     const PinholeCamera cam(s.camera);
     Image8 im{s.camera.width, s.camera.height,
@@ -195,7 +195,7 @@ Image8 truth_image(const RenderScene& rs, int n) {
 // alone (an aliased image, as is one with every sample at the same point) does not.
 TEST(Sampler, FourSamplesComeCloseToTheTruth) {
     const Scene s = small_plate4(40);
-    const RenderScene rs(s);
+    const TracedScene rs(s);
     const Image8 truth = truth_image(rs, 16);
     constexpr double kMinPsnr = 26.0;  // the samplers 28.9-29.8 dB, the centre 22.5
     RenderOptions opt;

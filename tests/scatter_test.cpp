@@ -192,12 +192,12 @@ TEST(Scatter, DeterministicForASeedAndAnyThreadCount) {
     tbb::task_arena(1).execute([&] {
         const Scene s = load(objs);
         h1 = placement_hash(s);
-        i1 = render_exact(RenderScene(s), {}).display;
+        i1 = render_exact(TracedScene(s), {}).display;
     });
     tbb::task_arena(2).execute([&] {
         const Scene s = load(objs);
         h2 = placement_hash(s);
-        i2 = render_exact(RenderScene(s), {}).display;
+        i2 = render_exact(TracedScene(s), {}).display;
     });
     EXPECT_EQ(h1, h2);
     EXPECT_EQ(i1.rgb, i2.rgb);
@@ -251,7 +251,7 @@ TEST(Scatter, CommandWritesExplicitInstancesThatRenderTheSameImage) {
     ASSERT_EQ(a.objects.size(), b.objects.size());
     EXPECT_TRUE(b.scatters.empty());
     EXPECT_EQ(placement_hash(a), placement_hash(b));  // the mesh path was moved to stay found
-    EXPECT_EQ(render_exact(RenderScene(a), {}).display.rgb, render_exact(RenderScene(b), {}).display.rgb);
+    EXPECT_EQ(render_exact(TracedScene(a), {}).display.rgb, render_exact(TracedScene(b), {}).display.rgb);
 }
 
 }  // namespace

@@ -133,7 +133,7 @@ TEST(SceneLimits, ExtremeQuarticRendersWithoutCrashing) {
     const std::string obj = R"({"type": "quartic", "material": "m",
         "polynomial": "(x^2+y^2+z^2)^2 - 1e308"}, {"type": "sphere", "radius": 1, "material": "m"})";
     const Scene s = load_scene_text(scene_with(obj), "scene.json");
-    const RenderScene rs(s);
+    const TracedScene rs(s);
     const RenderOutput out = render_exact(rs, {});
     EXPECT_EQ(out.display.rgb.size(), 8u * 6u * 3u);
 }
@@ -154,14 +154,14 @@ TEST(SceneLimits, ObjectsBeyondFloatRangeAreStillHit) {
         scene_with(R"({"type": "sphere", "center": [0, 1e19, 0], "radius": 0.99999999999e19,
                        "material": "m"})"),
         "scene.json");
-    const RenderScene rs(s);
+    const TracedScene rs(s);
     SurfaceHit hit;
     EXPECT_TRUE(rs.intersect({{0, -6, 0}, {0, 1, 0}}, 0, kInfinity, hit));
 }
 
 TEST(SceneLimits, NonFiniteRaysMiss) {
     const Scene s = load_scene_text(scene_with(kSphere), "scene.json");
-    const RenderScene rs(s);
+    const TracedScene rs(s);
     SurfaceHit hit;
     const double nan = std::numeric_limits<double>::quiet_NaN();
     EXPECT_FALSE(rs.intersect({{nan, -6, 0}, {0, 1, 0}}, 0, kInfinity, hit));

@@ -6,7 +6,7 @@
 // left of a ray is composed by LayerComposite (geometry/sub_rays.h): sheets of sub-rays block
 // each sub-ray once, the tables' sheets are independent draws (the product of 1 - alpha).
 // Exact shapes have alpha = 1, so a scene without lattices shades as shade() does.
-#include "render/core/render_scene.h"
+#include "render/core/traced_scene.h"
 #include "render/core/shading.h"
 
 namespace lat {

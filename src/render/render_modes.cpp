@@ -112,7 +112,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
                                             settings.progress, *filtering);
                 r.bytes_added += r.lattices.table_bytes;
             }
-            RenderScene::InstanceShapeFn instance_shape;
+            TracedScene::InstanceShapeFn instance_shape;
             if (filtering)
                 instance_shape = [&](int prim) {
                     const auto i = static_cast<std::size_t>(prim);
@@ -121,7 +121,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             r.prepare_ms = ms_since(t0);
             dist::mark(dist::Step::kTables);
             t0 = clock::now();
-            const RenderScene rs(scene, instance_shape, settings.accel,
+            const TracedScene rs(scene, instance_shape, settings.accel,
                                  r.lattices.widest_footprints);
             r.build_ms = ms_since(t0);
             dist::mark(dist::Step::kAccel);

@@ -12,7 +12,7 @@
 #include "geometry/chain.h"
 #include "render/core/camera.h"
 #include "render/core/sampler.h"
-#include "render/core/render_scene.h"
+#include "render/core/traced_scene.h"
 #include "render/baselines/scene_parts.h"
 #include "render/core/shading.h"
 #include "util/error.h"
@@ -148,7 +148,7 @@ private:
 
 // Light i reaching the start of shadow ray r (for_each_light's visible): the ray against the
 // base, then the particles' map.
-double light_visibility(const RenderScene& base, const std::vector<ShadowMap>& maps, std::size_t i,
+double light_visibility(const TracedScene& base, const std::vector<ShadowMap>& maps, std::size_t i,
                         const Ray& r, double tmin, double tmax, std::uint32_t self) {
     if (base.occluded(r, tmin, tmax, self)) return 0.0;
     return maps[i].visibility(r.o);
@@ -157,7 +157,7 @@ double light_visibility(const RenderScene& base, const std::vector<ShadowMap>& m
 // Kajiya-Kay (1989): diffuse by the sine between tangent and light, specular by the sine
 // between tangent and half vector (the cone of reflections about the strand), flat over the
 // particle as a particle system shades.
-Vec3 shade_particle(const Scene& s, const RenderScene& base, const std::vector<ShadowMap>& maps,
+Vec3 shade_particle(const Scene& s, const TracedScene& base, const std::vector<ShadowMap>& maps,
                     const Particle& p, ShadeState& state) {
     const Material& m = s.materials[p.material];
     const Vec3 mid = (p.a + p.b) * 0.5;
@@ -188,7 +188,7 @@ Vec3 shade_particle(const Scene& s, const RenderScene& base, const std::vector<S
 }
 
 // Phong, as exact mode shades; the particles' shadows from their maps.
-Vec3 shade_base(const RenderScene& base, const std::vector<ShadowMap>& maps, const Ray& ray,
+Vec3 shade_base(const TracedScene& base, const std::vector<ShadowMap>& maps, const Ray& ray,
                 const SurfaceHit& hit, ShadeState& state) {
     const auto visible = [&](std::size_t i, const Ray& r, double tmin, double tmax, double) {
         return light_visibility(base, maps, i, r, tmin, tmax, hit.object);
@@ -232,7 +232,7 @@ ParticleSet make_particles(const Scene& scene) {
 RenderOutput render_particles(const Scene& scene, const ParticleSet& set, const ParticleOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
     const Scene base_only = base_scene(scene);
-    const RenderScene base(base_only);
+    const TracedScene base(base_only);
     const std::vector<Particle>& ps = set.particles;
 
     // Shadow maps, one per light, around the particles' bounding sphere.

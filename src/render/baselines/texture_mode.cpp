@@ -7,7 +7,7 @@
 #include <cmath>
 #include <map>
 
-#include "render/core/render_scene.h"
+#include "render/core/traced_scene.h"
 #include "render/baselines/scene_parts.h"
 #include "render/core/shading.h"
 #include "scene/scatter.h"
@@ -131,7 +131,7 @@ TextureMaps bake_texture(const Scene& scene, const TextureOptions& opt) {
     maps.atlas = make_texture_atlas(base, opt.width);
     const TextureAtlas& atlas = *maps.atlas;
     const Scene fur = instance_scene(scene);
-    const RenderScene rs(fur);
+    const TracedScene rs(fur);
     const int n = std::max(1, opt.subsamples);
     const std::size_t texels = atlas.texel_count();
     maps.colour_coverage.assign(texels * 4, 0);
@@ -182,7 +182,7 @@ namespace {
 // Exact shading, but at the base surface the bare base and the baked fur blended by coverage.
 class TextureIntegrator final : public Integrator {
 public:
-    TextureIntegrator(const Scene& scene, const TextureMaps& maps, const RenderScene& rs)
+    TextureIntegrator(const Scene& scene, const TextureMaps& maps, const TracedScene& rs)
         : scene_(scene), maps_(maps), rs_(rs) {
         if (!maps.atlas) return;
         // The base's index among the traced objects: instances before it were removed.
@@ -200,7 +200,7 @@ public:
 private:
     const Scene& scene_;  // with its instances
     const TextureMaps& maps_;
-    const RenderScene& rs_;  // the scene without them
+    const TracedScene& rs_;  // the scene without them
     std::uint32_t base_index_ = 0;
 
     Vec3 textured(const Ray& ray, const SurfaceHit& hit, ShadeState& state) const {
@@ -237,7 +237,7 @@ private:
 
 RenderOutput render_texture(const Scene& scene, const TextureMaps& maps, const RenderOptions& opt) {
     const Scene base_only = base_scene(scene);
-    const RenderScene rs(base_only);
+    const TracedScene rs(base_only);
     return render_image(base_only.camera, TextureIntegrator(scene, maps, rs), opt);
 }
 

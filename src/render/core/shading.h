@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "render/core/render_scene.h"
+#include "render/core/traced_scene.h"
 
 namespace lat {
 
@@ -67,7 +67,7 @@ inline Vec3 phong_term(const Material& m, Vec3 color, Vec3 n, Vec3 l, Vec3 v, Ve
 }
 
 // Radiance (linear, unclamped) seen along `ray` at `hit`.
-Vec3 shade(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeState& state);
+Vec3 shade(const TracedScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeState& state);
 
 // Start of shadow rays: far enough from the surface to skip its own crossing, which double
 // precision places within ~1e-12 relative of the true one, and small against any feature.
@@ -85,7 +85,7 @@ double shadow_epsilon(Vec3 p);
 // layered shading, the texture mode's baked surfaces and particle mode (whose visibility reads
 // a shadow map per light) go through it.
 template <class Term, class Visible, class Lit>
-void for_each_light(const RenderScene& rs, Vec3 p, ShadeState& state, Term&& term,
+void for_each_light(const TracedScene& rs, Vec3 p, ShadeState& state, Term&& term,
                     Visible&& visible, Lit&& lit) {
     const Scene& s = rs.scene();
     const double eps = shadow_epsilon(p);
@@ -109,7 +109,7 @@ void for_each_light(const RenderScene& rs, Vec3 p, ShadeState& state, Term&& ter
 
 // visible for for_each_light and shade_with where nothing is partly covered: the light
 // arrives whole (1) unless the shadow ray, leaving object self, meets something (0).
-inline auto hard_shadows(const RenderScene& rs, std::uint32_t self, ShadeState& state) {
+inline auto hard_shadows(const TracedScene& rs, std::uint32_t self, ShadeState& state) {
     return [&rs, self, &state](std::size_t light, const Ray& r, double tmin, double tmax, double) {
         return rs.occluded(r, tmin, tmax, self, state.kept_blocker(light)) ? 0.0 : 1.0;
     };
@@ -119,7 +119,7 @@ inline auto hard_shadows(const RenderScene& rs, std::uint32_t self, ShadeState& 
 // the light that arrives: 0 or 1 for shade(), a transmittance through partial hits for layered
 // rays (render/layers.h), a shadow map's for particle mode's base.
 template <class Visible>
-Vec3 shade_with(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeState& state,
+Vec3 shade_with(const TracedScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeState& state,
                 Visible&& visible) {
     const Scene& s = rs.scene();
     const Material& m = s.materials[hit.material];

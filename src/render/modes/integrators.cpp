@@ -15,11 +15,11 @@ Vec3 LayeredIntegrator::radiance(const Ray& ray, ShadeState& state) const {
     return trace_layers(rs_, ray, spread_, state);
 }
 
-RenderOutput render_exact(const RenderScene& rs, const RenderOptions& opt) {
+RenderOutput render_exact(const TracedScene& rs, const RenderOptions& opt) {
     return render_image(rs.scene().camera, ExactIntegrator(rs), opt);
 }
 
-RenderOutput render_layered(const RenderScene& rs, const RenderOptions& opt) {
+RenderOutput render_layered(const TracedScene& rs, const RenderOptions& opt) {
     const Camera& camera = rs.scene().camera;
     return render_image(camera, LayeredIntegrator(rs, sample_spread(camera, opt.spp)), opt);
 }

@@ -3,7 +3,7 @@
 // exact point samples, and layers of partial coverage traced front to back. The texture
 // baseline has its own (render/baselines/texture_mode.cpp).
 #include "render/core/integrator.h"
-#include "render/core/render_scene.h"
+#include "render/core/traced_scene.h"
 #include "render/core/renderer.h"
 
 namespace lat {
@@ -11,27 +11,27 @@ namespace lat {
 // Each ray's closest hit, shaded by the reference Phong rule (shade()), or the background.
 class ExactIntegrator final : public Integrator {
 public:
-    explicit ExactIntegrator(const RenderScene& rs) : rs_(rs) {}
+    explicit ExactIntegrator(const TracedScene& rs) : rs_(rs) {}
     Vec3 radiance(const Ray& ray, ShadeState& state) const override;
 
 private:
-    const RenderScene& rs_;
+    const TracedScene& rs_;
 };
 
 // Each ray traced front to back through partial hits (render/layers.h), its footprint `spread`
 // wide per unit of distance (sample_spread): prefiltered lattices and sub-ray sheets.
 class LayeredIntegrator final : public Integrator {
 public:
-    LayeredIntegrator(const RenderScene& rs, double spread) : rs_(rs), spread_(spread) {}
+    LayeredIntegrator(const TracedScene& rs, double spread) : rs_(rs), spread_(spread) {}
     Vec3 radiance(const Ray& ray, ShadeState& state) const override;
 
 private:
-    const RenderScene& rs_;
+    const TracedScene& rs_;
     double spread_;
 };
 
 // The scene's image through each integrator, the footprint's spread from the camera and spp.
-RenderOutput render_exact(const RenderScene& rs, const RenderOptions& opt = {});
-RenderOutput render_layered(const RenderScene& rs, const RenderOptions& opt = {});
+RenderOutput render_exact(const TracedScene& rs, const RenderOptions& opt = {});
+RenderOutput render_layered(const TracedScene& rs, const RenderOptions& opt = {});
 
 }  // namespace lat

@@ -1,6 +1,8 @@
 #pragma once
-// A scene made ready to trace: its objects' shapes behind the Embree accelerator, with the
-// closest-hit query (Intersect) and the cheaper any-hit query for shadow rays (Occluded).
+// A scene made ready to trace (TracedScene): its objects' shapes behind the Embree
+// accelerator, with the closest-hit query (intersect) and the cheaper any-hit query for shadow
+// rays (occluded). The scene as read is Scene (scene/scene.h); the lattices that answer its
+// instances are SceneLattices (render/modes/scene_lattices.h).
 #include <functional>
 #include <memory>
 #include <span>
@@ -29,13 +31,13 @@ struct SurfaceHit {
     SubRayNormals normals;
 };
 
-class RenderScene {
+class TracedScene {
 public:
     // `instance_shape`, when given, supplies the shape traced for instances of primitive i
     // (e.g. its lattice); by default instances are traced exactly as their sphere/cylinder union.
     using InstanceShapeFn = std::function<std::shared_ptr<const Shape>(int primitive)>;
     // widest_footprints: per object, or empty (infinity), its AccelObject::widest_footprint.
-    explicit RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape = {},
+    explicit TracedScene(const Scene& scene, const InstanceShapeFn& instance_shape = {},
                          const AccelOptions& accel = {},
                          std::span<const double> widest_footprints = {});
 
@@ -75,5 +77,9 @@ private:
 
     void surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const;
 };
+
+// The former name, for render/layers.* while it moves to its own folder: remove once nothing
+// uses it.
+using RenderScene = TracedScene;
 
 }  // namespace lat

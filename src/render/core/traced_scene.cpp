@@ -1,4 +1,4 @@
-#include "render/core/render_scene.h"
+#include "render/core/traced_scene.h"
 
 #include <cassert>
 
@@ -6,7 +6,7 @@
 
 namespace lat {
 
-RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_shape,
+TracedScene::TracedScene(const Scene& scene, const InstanceShapeFn& instance_shape,
                          const AccelOptions& accel, std::span<const double> widest_footprints)
     : scene_(scene) {
     assert(widest_footprints.empty() || widest_footprints.size() == scene.objects.size());
@@ -27,14 +27,14 @@ RenderScene::RenderScene(const Scene& scene, const InstanceShapeFn& instance_sha
     accel_ = std::make_unique<EmbreeAccel>(accel_objects_, accel);
 }
 
-bool RenderScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const {
+bool TracedScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const {
     AccelHit h;
     if (!accel_->intersect(r, tmin, tmax, h)) return false;
     surface_hit(r, h, hit);
     return true;
 }
 
-bool RenderScene::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
+bool TracedScene::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                                    SurfaceHit& hit, std::vector<SurfaceHit>& partial,
                                    const LayerStop& stop) const {
     AccelHit h;
@@ -46,7 +46,7 @@ bool RenderScene::intersect_layers(const Ray& r, double tmin, double tmax, std::
     return found;
 }
 
-void RenderScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const {
+void TracedScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const {
     const SceneObject& o = scene_.objects[h.object];
     const Shape& shape = *shapes_[h.object];
     hit.t = h.t;
