@@ -13,7 +13,8 @@
 #include "geometry/chain.h"
 #include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
-#include "geometry/sub_rays.h"
+#include "coverage/sheets.h"
+#include "coverage/sub_rays.h"
 #include "geometry/triangle_mesh.h"
 #include "hook_primitive.h"
 #include "lattice/encoding.h"
@@ -257,7 +258,7 @@ TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
     }
 }
 
-// A camera ray's sheets (Shape::sheets) split its sub-rays by depth: the sub-rays that meet the
+// A camera ray's sheets (SheetSource) split its sub-rays by depth: the sub-rays that meet the
 // primitive within kSheetDepth footprint widths of the nearest make the first sheet, those
 // within that of the nearest left the next, each sheet the mean of its sub-rays' points and
 // normals and their share as the coverage, with the sub-rays' own normals, in ray order;
@@ -294,7 +295,7 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
                     met |= 1u << k;
                     t[k] = c.t, p[k] = sub.at(c.t), nrm[k] = normalize(long_hook().normal(sub, c));
                 }
-            std::array<SheetCrossing, Shape::kMaxSheets> got;
+            std::array<SheetCrossing, kMaxSheets> got;
             const int count = s.sheets(r, 0.0, kInfinity, got);
             int expected = 0;
             for (unsigned left = met; left != 0; ++expected) {
@@ -327,7 +328,7 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
             EXPECT_EQ(count, expected);
             // A tmax between two sheets cuts the farther: the nearer are as they were.
             if (count > 1) {
-                std::array<SheetCrossing, Shape::kMaxSheets> cut;
+                std::array<SheetCrossing, kMaxSheets> cut;
                 const double tmax = 0.5 * (got[0].crossing.t + got[1].crossing.t);
                 ASSERT_EQ(s.sheets(r, 0.0, tmax, cut), 1);
                 EXPECT_EQ(cut[0].crossing.t, got[0].crossing.t);

@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "geometry/ray_quad.h"
-#include "geometry/sub_rays.h"
+#include "coverage/sub_rays.h"
 
 namespace lat {
 namespace {
@@ -51,7 +51,7 @@ double lod_level(double cell0, double width) {
 
 double farthest_sub_ray(double width) {
     // The corner one of n x n: sqrt(2) (n - 1) / 2n of the width from the ray, 1 % more for
-    // directions across it that are perpendicular within 1e-3 only (geometry/sub_rays.h).
+    // directions across it that are perpendicular within 1e-3 only (coverage/sub_rays.h).
     constexpr int n = kExactSubRays;
     return width * std::sqrt(2.0) * (n - 1) / (2 * n) * 1.01;
 }
@@ -391,7 +391,7 @@ void FilteredLatticeShape::exact_sub_rays(double width, bool normal, const Ray& 
     } else if (chain_)
         parts = chain_->all_parts();
     // Along the world's directions across the ray where the renderer set them, so that the
-    // k-th sub-ray is the same in every lattice (geometry/sub_rays.h).
+    // k-th sub-ray is the same in every lattice (coverage/sub_rays.h).
     // (Perpendicular to the ray and each other within 1e-3, which farthest_sub_ray allows for:
     // made exactly so, the basis cost Plate 2 a sixth of its time.)
     const RayFootprint& f = footprint_of(r);

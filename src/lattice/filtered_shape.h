@@ -3,7 +3,7 @@
 // the primitive's own crossings of sub-rays across each ray's footprint.
 // A ray gets one "sheet" from the lattice: a point, a normal and a coverage alpha, the share of
 // the rays around it that meet the primitive. The renderer shades alpha of it and lets the ray
-// go on behind for the rest (render/layers.h). Filters:
+// go on behind for the rest (coverage/layers.h). Filters:
 //   box     the coverage of the pair the ray snaps to (constant over the pair's cells);
 //   smooth  the coverages of the 5 pairs around the ray's real entry and exit points, blended
 //           linearly over a simplex of the 4-D (entry, exit) grid: continuous in ray space.
@@ -21,7 +21,8 @@
 #include <vector>
 
 #include "geometry/chain.h"
-#include "geometry/sub_rays.h"
+#include "coverage/sheets.h"
+#include "coverage/sub_rays.h"
 #include "lattice/hit_table_shape.h"
 #include "lattice/part_boxes.h"
 
@@ -63,7 +64,7 @@ double lod_blend(double f, double band);
 // times the time, and one sub-ray is point sampling (bench/notes/filtering-constants.md).
 inline constexpr int kExactSubRays = 2;
 static_assert(kExactSubRays * kExactSubRays == kSubRays);
-static_assert(kSubRays <= Shape::kMaxSheets, "a sheet per sub-ray at most");
+static_assert(kSubRays <= kMaxSheets, "a sheet per sub-ray at most");
 // A camera ray's sub-rays that meet the primitive within this many footprint widths (along the
 // ray) of the nearest one make one sheet, shaded once at their mean point; those farther make
 // sheets of their own, each shaded with its own shadow rays (sheets). One sheet for them all had
@@ -92,7 +93,7 @@ struct FilterLevel {
     TableContext ctx;
 };
 
-class FilteredLatticeShape final : public Shape {
+class FilteredLatticeShape final : public Shape, public SheetSource {
 public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage (or is null:
     // FilterLevel); the primitive (ctx.primitive) must outlive the shape. table_error:

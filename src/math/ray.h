@@ -7,7 +7,7 @@ namespace lat {
 
 // What a ray stands for beyond its line: the footprint of a pixel (or of what a shadow ray
 // leaves), which picks a filtered lattice's level of detail and spans its sub-rays
-// (lattice/filtered_shape.h, geometry/sub_rays.h). The renderer makes one per ray; the
+// (lattice/filtered_shape.h, coverage/sub_rays.h). The renderer makes one per ray; the
 // accelerator hands each object its own copy in the object's space.
 struct RayFootprint {
     // The width (world units) at parameter t of the world ray (unit direction) is
