@@ -18,7 +18,9 @@
 #include "geometry/triangle_mesh.h"
 #include "hook_primitive.h"
 #include "lattice/encoding.h"
+#include "lattice/answer_plan.h"
 #include "lattice/filtered_shape.h"
+#include "lattice/sub_ray_shape.h"
 #include "lattice/rasterizer.h"
 
 namespace lat {
@@ -31,7 +33,8 @@ const TableContext& kFine = test::kHookContext;  // cells of 0.5
 // crossings or by the table alone.
 struct HookLattice {
     std::vector<ByteBuffer> payloads;  // the tables read them in place
-    std::unique_ptr<FilteredLatticeShape> exact, tables_only;
+    std::unique_ptr<SubRayShape> exact;
+    std::unique_ptr<FilteredLatticeShape> tables_only;
 };
 
 // The widest footprint the exact hook's sub-rays span (kFine cells of 0.5).
@@ -56,8 +59,8 @@ HookLattice hook_lattice(const Shape& primitive = hook()) {
     const std::vector<FilterLevel> levels{
         {e.open(h.payloads.back().data(), h.payloads.back().size(), r.hits, ctx), ctx}};
     const double error = e.error_bound(kFine, {});
-    h.exact = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, kExactWidth);
-    h.tables_only = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, 0.0);
+    h.exact = std::make_unique<SubRayShape>(ctx, levels.back().table, error, kExactWidth);
+    h.tables_only = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error);
     return h;
 }
 
@@ -266,7 +269,7 @@ TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
 // them, intersect's sheet (no normals).
 TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
     const HookLattice h = hook_lattice(long_hook());
-    const FilteredLatticeShape& s = *h.exact;
+    const SubRayShape& s = *h.exact;
     const Bounds3 box{{0, 0, 0}, Vec3{4, 2, 4}};
     const int n = kExactSubRays;
     int split = 0, whole = 0;
@@ -360,7 +363,7 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
 // by more than their sub-rays' reach are culled.
 TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
     const HookLattice h = hook_lattice(long_hook());
-    const FilteredLatticeShape& s = *h.exact;
+    const SubRayShape& s = *h.exact;
     ASSERT_GT(s.cull_count(), 0u);
     const auto meets_a_part = [&](const Ray& r) {
         for (std::size_t i = 0; i < s.cull_count(); ++i)
@@ -424,7 +427,7 @@ std::vector<Ray> rays_in_mid_planes(Vec3 centre, int per_plane) {
 // (boxes, split in halves).
 void expect_instances_culled_by_their_own_bound(const Shape& primitive) {
     const HookLattice h = hook_lattice(primitive);
-    const FilteredLatticeShape& s = *h.exact;
+    const SubRayShape& s = *h.exact;
     const Transform turned = Transform::translate({3, -2, 5}) * Transform::rotate({1, 2, 3}, 0.7) *
                              Transform::scale({1.5, 1.5, 1.5});
     std::vector<Ray> local_rays = rays(1500);
@@ -486,7 +489,7 @@ TEST(FilteredCloseUps, EachInstanceIsCulledByItsOwnWidestFootprint) {
 // than it, the two instances' bounds apart.
 TEST(FilteredCloseUps, TheAcceleratorHandsEachInstanceItsBound) {
     const HookLattice h = hook_lattice(long_hook());
-    const FilteredLatticeShape& s = *h.exact;
+    const SubRayShape& s = *h.exact;
     const Transform near = Transform::translate({3, -2, 5}) * Transform::rotate({1, 2, 3}, 0.7);
     const Transform far = Transform::translate({3, 20, 5});
     const double near_widest = 0.3 * kExactWidth;
@@ -611,8 +614,8 @@ int differing_answers(const Shape& primitive) {
     const ByteBuffer payload = e.build(raster.raw, ctx, {});
     const std::vector<FilterLevel> levels{
         {e.open(payload.data(), payload.size(), raster.hits, ctx), ctx}};
-    const FilteredLatticeShape asked(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), kExactWidth);
-    const FilteredLatticeShape tables(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), 0.0);
+    const SubRayShape asked(ctx, levels.back().table, e.error_bound(ctx, {}), kExactWidth);
+    const FilteredLatticeShape tables(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}));
     const RayFootprint vanishing = width_footprint(1e-9);
     int differ = 0;
     for (const Ray& line : rays(3000)) {
@@ -640,7 +643,7 @@ TEST(FilteredCloseUps, APrimitiveAnsweredByItsCrossingsNeedsNoTable) {
     const HookLattice h = hook_lattice(long_hook());
     TableContext ctx = kFine;
     ctx.primitive = &long_hook();
-    const FilteredLatticeShape bare({{nullptr, ctx}}, LatticeFilter::kSmooth, 0.0, kExactWidth);
+    const SubRayShape bare(ctx, nullptr, 0.0, kExactWidth);
     EXPECT_EQ(bare.bounds().lo, h.exact->bounds().lo);
     EXPECT_EQ(bare.bounds().hi, h.exact->bounds().hi);
     int hits = 0, spans = 0;
@@ -673,7 +676,7 @@ TEST(FilteredCloseUps, APrimitiveAnsweredByItsCrossingsNeedsNoTable) {
     }
     EXPECT_GT(hits, 1000);
     EXPECT_GT(spans, 100);
-    EXPECT_THROW(FilteredLatticeShape({{nullptr, ctx}}, LatticeFilter::kSmooth, 0.0, 0.0),
+    EXPECT_THROW(FilteredLatticeShape({{nullptr, ctx}}, LatticeFilter::kSmooth, 0.0),
                  std::logic_error);
 }
 
@@ -690,9 +693,8 @@ TEST(FilteredCloseUps, ChainsOfAnyPartsAnswerFromTheirCrossings) {
         const Encoding& e = find_encoding("coverage");
         const RasterizeResult raster = rasterize(ctx);
         const ByteBuffer payload = e.build(raster.raw, ctx, {});
-        const FilteredLatticeShape asked(
-            {{e.open(payload.data(), payload.size(), raster.hits, ctx), ctx}},
-            LatticeFilter::kSmooth, e.error_bound(ctx, {}), kExactWidth);
+        const SubRayShape asked(ctx, e.open(payload.data(), payload.size(), raster.hits, ctx),
+                                e.error_bound(ctx, {}), kExactWidth);
         int hits = 0;
         for (const Ray& r : rays(3000)) {  // without a footprint
             Crossing exact, got;
