@@ -13,9 +13,8 @@ Vec3 shade_layer(const RenderScene& rs, const Ray& ray, const SurfaceHit& hit, d
                              double dist) {
         // Narrowing to the light; sub-rays along the same world directions in every lattice
         // (coverage/sub_rays.h).
-        const double w = shadow_width(hit.n, ray.d, r.d, width);
-        const RayFootprint f = footprint_across(normalize(r.d), w, -w / dist, true);
-        return transmittance(rs, {r.o, r.d, &f}, tmin, tmax, hit.object, state.kept_blocker(light));
+        const TraceRay shadow = TraceRay::shadow(r, shadow_width(hit.n, ray.d, r.d, width), dist);
+        return transmittance(rs, shadow.ray(), tmin, tmax, hit.object, state.kept_blocker(light));
     };
     return shade_with(rs, ray, hit, state, visible);
 }
@@ -29,13 +28,13 @@ double transmittance(const RenderScene& rs, const Ray& r, double tmin, double tm
     return transmitted(partial);
 }
 
-Vec3 trace_layers(const RenderScene& rs, const Ray& ray, double spread, ShadeState& state) {
+Vec3 trace_layers(const RenderScene& rs, const TraceRay& traced, ShadeState& state) {
     thread_local std::vector<SurfaceHit> partial;  // scratch, reused ray after ray
-    // Sub-rays along the same world directions in every lattice (coverage/sub_rays.h).
-    const RayFootprint f = footprint_across(normalize(ray.d), 0, spread, false);
+    const Ray ray = traced.line();  // shaded as its line
+    const double spread = traced.footprint.spread;
     SurfaceHit opaque;
-    const bool found = rs.intersect_layers({ray.o, ray.d, &f}, 0.0, kInfinity,
-                                           EmbreeAccel::kNoObject, opaque, partial, camera_stop());
+    const bool found = rs.intersect_layers(traced.ray(), 0.0, kInfinity, EmbreeAccel::kNoObject,
+                                           opaque, partial, camera_stop());
     // Shading moves the footprint (shadow rays): the layers are all found first. (Shadow rays
     // leave `partial` as it is: transmittance has its own.)
     return composite_layers(

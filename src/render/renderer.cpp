@@ -48,7 +48,6 @@ struct TileContext {
     PinholeCamera cam;
     PixelSampler sampler;
     int w, h, spp, tiles_x;
-    double spread;
     RenderOutput& out;
 };
 
@@ -73,12 +72,13 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
             Vec3 sum, sum_clamped;
             for (int k = 0; k < spp; ++k) {
                 const auto [ox, oy] = tc.sampler.offset(static_cast<std::uint64_t>(j) * w + i, k);
-                const Ray ray = tc.cam.ray(i, j, ox, oy);
+                const TraceRay traced = tc.cam.trace_ray(i, j, ox, oy);
+                const Ray ray = traced.line();
                 ++rays;
                 SurfaceHit hit;
                 Vec3 c = s.background;
                 if (tc.opt.layered)
-                    c = trace_layers(tc.rs, ray, tc.spread, state);
+                    c = trace_layers(tc.rs, traced, state);
                 else if (tc.rs.intersect(ray, 0.0, kInfinity, hit))
                     c = tc.opt.shader ? tc.opt.shader(ray, hit, state)
                                       : shade(tc.rs, ray, hit, state);
@@ -195,9 +195,8 @@ RenderOutput render_image(const RenderScene& rs, const RenderOptions& opt) {
     out.display = {w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h * 3)};
     const PixelSampler sampler(opt.sampler, opt.spp);
     const int spp = sampler.spp();
-    const double spread = sample_spread(s.camera, spp);
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-    const TileContext tc{rs, opt, PinholeCamera(s.camera), sampler, w, h, spp, tiles_x, spread, out};
+    const TileContext tc{rs, opt, PinholeCamera(s.camera, spp), sampler, w, h, spp, tiles_x, out};
 
     TileCounts counts;
     const bool across = opt.across_ranks && dist::distributed();
