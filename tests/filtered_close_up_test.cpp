@@ -711,7 +711,7 @@ TEST(FilteredCloseUps, ChainsOfAnyPartsAnswerFromTheirCrossings) {
 // A mesh descends its own hierarchy: one of many more triangles than kMaxExactCost is answered
 // from its crossings (a sheet of 2 x 12 x 8 triangles); a CSG tree costs its leaves' costs, so
 // one with such a chain as a leaf keeps to its tables, and so does one of six tori (a quartic
-// costs 12), where one of five does not (answered_by_primitive: scene_lattices' rule, which
+// costs 12), where one of five does not (answered_by_primitive: the answer plan's rule, which
 // gives such a primitive its crossings only past the build budget; the shape answers by them
 // whenever it is given a width).
 TEST(FilteredCloseUps, MeshesAnswerExactlyAndTreesCostTheirLeaves) {

@@ -169,7 +169,7 @@ public:
 
     // About how many simple tests (a sphere's or a cylinder's) one intersect() makes: what a
     // lattice weighs before tracing its primitive exactly where its tables could answer
-    // (FilteredLatticeShape). By default its primitives, tested one by one.
+    // (lattice/answer_plan.h). By default its primitives, tested one by one.
     virtual double intersect_cost() const { return static_cast<double>(primitive_count()); }
 
     // Shapes made of many parts (sphere/cylinder chains) expose them so the accelerator can
@@ -226,7 +226,7 @@ public:
     virtual std::size_t cull_count() const { return 1; }
     // The bounds of cull part i placed by xf. widest: the widest footprint (shape units) of the
     // rays this placement is traced with (AccelObject::widest_footprint; infinity: any). A shape
-    // whose reach grows with the footprint (a filtered lattice's sub-rays) culls narrower for
+    // whose reach grows with the footprint (a lattice's sub-rays) culls narrower for
     // narrower ones; its queries then take the same bound from their ray's footprint
     // (RayFootprint::widest).
     virtual Bounds3 cull_bounds(std::size_t, const Transform& xf, double /*widest*/) const {

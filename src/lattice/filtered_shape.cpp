@@ -23,12 +23,10 @@ double reach_cells(LatticeFilter f) {
 }
 
 // The smooth filter's culling cuts its tent at this distance (cells of the culling level): the
-// bound above is met only by pairs of tiny weight at the far corners of the blend's simplex.
-// Coverage lost (Coverage.CullingKeepsNearlyAllTheCoverage: a hair 0.16 coarse cells thick and
-// the hook, lines and rays starting inside): at most 3.4e-4 of the coarser level's rays'
-// coverage, 1e-6 of the culling level's; at 1.5 cells 4.1e-3 (the thin hair), at the bound
-// 2.7e-5. Plates 4 and 5 and the furry bunny render 4 %, 7 % and 10 % faster than at the bound,
-// with the same PSNR to 0.01 dB.
+// bound above is met only by pairs of tiny weight at the far corners of the blend's simplex, so
+// the cut loses a negligible share of coverage (Coverage.CullingKeepsNearlyAllTheCoverage
+// bounds it) and saves the tests of the rays that meet only that far corner
+// (bench/notes/filtering-constants.md has both).
 constexpr double kSmoothCullCells = 1.8;
 double cull_cells(LatticeFilter f) {
     return std::min(reach_cells(f), kSmoothCullCells);
@@ -190,11 +188,11 @@ bool FilteredLatticeShape::to_crossing(const Sheet& s, double finer, const Ray& 
     }
     // The normal is the coverage-weighted mean of unit normals, left unnormalised: its length
     // (below 1 where they diverge) tells the shading how much the normals under the footprint
-    // spread (SurfaceHit::normal_length). The tables' pairs give their spread over the filter's tent, about a
-    // cell of the level wide; a footprint narrower than the finest level's cell (close-ups)
-    // covers less of it, and for smooth surfaces the spread, 1 - length, goes as the width
-    // squared (unscaled, scaled, without normal filtering: Plate 2, thistles, 36.3, 39.6,
-    // 39.6 dB; Plate 3, a hair close up, 42.2, 43.1, 43.1 dB; Plates 4 and 5 need no scaling).
+    // spread (SurfaceHit::normal_length). The tables' pairs give their spread over the
+    // filter's tent, about a cell of the level wide; a footprint narrower than the finest
+    // level's cell (close-ups) covers less of it, and for smooth surfaces the spread,
+    // 1 - length, goes as the width squared: scaled so, close-ups shade as without normal
+    // filtering (bench/notes/filtering-constants.md).
     Vec3 n = s.n / s.alpha;
     if (const double ln = length(s.n); ln > 0) {
         const double len = 1 - (1 - std::min(1.0, ln / s.alpha)) * std::exp2(-2 * finer);
