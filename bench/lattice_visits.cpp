@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 
+#include "coverage/sheets.h"
 #include "io/image.h"
 #include "render/modes/integrators.h"
 #include "render/modes/scene_lattices.h"
@@ -28,9 +29,10 @@ struct Counts {
     std::atomic<std::uint64_t> intersect{0}, occluded{0}, spans{0}, shading{0};
 };
 
-class CountingShape final : public lat::Shape {
+class CountingShape final : public lat::Shape, public lat::SheetSource {
 public:
-    CountingShape(std::shared_ptr<const lat::Shape> s, Counts& c) : s_(std::move(s)), c_(c) {}
+    CountingShape(std::shared_ptr<const lat::Shape> s, Counts& c)
+        : s_(std::move(s)), sheets_(lat::sheet_source(*s_)), c_(c) {}
 
     lat::Bounds3 bounds() const override { return s_->bounds(); }
     bool intersect(const lat::Ray& r, double tmin, double tmax, lat::Crossing& hit) const override {
@@ -38,9 +40,9 @@ public:
         return s_->intersect(r, tmin, tmax, hit);
     }
     int sheets(const lat::Ray& r, double tmin, double tmax,
-               std::span<lat::SheetCrossing, kMaxSheets> out) const override {
+               std::span<lat::SheetCrossing, lat::kMaxSheets> out) const override {
         c_.intersect.fetch_add(1, std::memory_order_relaxed);
-        return s_->sheets(r, tmin, tmax, out);
+        return lat::sheets_of(*s_, sheets_, r, tmin, tmax, out);
     }
     bool occluded(const lat::Ray& r, double tmin, double tmax) const override {
         c_.occluded.fetch_add(1, std::memory_order_relaxed);
@@ -100,6 +102,7 @@ public:
 
 private:
     std::shared_ptr<const lat::Shape> s_;
+    const lat::SheetSource* sheets_;  // s_'s, if it has one: forwarded unchanged
     Counts& c_;
 };
 

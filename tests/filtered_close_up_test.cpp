@@ -13,11 +13,14 @@
 #include "geometry/chain.h"
 #include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
-#include "geometry/sub_rays.h"
+#include "coverage/sheets.h"
+#include "coverage/sub_rays.h"
 #include "geometry/triangle_mesh.h"
 #include "hook_primitive.h"
 #include "lattice/encoding.h"
+#include "lattice/answer_plan.h"
 #include "lattice/filtered_shape.h"
+#include "lattice/sub_ray_shape.h"
 #include "lattice/rasterizer.h"
 
 namespace lat {
@@ -30,7 +33,8 @@ const TableContext& kFine = test::kHookContext;  // cells of 0.5
 // crossings or by the table alone.
 struct HookLattice {
     std::vector<ByteBuffer> payloads;  // the tables read them in place
-    std::unique_ptr<FilteredLatticeShape> exact, tables_only;
+    std::unique_ptr<SubRayShape> exact;
+    std::unique_ptr<FilteredLatticeShape> tables_only;
 };
 
 // The widest footprint the exact hook's sub-rays span (kFine cells of 0.5).
@@ -55,8 +59,8 @@ HookLattice hook_lattice(const Shape& primitive = hook()) {
     const std::vector<FilterLevel> levels{
         {e.open(h.payloads.back().data(), h.payloads.back().size(), r.hits, ctx), ctx}};
     const double error = e.error_bound(kFine, {});
-    h.exact = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, kExactWidth);
-    h.tables_only = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error, 0.0);
+    h.exact = std::make_unique<SubRayShape>(ctx, levels.back().table, error, kExactWidth);
+    h.tables_only = std::make_unique<FilteredLatticeShape>(levels, LatticeFilter::kSmooth, error);
     return h;
 }
 
@@ -257,7 +261,7 @@ TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
     }
 }
 
-// A camera ray's sheets (Shape::sheets) split its sub-rays by depth: the sub-rays that meet the
+// A camera ray's sheets (SheetSource) split its sub-rays by depth: the sub-rays that meet the
 // primitive within kSheetDepth footprint widths of the nearest make the first sheet, those
 // within that of the nearest left the next, each sheet the mean of its sub-rays' points and
 // normals and their share as the coverage, with the sub-rays' own normals, in ray order;
@@ -265,7 +269,7 @@ TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
 // them, intersect's sheet (no normals).
 TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
     const HookLattice h = hook_lattice(long_hook());
-    const FilteredLatticeShape& s = *h.exact;
+    const SubRayShape& s = *h.exact;
     const Bounds3 box{{0, 0, 0}, Vec3{4, 2, 4}};
     const int n = kExactSubRays;
     int split = 0, whole = 0;
@@ -294,7 +298,7 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
                     met |= 1u << k;
                     t[k] = c.t, p[k] = sub.at(c.t), nrm[k] = normalize(long_hook().normal(sub, c));
                 }
-            std::array<SheetCrossing, Shape::kMaxSheets> got;
+            std::array<SheetCrossing, kMaxSheets> got;
             const int count = s.sheets(r, 0.0, kInfinity, got);
             int expected = 0;
             for (unsigned left = met; left != 0; ++expected) {
@@ -327,7 +331,7 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
             EXPECT_EQ(count, expected);
             // A tmax between two sheets cuts the farther: the nearer are as they were.
             if (count > 1) {
-                std::array<SheetCrossing, Shape::kMaxSheets> cut;
+                std::array<SheetCrossing, kMaxSheets> cut;
                 const double tmax = 0.5 * (got[0].crossing.t + got[1].crossing.t);
                 ASSERT_EQ(s.sheets(r, 0.0, tmax, cut), 1);
                 EXPECT_EQ(cut[0].crossing.t, got[0].crossing.t);
@@ -359,7 +363,7 @@ TEST(FilteredCloseUps, SheetsSplitTheSubRaysByDepth) {
 // by more than their sub-rays' reach are culled.
 TEST(FilteredCloseUps, CullingReachesAsFarAsTheRaysSubRays) {
     const HookLattice h = hook_lattice(long_hook());
-    const FilteredLatticeShape& s = *h.exact;
+    const SubRayShape& s = *h.exact;
     ASSERT_GT(s.cull_count(), 0u);
     const auto meets_a_part = [&](const Ray& r) {
         for (std::size_t i = 0; i < s.cull_count(); ++i)
@@ -423,7 +427,7 @@ std::vector<Ray> rays_in_mid_planes(Vec3 centre, int per_plane) {
 // (boxes, split in halves).
 void expect_instances_culled_by_their_own_bound(const Shape& primitive) {
     const HookLattice h = hook_lattice(primitive);
-    const FilteredLatticeShape& s = *h.exact;
+    const SubRayShape& s = *h.exact;
     const Transform turned = Transform::translate({3, -2, 5}) * Transform::rotate({1, 2, 3}, 0.7) *
                              Transform::scale({1.5, 1.5, 1.5});
     std::vector<Ray> local_rays = rays(1500);
@@ -485,7 +489,7 @@ TEST(FilteredCloseUps, EachInstanceIsCulledByItsOwnWidestFootprint) {
 // than it, the two instances' bounds apart.
 TEST(FilteredCloseUps, TheAcceleratorHandsEachInstanceItsBound) {
     const HookLattice h = hook_lattice(long_hook());
-    const FilteredLatticeShape& s = *h.exact;
+    const SubRayShape& s = *h.exact;
     const Transform near = Transform::translate({3, -2, 5}) * Transform::rotate({1, 2, 3}, 0.7);
     const Transform far = Transform::translate({3, 20, 5});
     const double near_widest = 0.3 * kExactWidth;
@@ -610,8 +614,8 @@ int differing_answers(const Shape& primitive) {
     const ByteBuffer payload = e.build(raster.raw, ctx, {});
     const std::vector<FilterLevel> levels{
         {e.open(payload.data(), payload.size(), raster.hits, ctx), ctx}};
-    const FilteredLatticeShape asked(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), kExactWidth);
-    const FilteredLatticeShape tables(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}), 0.0);
+    const SubRayShape asked(ctx, levels.back().table, e.error_bound(ctx, {}), kExactWidth);
+    const FilteredLatticeShape tables(levels, LatticeFilter::kSmooth, e.error_bound(ctx, {}));
     const RayFootprint vanishing = width_footprint(1e-9);
     int differ = 0;
     for (const Ray& line : rays(3000)) {
@@ -639,7 +643,7 @@ TEST(FilteredCloseUps, APrimitiveAnsweredByItsCrossingsNeedsNoTable) {
     const HookLattice h = hook_lattice(long_hook());
     TableContext ctx = kFine;
     ctx.primitive = &long_hook();
-    const FilteredLatticeShape bare({{nullptr, ctx}}, LatticeFilter::kSmooth, 0.0, kExactWidth);
+    const SubRayShape bare(ctx, nullptr, 0.0, kExactWidth);
     EXPECT_EQ(bare.bounds().lo, h.exact->bounds().lo);
     EXPECT_EQ(bare.bounds().hi, h.exact->bounds().hi);
     int hits = 0, spans = 0;
@@ -672,7 +676,7 @@ TEST(FilteredCloseUps, APrimitiveAnsweredByItsCrossingsNeedsNoTable) {
     }
     EXPECT_GT(hits, 1000);
     EXPECT_GT(spans, 100);
-    EXPECT_THROW(FilteredLatticeShape({{nullptr, ctx}}, LatticeFilter::kSmooth, 0.0, 0.0),
+    EXPECT_THROW(FilteredLatticeShape({{nullptr, ctx}}, LatticeFilter::kSmooth, 0.0),
                  std::logic_error);
 }
 
@@ -689,9 +693,8 @@ TEST(FilteredCloseUps, ChainsOfAnyPartsAnswerFromTheirCrossings) {
         const Encoding& e = find_encoding("coverage");
         const RasterizeResult raster = rasterize(ctx);
         const ByteBuffer payload = e.build(raster.raw, ctx, {});
-        const FilteredLatticeShape asked(
-            {{e.open(payload.data(), payload.size(), raster.hits, ctx), ctx}},
-            LatticeFilter::kSmooth, e.error_bound(ctx, {}), kExactWidth);
+        const SubRayShape asked(ctx, e.open(payload.data(), payload.size(), raster.hits, ctx),
+                                e.error_bound(ctx, {}), kExactWidth);
         int hits = 0;
         for (const Ray& r : rays(3000)) {  // without a footprint
             Crossing exact, got;
@@ -708,7 +711,7 @@ TEST(FilteredCloseUps, ChainsOfAnyPartsAnswerFromTheirCrossings) {
 // A mesh descends its own hierarchy: one of many more triangles than kMaxExactCost is answered
 // from its crossings (a sheet of 2 x 12 x 8 triangles); a CSG tree costs its leaves' costs, so
 // one with such a chain as a leaf keeps to its tables, and so does one of six tori (a quartic
-// costs 12), where one of five does not (answered_by_primitive: scene_lattices' rule, which
+// costs 12), where one of five does not (answered_by_primitive: the answer plan's rule, which
 // gives such a primitive its crossings only past the build budget; the shape answers by them
 // whenever it is given a width).
 TEST(FilteredCloseUps, MeshesAnswerExactlyAndTreesCostTheirLeaves) {

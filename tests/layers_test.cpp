@@ -1,4 +1,4 @@
-// Tracing through partial hits (render/layers.h): EmbreeAccel::intersect_layers finds
+// Tracing through partial hits (coverage/layers.h): EmbreeAccel::intersect_layers finds
 // the partial crossings in ray order, each object's once, stops where compositing stops without
 // changing what it composites, and sums shadow rays' transmittance; and the shading of a mean
 // of normals (phong_term's normal_length) keeps the light the specular lobe reflects and takes
@@ -13,7 +13,8 @@
 #include <random>
 
 #include "accel/embree_accel.h"
-#include "geometry/sub_rays.h"
+#include "coverage/layer_composite.h"
+#include "coverage/sheets.h"
 #include "render/core/shading.h"
 
 namespace lat {
@@ -238,10 +239,10 @@ double specular_integral(double normal_length) {
     return sum;
 }
 
-// A lattice whose sub-rays meet it at two depths (Shape::sheets): half of them on a unit square
+// A lattice whose sub-rays meet it at two depths (SheetSource): half of them on a unit square
 // at height z, the other half at z + dz, each sheet with its sub-rays' normals (k sheet's
 // k-th: turned k + 1 about x); culled by several boxes, as Sheet.
-class TwoSheets final : public Shape {
+class TwoSheets final : public Shape, public SheetSource {
 public:
     // reach: how far back along the ray each cull box reaches beyond the one before.
     TwoSheets(double z, double dz, double reach = 6) : z_(z), dz_(dz), reach_(reach) {}

@@ -13,7 +13,6 @@
 #include "accel/embree_query.h"
 #include "accel/embree_rays.h"
 #include "accel/space_order.h"
-#include "geometry/sub_rays.h"
 #include "math/float_round.h"
 
 namespace lat {
@@ -25,7 +24,7 @@ namespace {
 // Whether a map keeps the directions across a ray across it and as long as its direction (a
 // similarity: turned and evenly scaled), within 1e-3 (scenes give rotations to 6 digits). A
 // sheared or unevenly scaled object offsets its sub-rays along its own directions
-// (geometry/sub_rays.h).
+// (coverage/sub_rays.h).
 bool keeps_directions_across(const Transform& xf) {
     const Vec3 c[3] = {xf.vector({1, 0, 0}), xf.vector({0, 1, 0}), xf.vector({0, 0, 1})};
     const double s2 = dot(c[0], c[0]), tol = 1e-3 * s2;
@@ -65,8 +64,9 @@ struct EmbreeAccel::Impl {
         for (const std::uint32_t i : order) {
             const AccelObject& o = given_objects[i];
             numbered[i] = static_cast<std::uint32_t>(objects.size());
-            objects.push_back({o.shape, o.xf, o.xf->inverse_map(), o.widest_footprint, i,
-                               o.xf->is_identity(), keeps_directions_across(*o.xf)});
+            objects.push_back({o.shape, sheet_source(*o.shape), o.xf, o.xf->inverse_map(),
+                               o.widest_footprint, i, o.xf->is_identity(),
+                               keeps_directions_across(*o.xf)});
             bounds.push_back(given_bounds[i]);
         }
     }
@@ -190,37 +190,37 @@ struct EmbreeAccel::Impl {
         if constexpr (K == Kind::kDirect)
             if (!self->first_visit(ctx, args->primID, shape, local)) return;
         self->hand_across(ctx, t.object);
-        assert(ctx->hit);             // rtcIntersect1 runs only for intersect and intersect_layers
-        assert(!ctx->stop.shadow());  // shadow rays: occluded_cb, blocks_transmittance
+        assert(ctx->hit);         // rtcIntersect1 runs only for intersect and intersect_layers
+        assert(!ctx->shadow());  // shadow rays: occluded_cb, blocks_transmittance
         const double tmax = ctx->found ? std::min(ctx->hit->t, ctx->tmax) : ctx->tmax;
-        const double tmin = ctx->partial ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
+        const double tmin = ctx->sink ? self->occlusion_tmin(ctx, t.object, local) : ctx->tmin;
         auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
         const unsigned geom = args->geomID, prim = args->primID;
         const unsigned placed = K == Kind::kProto ? inst : RTC_INVALID_GEOMETRY_ID;
         if constexpr (K == Kind::kDirect)
-            if (ctx->partial)
-                return self->add_sheets(ctx, rh, t.object, shape, local, tmin, tmax, geom, prim);
+            if (ctx->sink)
+                return self->add_sheets(ctx, rh, t.object, local, tmin, tmax, geom, prim);
         Crossing c;
         const bool hit = K == Kind::kDirect
                              ? shape.intersect(local, tmin, tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, tmax, c);
         // A shape of several parts (chains, meshes) is opaque: only a whole shape (a lattice)
         // answers with partial sheets.
-        assert(!ctx->partial || c.coverage >= 1.0f || !hit);
+        assert(!ctx->sink || c.coverage >= 1.0f || !hit);
         if (hit) self->record(ctx, rh, t.object, c, geom, prim, placed);
     }
 
-    // A camera ray through partial crossings: the object's sheets, partial ones kept (the ray
-    // goes on) unless a visit before this one kept them, in ray order up to the first opaque
-    // one, recorded as the hit.
-    void add_sheets(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Shape& shape,
-                    const Ray& local, double tmin, double tmax, unsigned geom,
-                    unsigned prim) const {
-        // Not on the stack: 4 sheets' default values written at every visit cost more than
-        // the visit of a shape that has one.
-        thread_local std::array<SheetCrossing, Shape::kMaxSheets> sheets;
-        const int n = shape.sheets(local, tmin, tmax, sheets);
-        const bool met = n > 0 && ctx->met_already(objects[obj].original);
+    // A camera ray through partial crossings: the object's sheets (coverage/sheets.h), partial
+    // ones handed to the sink (the ray goes on) unless a visit before this one handed them, in
+    // ray order up to the first opaque one, recorded as the hit.
+    void add_sheets(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Ray& local,
+                    double tmin, double tmax, unsigned geom, unsigned prim) const {
+        // Per-thread scratch, not on the stack: 4 sheets' default values written at every
+        // visit cost more than the visit of a shape that has one.
+        thread_local std::array<SheetCrossing, kMaxSheets> sheets;
+        const Placed& o = objects[obj];
+        const int n = sheets_of(*o.shape, o.sheets, local, tmin, tmax, sheets);
+        const bool met = n > 0 && ctx->sink->met_already(o.original);
         for (int i = 0; i < n; ++i) {
             const Crossing& c = sheets[static_cast<std::size_t>(i)].crossing;
             const SubRayNormals& normals = sheets[static_cast<std::size_t>(i)].normals;
@@ -228,7 +228,8 @@ struct EmbreeAccel::Impl {
                 if (met) continue;
                 AccelHit h = caller_hit(c.t, obj, c);
                 h.normals = normals;
-                ctx->add_camera_partial(h, rh->ray.tfar);
+                if (ctx->sink->add_camera(h, ctx->tmax))
+                    rh->ray.tfar = std::min(rh->ray.tfar, float_above(ctx->tmax));
                 continue;
             }
             record(ctx, rh, obj, c, geom, prim, RTC_INVALID_GEOMETRY_ID);
@@ -244,14 +245,14 @@ struct EmbreeAccel::Impl {
     template <Kind K>
     bool blocks_transmittance(QueryContext* ctx, Target t, const Shape& shape, const Ray& local,
                               double tmin) const {
-        assert(ctx->hit && ctx->partial && ctx->stop.shadow());
+        assert(ctx->hit && ctx->shadow());
         Crossing c;
         const bool hit = K == Kind::kDirect
                              ? shape.intersect(local, tmin, ctx->tmax, c)
                              : shape.intersect_primitive(t.part, local, tmin, ctx->tmax, c);
         if (!hit) return false;
         const AccelHit h = caller_hit(c.t, t.object, c);
-        if (c.coverage < 1.0f && !ctx->add_shadow_partial(h)) return false;
+        if (c.coverage < 1.0f && !ctx->sink->add_shadow(h)) return false;
         *ctx->hit = h;
         return true;
     }
@@ -267,7 +268,7 @@ struct EmbreeAccel::Impl {
         const Ray local = object_ray(o, ctx);
         const double tmin = occlusion_tmin(&ctx, ctx.self, local);
         const Target t{ctx.self, 0};
-        if (ctx.stop.shadow())
+        if (ctx.shadow())
             ctx.found = blocks_transmittance<Kind::kDirect>(&ctx, t, *o.shape, local, tmin);
         else
             ctx.found = o.shape->occluded(local, tmin, ctx.tmax);
@@ -300,7 +301,7 @@ struct EmbreeAccel::Impl {
         const Ray local = object_ray(o, ctx);
         const double tmin = occlusion_tmin(&ctx, last->object, local);
         bool blocked;
-        if (ctx.stop.shadow()) {  // a transmittance: a partial crossing it meets is kept
+        if (ctx.shadow()) {  // a transmittance: a partial crossing it meets is kept
             const Target t{last->object, whole ? 0 : last->part};
             blocked = whole ? blocks_transmittance<Kind::kDirect>(&ctx, t, *o.shape, local, tmin)
                             : blocks_transmittance<Kind::kFlat>(&ctx, t, *o.shape, local, tmin);
@@ -343,7 +344,7 @@ struct EmbreeAccel::Impl {
         self->hand_across(ctx, t.object);
         const double tmin = self->occlusion_tmin(ctx, t.object, local);
         bool hit;
-        if (ctx->stop.shadow())
+        if (ctx->shadow())
             hit = self->blocks_transmittance<K>(ctx, t, shape, local, tmin);
         else if constexpr (K == Kind::kDirect)
             hit = shape.occluded(local, tmin, ctx->tmax);
@@ -520,14 +521,13 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
 bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self,
                                    AccelHit& hit, std::vector<AccelHit>& partial,
                                    const LayerStop& stop, LastBlocker* last) const {
-    partial.clear();
+    LayerSink sink(partial, stop);
     const bool traceable = embree_can_trace(r, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
     QueryContext ctx(m, r, tmin, tmax, &hit);
     ctx.self = m.our_number(self);
-    ctx.partial = &partial;
-    ctx.stop = stop;
+    ctx.sink = &sink;
     if (traceable && stop.shadow()) {
         if (m.blocked_by_kept(ctx, last)) {
             ctx.found = true;
@@ -540,7 +540,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
         trace_closest(m.scene, ctx, r, tmin, tmax);
     const bool blocked = ctx.found && stop.shadow();
     // Unbounded shapes answer their closest crossing: only a lattice, which has a box, has
-    // several sheets (Shape::sheets).
+    // several sheets (coverage/sheets.h).
     for (const std::uint32_t i : m.unbounded) {
         if (blocked) break;
         const Placed& o = m.objects[i];
@@ -549,16 +549,13 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
         const double t1 = ctx.found ? std::min(hit.t, ctx.tmax) : ctx.tmax;
         if (!o.shape->intersect(local, m.occlusion_tmin(&ctx, i, local), t1, c)) continue;
         if (c.coverage < 1.0f) {
-            partial.push_back(m.caller_hit(c.t, i, c));
+            sink.keep(m.caller_hit(c.t, i, c));
         } else {
             ctx.found = true;
             hit = m.caller_hit(c.t, i, c);
         }
     }
-    // Partial crossings met before a closer opaque one was found lie behind it.
-    if (ctx.found) std::erase_if(partial, [&](const AccelHit& p) { return p.t >= hit.t; });
-    // In ray order (ties by object): the same for any traversal order.
-    std::sort(partial.begin(), partial.end(), in_ray_order);
+    sink.finish(ctx.found, hit.t);
     return ctx.found;
 }
 

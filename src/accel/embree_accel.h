@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "coverage/layer_sink.h"
 #include "geometry/shape.h"
 #include "math/transform.h"
 
@@ -34,27 +35,8 @@ struct AccelOptions {
     std::size_t flatten_budget = 4'000'000;
 };
 
-struct AccelHit {
-    double t = 0;
-    std::uint32_t object = 0;  // index into the objects given to the constructor
-    Crossing crossing;         // in the object's coordinates (same t)
-    SubRayNormals normals;     // a sheet's (Shape::sheets), in the object's coordinates
-};
-
-// How far a traversal through partial crossings needs to go (intersect_layers).
-struct LayerStop {
-    // Shadow rays: once the partial crossings met let less than this through, or an opaque
-    // one is met, the ray is blocked and the traversal ends at once (`hit` is then no
-    // closest crossing; only "blocked" is meant). 0: not a shadow ray.
-    double blocked_below = 0;
-    bool shadow() const { return blocked_below > 0; }
-    // Camera rays, composited front to back: the partial crossings up to the max_layers-th
-    // without sub-rays (LayerComposite::draws), or to where what they leave falls to min_left
-    // or below,
-    // are all that is seen; the traversal looks no farther. max_layers 0: no limit.
-    int max_layers = 0;
-    double min_left = 0;
-};
+// A crossing found by a query: the object, under the number the caller gave it.
+using AccelHit = ObjectHit;
 
 class EmbreeAccel {
 public:
@@ -93,9 +75,9 @@ public:
     bool occluded(const Ray& r, double tmin, double tmax, std::uint32_t self = kNoObject,
                   LastBlocker* last = nullptr) const;
     // One traversal for rays that see through partial crossings (Crossing::coverage < 1, from
-    // prefiltered lattices): `hit`, as intersect() finds it, is the closest opaque crossing, and
-    // `partial` every partial crossing before it (up to where `stop` says), in ray order. `self`
-    // as for occluded().
+    // lattices answered through a footprint): `hit`, as intersect() finds it, is the closest
+    // opaque crossing, and `partial` every partial crossing before it, in ray order, as a
+    // LayerSink with `stop` keeps them (coverage/layer_sink.h). `self` as for occluded().
     // last: for shadow rays (stop.shadow()), as for occluded().
     bool intersect_layers(const Ray& r, double tmin, double tmax, std::uint32_t self, AccelHit& hit,
                           std::vector<AccelHit>& partial, const LayerStop& stop = {},

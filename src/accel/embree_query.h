@@ -11,7 +11,9 @@
 
 #include "accel/embree_accel.h"
 #include "accel/embree_rays.h"
-#include "geometry/sub_rays.h"
+#include "coverage/layer_sink.h"
+#include "coverage/sheets.h"
+#include "coverage/sub_rays.h"
 
 namespace lat::embree_detail {
 
@@ -22,7 +24,8 @@ namespace lat::embree_detail {
 // shape and inverse map from the scene's records).
 struct Placed {
     const Shape* shape;
-    const Transform* xf;  // object -> world
+    const SheetSource* sheets;  // the shape's, if it has more than its closest crossing to give
+    const Transform* xf;        // object -> world
     Affine inverse;       // xf's inverse map
     double widest_footprint;
     std::uint32_t original;  // its index among the objects given to the constructor
@@ -41,11 +44,6 @@ struct Placed {
         return {inverse.point(r.o), inverse.vector(r.d), f};
     }
 };
-
-// Partial crossings in ray order, ties by object: the same for any traversal order.
-inline bool in_ray_order(const AccelHit& a, const AccelHit& b) {
-    return a.t != b.t ? a.t < b.t : a.object < b.object;
-}
 
 // Per-query state. Embree hands our callbacks the RTCIntersectContext; ours extends it with
 // the double-precision ray and the best hit so far (the documented way to pass query data).
@@ -89,47 +87,11 @@ struct QueryContext {
     // be kept (Impl::blocker_of).
     std::uint32_t self = EmbreeAccel::kNoObject;
     EmbreeAccel::LastBlocker tested_first, blocker;
-    // intersect_layers: where crossings of partial coverage go (they do not end the ray), how
-    // far to look, and for shadow rays what they let through (LayerComposite, which does not
-    // depend on the order they are met in).
-    std::vector<AccelHit>* partial = nullptr;
-    LayerStop stop;
-    LayerComposite transmitted;
-    // An object (the caller's number) answers a ray with its sheets at its first visit; met
-    // again (it fell out of the ring of tested objects), it is not counted twice.
-    bool met_already(std::uint32_t object) const {
-        for (const AccelHit& p : *partial)
-            if (p.object == object) return true;
-        return false;
-    }
-    // A shadow ray's partial crossing; whether the ray is now blocked. The stop has a margin
-    // (1e-9 relative) that the product of what the crossings let through, taken in any order,
-    // cannot close: transmittance() then finds at most blocked_below in ray order too.
-    bool add_shadow_partial(const AccelHit& h) {
-        assert(stop.shadow());
-        if (met_already(h.object)) return false;
-        partial->push_back(h);
-        transmitted.add(h.crossing);
-        return transmitted.left() < stop.blocked_below * (1 - 1e-9);
-    }
-    // A camera ray's partial crossing: the crossings are kept in ray order and cut where
-    // compositing will stop (LayerStop), and tmax and the traversal's tfar come down to the
-    // last one kept. (add_sheets keeps an object's sheets from being added twice.)
-    void add_camera_partial(const AccelHit& h, float& tfar) {
-        assert(!stop.shadow());
-        partial->insert(std::upper_bound(partial->begin(), partial->end(), h, in_ray_order), h);
-        if (stop.max_layers <= 0) return;
-        LayerComposite seen;
-        for (std::size_t i = 0; i < partial->size(); ++i) {
-            seen.add((*partial)[i].crossing);
-            if (seen.draws() == stop.max_layers || seen.left() <= stop.min_left) {
-                partial->resize(i + 1);
-                tmax = std::min(tmax, partial->back().t);
-                tfar = std::min(tfar, float_above(tmax));
-                break;
-            }
-        }
-    }
+    // intersect_layers: where crossings of partial coverage go (they do not end the ray), and
+    // the policy that says how far to look; null for the other queries.
+    LayerSink* sink = nullptr;
+    // A shadow ray's transmittance (intersect_layers with LayerStop::blocked_below).
+    bool shadow() const { return sink && sink->shadow(); }
     // The last object's object-space ray: consecutive parts of one object reuse it.
     std::uint32_t cached_obj = ~0u;
     Ray cached_local;

@@ -103,44 +103,17 @@ struct Crossing {
     std::uint32_t part = 0;
     std::uint32_t leaf = 0;
     bool has_stored = false;
-    // Of the ray's sub-rays (geometry/sub_rays.h), bit k when the k-th meets the surface here,
-    // where the coverage is their share; 0 otherwise. (In the padding, as coverage.)
+    // Partial coverage (coverage/): of the ray's sub-rays (coverage/sub_rays.h), bit k when the
+    // k-th meets the surface here, where the coverage is their share; 0 otherwise.
     std::uint8_t sub_rays = 0;
-    // The share of the rays around this one that meet the surface here (prefiltered lattices,
-    // prefiltered lattices: a partial hit lets the rest of the ray go on behind it); 1 for every exact shape.
-    // (In the padding after has_stored: a Crossing is no larger for it.)
+    // The share of the rays around this one that meet the surface here (lattices answered
+    // through a footprint: a partial hit lets the rest of the ray go on behind it); 1 for every
+    // exact shape. (Both in the padding after has_stored: a Crossing is no larger for them.)
     float coverage = 1.0f;
     SurfacePoint stored;  // when has_stored: in the coordinates of the shape that found it
 
     std::uint32_t leaf_index() const { return leaf & ~kFlipBit; }
     bool flipped() const { return (leaf & kFlipBit) != 0; }
-};
-
-// The unit normals (shape space) of the sub-rays a prefiltered lattice's sheet is made of
-// (Shape::sheets): the renderer averages their shading terms, where a mean normal's would blur
-// a hair's highlight and terminator across the pixel. count 0 for every other crossing.
-// Only n[0, count) is meant: the rest is left unset. Every camera sample makes a SurfaceHit and
-// every query an AccelHit, each holding one of these, and zeroing its 96 bytes (a `rep stos`)
-// took a third of the camera loop's own time on a scene of background alone.
-struct SubRayNormals {
-    SubRayNormals() {}  // user-provided, so that `{}` too leaves n unset
-    std::uint8_t count = 0;
-    // A Vec3 whose default construction leaves it unset.
-    struct Slot {
-        double x, y, z;
-        Slot() = default;
-        Slot(Vec3 v) : x(v.x), y(v.y), z(v.z) {}  // NOLINT: a Vec3 stored as it is
-        operator Vec3() const { return {x, y, z}; }  // NOLINT: read as the Vec3 it holds
-    };
-    std::array<Slot, 4> n;
-};
-// Copied whole as bytes, unset slots too; a Slot default-constructed is left unset.
-static_assert(std::is_trivially_copyable_v<SubRayNormals>);
-static_assert(std::is_trivially_default_constructible_v<SubRayNormals::Slot>);
-// One of a camera ray's sheets (Shape::sheets).
-struct SheetCrossing {
-    Crossing crossing;
-    SubRayNormals normals;
 };
 
 // One interval of a ray's line inside a solid: enters at in.t, leaves at out.t (in.t < out.t).
@@ -159,17 +132,6 @@ public:
 
     // The closest boundary crossing with tmin < t < tmax.
     virtual bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const = 0;
-    // A camera ray's surfaces through partial coverage (render/layers.h): at most kMaxSheets
-    // crossings with tmin < t < tmax, in ray order; returns how many. A prefiltered lattice
-    // answered by its sub-rays gives one per depth at which they meet it (a tuft's strands one
-    // behind the other), each shaded as its own surface with its sub-rays' normals; every other
-    // shape its closest crossing.
-    static constexpr int kMaxSheets = 4;
-    virtual int sheets(const Ray& r, double tmin, double tmax,
-                       std::span<SheetCrossing, kMaxSheets> out) const {
-        out[0].normals.count = 0;
-        return intersect(r, tmin, tmax, out[0].crossing) ? 1 : 0;
-    }
     // Whether any boundary crossing has tmin < t < tmax (shadow rays).
     virtual bool occluded(const Ray& r, double tmin, double tmax) const {
         Crossing c;
@@ -207,7 +169,7 @@ public:
 
     // About how many simple tests (a sphere's or a cylinder's) one intersect() makes: what a
     // lattice weighs before tracing its primitive exactly where its tables could answer
-    // (FilteredLatticeShape). By default its primitives, tested one by one.
+    // (lattice/answer_plan.h). By default its primitives, tested one by one.
     virtual double intersect_cost() const { return static_cast<double>(primitive_count()); }
 
     // Shapes made of many parts (sphere/cylinder chains) expose them so the accelerator can
@@ -264,7 +226,7 @@ public:
     virtual std::size_t cull_count() const { return 1; }
     // The bounds of cull part i placed by xf. widest: the widest footprint (shape units) of the
     // rays this placement is traced with (AccelObject::widest_footprint; infinity: any). A shape
-    // whose reach grows with the footprint (a filtered lattice's sub-rays) culls narrower for
+    // whose reach grows with the footprint (a lattice's sub-rays) culls narrower for
     // narrower ones; its queries then take the same bound from their ray's footprint
     // (RayFootprint::widest).
     virtual Bounds3 cull_bounds(std::size_t, const Transform& xf, double /*widest*/) const {

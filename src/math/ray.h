@@ -7,8 +7,9 @@ namespace lat {
 
 // What a ray stands for beyond its line: the footprint of a pixel (or of what a shadow ray
 // leaves), which picks a filtered lattice's level of detail and spans its sub-rays
-// (lattice/filtered_shape.h, geometry/sub_rays.h). The renderer makes one per ray; the
-// accelerator hands each object its own copy in the object's space.
+// (lattice/filtered_shape.h, lattice/sub_ray_shape.h). The camera makes one with each camera
+// ray (TraceRay, render/core/camera.h), shading one with each shadow ray; the accelerator hands each
+// object its own copy in the object's space (accel/embree_query.h).
 struct RayFootprint {
     // The width (world units) at parameter t of the world ray (unit direction) is
     // width0 + spread * t. 0 (the default) asks for the finest level.

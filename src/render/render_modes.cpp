@@ -64,7 +64,7 @@ std::optional<LatticeFiltering> lattice_policy(const Scene& scene, RenderMode mo
         case RenderMode::kAuto: f.policy = LatticePolicy::kAuto; break;
         default: return std::nullopt;
     }
-    f.spread = sample_spread(scene.camera, settings.spp);
+    f.spread = PinholeCamera(scene.camera, settings.spp).spread();
     return f;
 }
 

@@ -9,6 +9,7 @@
 
 #include "lattice/encoding.h"
 #include "lattice/filtered_shape.h"
+#include "lattice/sub_ray_shape.h"
 #include "lattice/table.h"
 #include "util/memory.h"
 

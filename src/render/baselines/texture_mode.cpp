@@ -190,7 +190,8 @@ public:
             if (scene.objects[i].primitive < 0) ++base_index_;
     }
 
-    Vec3 radiance(const Ray& ray, ShadeState& state) const override {
+    Vec3 radiance(const TraceRay& traced, ShadeState& state) const override {
+        const Ray ray = traced.line();
         SurfaceHit hit;
         if (!rs_.intersect(ray, 0.0, kInfinity, hit)) return rs_.scene().background;
         if (!maps_.atlas || hit.object != base_index_) return shade(rs_, ray, hit, state);

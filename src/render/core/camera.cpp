@@ -5,19 +5,17 @@
 
 namespace lat {
 
-PinholeCamera::PinholeCamera(const Camera& c)
+PinholeCamera::PinholeCamera(const Camera& c, int spp)
     : eye_(c.eye),
       h_(std::tan(c.fov_y_deg * M_PI / 360.0)),
       aspect_(static_cast<double>(c.width) / c.height),
       width_(c.width),
-      height_(c.height) {
+      height_(c.height),
+      spread_(2 * std::tan(c.fov_y_deg * M_PI / 360.0) / c.height /
+              std::sqrt(double(std::max(1, spp)))) {
     w_ = normalize(c.look_at - c.eye);
     u_ = normalize(cross(w_, c.up));
     v_ = cross(u_, w_);
-}
-
-double sample_spread(const Camera& c, int spp) {
-    return 2 * std::tan(c.fov_y_deg * M_PI / 360.0) / c.height / std::sqrt(double(std::max(1, spp)));
 }
 
 }  // namespace lat

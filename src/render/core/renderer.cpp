@@ -67,7 +67,7 @@ void render_tile(const TileContext& tc, int tile, TileCounts& counts) {
             for (int k = 0; k < spp; ++k) {
                 const auto [ox, oy] = tc.sampler.offset(static_cast<std::uint64_t>(j) * w + i, k);
                 ++rays;
-                const Vec3 c = tc.integrator.radiance(tc.cam.ray(i, j, ox, oy), state);
+                const Vec3 c = tc.integrator.radiance(tc.cam.trace_ray(i, j, ox, oy), state);
                 sum += c;
                 sum_clamped += Vec3{std::clamp(c.x, 0.0, 1.0), std::clamp(c.y, 0.0, 1.0),
                                     std::clamp(c.z, 0.0, 1.0)};
@@ -119,7 +119,7 @@ RenderOutput render_image(const Camera& camera, const Integrator& integrator,
     const PixelSampler sampler(opt.sampler, opt.spp);
     const int spp = sampler.spp();
     const TileGrid grid{w, h, kTile};
-    const TileContext tc{integrator, PinholeCamera(camera), sampler, grid, spp, out};
+    const TileContext tc{integrator, PinholeCamera(camera, spp), sampler, grid, spp, out};
 
     TileCounts counts;
     const bool across = opt.across_ranks && dist::distributed();

@@ -20,7 +20,7 @@ struct SurfaceHit {
     std::uint32_t material = 0;
     std::uint32_t object = 0;
     std::uint32_t part = 0;  // the shape's part that was hit (a mesh's triangle)
-    double alpha = 1;  // coverage: below 1 only for prefiltered lattices (render/layers.h)
+    double alpha = 1;  // coverage: below 1 only for lattices answered through a footprint (coverage/layers.h)
     std::uint8_t sub_rays = 0;  // which sub-rays the coverage is (Crossing::sub_rays)
     // Prefiltered lattices answer with the mean of the unit normals under a ray's footprint:
     // its length, below 1 where they diverge, widens the specular lobe (phong_term). 1 for
@@ -78,8 +78,5 @@ private:
     void surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const;
 };
 
-// The former name, for render/layers.* while it moves to its own folder: remove once nothing
-// uses it.
-using RenderScene = TracedScene;
 
 }  // namespace lat

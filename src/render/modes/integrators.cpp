@@ -5,14 +5,15 @@
 
 namespace lat {
 
-Vec3 ExactIntegrator::radiance(const Ray& ray, ShadeState& state) const {
+Vec3 ExactIntegrator::radiance(const TraceRay& traced, ShadeState& state) const {
+    const Ray ray = traced.line();
     SurfaceHit hit;
     if (!rs_.intersect(ray, 0.0, kInfinity, hit)) return rs_.scene().background;
     return shade(rs_, ray, hit, state);
 }
 
-Vec3 LayeredIntegrator::radiance(const Ray& ray, ShadeState& state) const {
-    return trace_layers(rs_, ray, spread_, state);
+Vec3 LayeredIntegrator::radiance(const TraceRay& ray, ShadeState& state) const {
+    return trace_layers(rs_, ray, state);
 }
 
 RenderOutput render_exact(const TracedScene& rs, const RenderOptions& opt) {
@@ -20,8 +21,7 @@ RenderOutput render_exact(const TracedScene& rs, const RenderOptions& opt) {
 }
 
 RenderOutput render_layered(const TracedScene& rs, const RenderOptions& opt) {
-    const Camera& camera = rs.scene().camera;
-    return render_image(camera, LayeredIntegrator(rs, sample_spread(camera, opt.spp)), opt);
+    return render_image(rs.scene().camera, LayeredIntegrator(rs), opt);
 }
 
 }  // namespace lat

@@ -12,25 +12,24 @@ namespace lat {
 class ExactIntegrator final : public Integrator {
 public:
     explicit ExactIntegrator(const TracedScene& rs) : rs_(rs) {}
-    Vec3 radiance(const Ray& ray, ShadeState& state) const override;
+    Vec3 radiance(const TraceRay& ray, ShadeState& state) const override;
 
 private:
     const TracedScene& rs_;
 };
 
-// Each ray traced front to back through partial hits (render/layers.h), its footprint `spread`
-// wide per unit of distance (sample_spread): prefiltered lattices and sub-ray sheets.
+// Each ray traced front to back through partial hits (render/layers.h), its footprint (the
+// camera's, TraceRay) choosing prefiltered lattices' levels and spanning sub-ray sheets.
 class LayeredIntegrator final : public Integrator {
 public:
-    LayeredIntegrator(const TracedScene& rs, double spread) : rs_(rs), spread_(spread) {}
-    Vec3 radiance(const Ray& ray, ShadeState& state) const override;
+    explicit LayeredIntegrator(const TracedScene& rs) : rs_(rs) {}
+    Vec3 radiance(const TraceRay& ray, ShadeState& state) const override;
 
 private:
     const TracedScene& rs_;
-    double spread_;
 };
 
-// The scene's image through each integrator, the footprint's spread from the camera and spp.
+// The scene's image through each integrator.
 RenderOutput render_exact(const TracedScene& rs, const RenderOptions& opt = {});
 RenderOutput render_layered(const TracedScene& rs, const RenderOptions& opt = {});
 

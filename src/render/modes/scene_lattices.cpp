@@ -141,15 +141,6 @@ double sub_ray_bounds(const Scene& scene, int prim, const TableContext& base, do
     return widest;
 }
 
-// Why auto mode answers a primitive by its sub-rays (answered_by_primitive).
-std::string cheap_reason(const Shape& primitive) {
-    const double cost = primitive.intersect_cost();
-    if (cost <= kMaxExactCost)
-        return "cheap to intersect: " + std::to_string(static_cast<long long>(std::ceil(cost))) +
-               " simple tests, at most " + std::to_string(static_cast<int>(kMaxExactCost));
-    return "a chain of spheres and cylinders: its sub-rays test only the parts near them";
-}
-
 // One level's table from the cache, counted in out's totals and in the answer's levels.
 std::shared_ptr<const LatticeTable> read_table(const TableCache& cache, const TablePlan& plan,
                                                bool progress, SceneLattices& out,
@@ -164,65 +155,51 @@ std::shared_ptr<const LatticeTable> read_table(const TableCache& cache, const Ta
     return e.table;
 }
 
-// A primitive's filtered lattice: its levels from the cache, coarse to fine, or its own
-// crossings of sub-rays, as filtering.policy has it. csg_leaf: some CSG tree holds an instance
-// of it; instanced: some object is an instance of it.
+// A primitive's lattice answered through a footprint, as planned (lattice/answer_plan.h): its
+// levels from the cache, coarse to fine, or its own crossings of sub-rays. base: the lattice
+// asked for.
+//   A primitive answered by its own crossings reads its table only as a CSG leaf (spans,
+// `inside`), and only in auto mode: the lattice asked for serves it there, and elsewhere no
+// table is loaded or built. On each instance its sub-rays, and so its culling, span at most
+// kSubRayWidening times the widest footprint of the camera's pixels on that instance
+// (AccelObject::widest_footprint); the shape's own bound is the widest over its instances.
 void filtered_lattice(const Scene& scene, int prim, const TableCache* cache, const TableSpec& spec,
-                      bool progress, const LatticeFiltering& filtering, bool csg_leaf,
-                      bool instanced, SceneLattices& out, PrimitiveAnswer& answer) {
+                      bool progress, const LatticeFiltering& filtering, const TableContext& base,
+                      const AnswerQuery& q, AnswerPlan plan, SceneLattices& out,
+                      PrimitiveAnswer& answer) {
     const Primitive& p = scene.primitives[static_cast<std::size_t>(prim)];
-    // A primitive answered by its own crossings reads its table only as a CSG leaf (spans,
-    // `inside`), and only in auto mode: the lattice asked for serves it there, and elsewhere no
-    // table is loaded or built. With footprint filtering in exact mode a CSG leaf keeps its
-    // exact shape (the shape's spans are the primitive's). On each instance its sub-rays, and
-    // so its culling, span at most kSubRayWidening times the widest footprint of the camera's
-    // pixels on that instance (AccelObject::widest_footprint); the shape's own bound is the
-    // widest over its instances, above 0 exactly when the shape answers by its crossings.
-    // In auto mode a costlier primitive whose levels wanted are past the work budget answers by
-    // its crossings too: tables coarser than its footprints blur it, and cost more than finer
-    // ones, their sheets being wider and less opaque (bench/notes).
-    const TableContext base = plan_table(p, spec, scene.file).context;
-    const bool lod = filtering.lod && filtering.spread > 0;
-    const bool sub_rays_everywhere = filtering.policy == LatticePolicy::kFootprint;
-    bool by_crossings = sub_rays_everywhere ||
-                        (filtering.policy == LatticePolicy::kAuto && lod && base.primitive &&
-                         answered_by_primitive(*base.primitive));
-    if (by_crossings && filtering.policy == LatticePolicy::kAuto)
-        answer.why = cheap_reason(*base.primitive);
     std::pair<int, int> range{0, 0};
-    if (lod && !by_crossings) {
+    if (q.lod && plan.by == AnsweredBy::kFilteredTables) {
         const LevelCosts costs{scene, p, spec};
         const std::pair<int, int> wanted = lod_range(scene, prim, base, filtering.spread);
         assert(cache);  // every policy but kFootprint reads tables
         const LevelChoice choice = choose_levels(costs, *cache, wanted, filtering);
-        by_crossings = filtering.policy == LatticePolicy::kAuto && choice.over_budget && base.primitive;
-        if (by_crossings) answer.why = "its finer levels are over --lod-budget";
+        if (choice.over_budget) plan_past_budget(q, base.primitive, plan);
+        const bool by_crossings = plan.by == AnsweredBy::kSubRayCrossings;
         if (!by_crossings) range = choice.range;
         const std::string note = levels_note(costs, wanted, choice, filtering, by_crossings);
         if (!note.empty()) out.notes.push_back(note);
     }
-    // Footprint filtering leaves a primitive found only in CSG its own exact shape; auto mode
-    // gives it its table's point-sampled spans, as below.
-    if (sub_rays_everywhere && !instanced) return;
-    const double exact_width =
+    answer.why = plan.why;
+    if (plan.exact_shape) return;
+    const bool by_crossings = plan.by == AnsweredBy::kSubRayCrossings;
+    const double sub_ray_width =
         by_crossings ? sub_ray_bounds(scene, prim, base, filtering.spread, out) : 0;
-    answer.by = by_crossings ? AnsweredBy::kSubRayCrossings : AnsweredBy::kFilteredTables;
+    answer.by = plan.by;
     if (!by_crossings) answer.encoding = spec.encoding;
     std::vector<FilterLevel> levels;
     double error = 0;
-    const bool reads_tables = !by_crossings || (csg_leaf && !sub_rays_everywhere);
-    if (!reads_tables) levels.push_back({nullptr, base});
+    if (!plan.reads_tables) levels.push_back({nullptr, base});
     PrimitiveAnswer csg_tables;  // tables read for CSG alone are not how instances are answered
-    for (int j = range.first; reads_tables && j <= range.second; ++j) {
-        const TablePlan plan = level_plan(scene, p, spec, j);
+    for (int j = range.first; plan.reads_tables && j <= range.second; ++j) {
+        const TablePlan level = level_plan(scene, p, spec, j);
         assert(cache);
-        levels.push_back({read_table(*cache, plan, progress, out, by_crossings ? csg_tables : answer),
-                          plan.context});
-        error = plan.error_bound();
+        PrimitiveAnswer& counted = by_crossings ? csg_tables : answer;
+        levels.push_back({read_table(*cache, level, progress, out, counted), level.context});
+        error = level.error_bound();
     }
-    out.shapes[static_cast<std::size_t>(prim)] =
-        std::make_shared<FilteredLatticeShape>(std::move(levels), filtering.filter, error,
-                                               std::max(0.0, exact_width));
+    out.shapes[static_cast<std::size_t>(prim)] = footprint_shape(
+        plan, std::move(levels), filtering.filter, error, std::max(0.0, sub_ray_width));
 }
 
 }  // namespace
@@ -253,16 +230,6 @@ std::pair<double, double> footprint_range(const Scene& scene, int prim, const Ta
     return {lo, hi};
 }
 
-std::string_view answer_name(AnsweredBy by) {
-    switch (by) {
-        case AnsweredBy::kTable: return "table";
-        case AnsweredBy::kFilteredTables: return "filtered tables";
-        case AnsweredBy::kSubRayCrossings: return "sub-rays";
-        case AnsweredBy::kExact: return "exact";
-    }
-    return "";
-}
-
 SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const TableSpec& spec,
                              bool progress, const LatticeFiltering& filtering) {
     SceneLattices out;
@@ -290,12 +257,20 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const 
         PrimitiveAnswer answer;
         answer.primitive = p.name;
         answer.where = p.where;
-        if (sub_rays && !p.lattice) {
-            answer.by = AnsweredBy::kExact;
-            answer.why = "it has no lattice box";
-        } else if (filtering.filter != LatticeFilter::kNone) {
-            filtered_lattice(scene, static_cast<int>(i), cache, spec, progress, filtering,
-                             csg_leaf[i], instanced[i], out, answer);
+        const AnswerQuery q{filtering.policy, filtering.filter,
+                            filtering.lod && filtering.spread > 0, p.lattice.has_value(),
+                            instanced[i], csg_leaf[i]};
+        TableContext base;  // the lattice asked for, once the plan asks for the primitive
+        const AnswerPlan how = plan_answer(q, [&] {
+            base = plan_table(p, spec, scene.file).context;
+            return base.primitive;
+        });
+        if (how.by == AnsweredBy::kExact) {
+            answer.by = how.by;
+            answer.why = how.why;
+        } else if (how.by != AnsweredBy::kTable) {
+            filtered_lattice(scene, static_cast<int>(i), cache, spec, progress, filtering, base, q,
+                             how, out, answer);
         } else {
             const TablePlan plan = plan_table(p, spec, scene.file);
             answer.encoding = spec.encoding;

@@ -7,20 +7,10 @@
 #include <vector>
 
 #include "lattice/cache/table_cache.h"
-#include "lattice/filtered_shape.h"
+#include "lattice/answer_plan.h"
 #include "scene/scene.h"
 
 namespace lat {
-
-// How an instanced primitive's rays are answered: the one list of the ways, as reported on the
-// summary line and in --stats (answer_name).
-enum class AnsweredBy {
-    kTable,           // its point-sampled table (no filter), as rasterized
-    kFilteredTables,  // its coverage tables, filtered, at the levels of detail read
-    kSubRayCrossings, // its own exact crossings of sub-rays across each ray's footprint
-    kExact,           // its own exact crossing of each ray (no lattice box to cull sub-rays by)
-};
-std::string_view answer_name(AnsweredBy by);
 
 // What answers one primitive, and why, for the summary line and --stats.
 struct PrimitiveAnswer {
@@ -30,14 +20,6 @@ struct PrimitiveAnswer {
     std::string encoding;              // of the tables read; empty for sub-rays
     std::vector<long long> sigma_inv;  // the levels read, coarse to fine; empty for sub-rays
     std::string why;                   // how the mode chose (auto mode), else empty
-};
-
-// Who decides how instanced primitives are answered: the render mode (render/render_modes.h).
-enum class LatticePolicy {
-    kTables,   // lattice mode: every primitive by its tables, never its own crossings
-    kAuto,     // auto mode: a primitive cheap to intersect by sub-rays, a costlier one by its
-               // tables while the levels it wants are within the build budget
-    kFootprint,  // exact mode with footprint filtering: every primitive by sub-rays, no table
 };
 
 struct SceneLattices {
@@ -59,8 +41,8 @@ struct SceneLattices {
 // How lattices are filtered: the filter, and whether levels of detail are built. With
 // lod, each primitive gets the levels sigma^-1 = K 2^j whose cells match the footprints of the
 // camera's pixels (spread: a pixel's angle) somewhere on its instances, at most kMaxLodLevels;
-// a primitive answered_by_primitive, or one whose levels wanted are past the work budget (below),
-// is answered by its crossings and gets the lattice asked for alone, only if a CSG tree holds a
+// a primitive its plan answers by its crossings (lattice/answer_plan.h: answered_by_primitive,
+// or levels wanted past the work budget, below) is answered so and gets the lattice asked for alone, only if a CSG tree holds a
 // copy (no ray reads it elsewhere).
 // Levels of detail beyond sigma^-1 = K are built only up to kMaxLodPairs ordered pairs of
 // boundary points: rays that want finer get the finest level within it, not a table that takes

@@ -1,4 +1,4 @@
-#include "geometry/sub_rays.h"
+#include "coverage/sub_rays.h"
 
 namespace lat {
 
@@ -9,17 +9,6 @@ void across_in_object(const RayFootprint& world, const Affine& inverse, bool ide
     if (!object.across) return;
     object.u = identity ? world.u : inverse.vector(world.u);
     object.v = identity ? world.v : inverse.vector(world.v);
-}
-
-double LayerComposite::add(double coverage, std::uint8_t sub_rays) {
-    const double before = left();
-    if (sub_rays == 0) {
-        free_ *= 1.0 - coverage;
-        ++draws_;
-    } else {
-        covered_ |= sub_rays;
-    }
-    return before > 0 ? 1.0 - left() / before : 1.0;
 }
 
 }  // namespace lat
