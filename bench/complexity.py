@@ -263,7 +263,10 @@ def bench_burr(a):
     for m in BURR_MODES:  # a first render builds what is not cached, timed apart
         s = render(a, scene, images[m], *args[m])
         r["modes"][m] = {"runs_ms": [], "build_s": burr_builds(a, cache, m, s)}
+    base, base_png = without_instances(a, BURR), os.path.join(a.work, "base.png")
+    r["base_runs_ms"] = []
     for _ in range(a.runs):  # interleaved, so that load from other processes hits all alike
+        r["base_runs_ms"].append(render(a, base, base_png)["render_ms"])
         for m in BURR_MODES:
             s = render(a, scene, images[m], *args[m])
             assert s.get("tables_built", 0) == 0, "tables should have come from the cache"
@@ -273,9 +276,12 @@ def bench_burr(a):
             M["table_visits"] = s.get("table_visits", 0)
             M["notes"] = s.get("lattice_notes", [])
             M["how"] = "; ".join(p["how"] for p in s.get("primitives", []))
+    r["base_ms"] = statistics.median(r["base_runs_ms"])
     for m, M in r["modes"].items():
         M["ms"] = statistics.median(M["runs_ms"])
         M["psnr_db"] = modes.psnr(a.lattice, images[m], truth)
+        if M["table_visits"]:  # everything the instances add, per visit (as above)
+            M["ns_per_visit_est"] = (M["ms"] - r["base_ms"]) * 1e6 * a.threads / M["table_visits"]
     return r
 
 
@@ -288,15 +294,17 @@ def markdown_burr(r):
           "(stratified jitter). Build s: the tables' cold build, when the first render built "
           "them (kept beside the cache for later runs). Tables answer in lattice mode when "
           "visits > 0 and no note says a level fell back.\n")
-    print("| mode | render ms | build s (cold) | PSNR dB | table bytes | table visits | answered by "
-          "| notes |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | --- | --- |")
+    print("| mode | render ms | build s (cold) | PSNR dB | table bytes | table visits | "
+          "ns/visit (est.) | answered by | notes |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |")
     for m, M in r["modes"].items():
         build = f"{M['build_s']:.1f}" if M.get("build_s") is not None else "-"
+        nsv = f"{M['ns_per_visit_est']:.0f}" if "ns_per_visit_est" in M else "-"
         print(f"| {m} | {fmt_ms(M['ms'])} | {build} | {fmt_db(M['psnr_db'])} | "
-              f"{M['table_bytes']} | {M['table_visits']} | {M['how'] or 'exact'} | "
+              f"{M['table_bytes']} | {M['table_visits']} | {nsv} | {M['how'] or 'exact'} | "
               f"{' '.join(M['notes']) or '-'} |")
-    print()
+    print(f"\nWithout its instances the scene renders in {fmt_ms(r['base_ms'])} ms; ns/visit: "
+          "(render ms - that) x threads / table visits, everything the instances add.\n")
 
 
 def main():
@@ -345,7 +353,8 @@ def main():
     res["config"]["seconds"] = time.time() - t0
     os.makedirs(a.out, exist_ok=True)
     json.dump(res, open(os.path.join(a.out, "complexity.json"), "w"), indent=2)
-    markdown(res)
+    if res["primitives"]:
+        markdown(res)
     markdown_checks(res)
     markdown_burr(res.get("burr"))
 
