@@ -227,7 +227,9 @@ BURR_MODES = {
     "exact 1 spp": ["--mode", "exact"],
     "exact 4 spp": ["--mode", "exact", "--spp", "4"],
     "lattice": ["--mode", "lattice"],
+    "lattice --filter box": ["--mode", "lattice", "--filter", "box"],
     "lattice --lod off": ["--mode", "lattice", "--lod", "off"],
+    "auto": ["--mode", "auto"],
 }
 BURR_TRUTH_SPP = 256
 
@@ -258,7 +260,7 @@ def bench_burr(a):
     truth = modes.ground_truth(a.lattice, scene, a.work, BURR_TRUTH_SPP)
     r = {"scene": BURR, "loadavg": os.getloadavg()[0], "modes": {}}
     images = {m: os.path.join(a.work, f"burr-{i}.png") for i, m in enumerate(BURR_MODES)}
-    args = {m: v + (["--lattice-dir", cache] if "lattice" in v else [])
+    args = {m: v + (["--lattice-dir", cache] if v[1] != "exact" else [])
             for m, v in BURR_MODES.items()}
     for m in BURR_MODES:  # a first render builds what is not cached, timed apart
         s = render(a, scene, images[m], *args[m])

@@ -120,6 +120,8 @@ FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, Latt
     if (chain_ && chain_->primitive_count() >= kMinBoxedParts)
         part_boxes_ = std::make_unique<const PartBoxes>(*chain_, box(), true);
     paired_shadows_ = exact_ && !chain_ && primitive_->intersect_cost() > kMaxExactCost;
+    box_shadows_ = !exact_ && primitive_ && !dynamic_cast<const ChainShape*>(primitive_) &&
+                   primitive_->intersect_cost() > kMaxExactCost;
 }
 
 void FilteredLatticeShape::spans(const Ray& r, SpanList& out) const {
@@ -343,7 +345,7 @@ void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, d
     const auto lo = static_cast<std::size_t>(std::floor(level));
     // The box filter, constant over a pair's cells, gets its smoothness from blending levels:
     // it blends them all the way (Plate 4: 33.6 dB, in the band only 32.6 dB).
-    const bool smooth = filter_ == LatticeFilter::kSmooth;
+    const bool smooth = filter_ == LatticeFilter::kSmooth && (normal || !box_shadows_);
     const double w_hi = lod_blend(level - double(lo), smooth ? kLodBlendBand : 1.0);
     // The levels of weight above 0: their pairs are found first and located in their tables
     // together, so that the cache misses of the two tables overlap.
