@@ -589,7 +589,8 @@ std::string near_and_far(bool row, bool far_bead) {
 // The lattices scene_lattices gives a scene's one primitive, with levels of detail on, within
 // a pair and a work budget, with its cache in dir.
 SceneLattices levels_for(const test::TempDir& dir, const std::string& scene, double max_pairs,
-                         double max_work = kMaxLodWork) {
+                         double max_work = kMaxLodWork,
+                         LatticeFilter filter = LatticeFilter::kSmooth) {
     const std::string path = (dir.path() / "near-and-far.json").string();
     std::ofstream(path) << scene;
     const Scene s = load_scene(path);
@@ -597,12 +598,51 @@ SceneLattices levels_for(const test::TempDir& dir, const std::string& scene, dou
     TableSpec spec;
     spec.encoding = "coverage";
     return scene_lattices(s, cache, spec, false,
-                          {LatticeFilter::kSmooth, true, 0.01, max_pairs, max_work});
+                          {filter, true, 0.01, max_pairs, max_work});
 }
 // How many levels it reads (from a fresh cache).
 std::size_t levels_built(const std::string& scene, double max_pairs, double max_work = kMaxLodWork) {
     test::TempDir dir;
     return levels_for(dir, scene, max_pairs, max_work).paths.size();
+}
+
+// A costly primitive's shadow rays (coverage only) read its smooth-filtered tables as the box
+// filter does, one pair a level: their sheets are the box-filtered lattice's to the bit, while
+// its camera rays keep the smooth blend.
+TEST(Coverage, ACostlyPrimitivesShadowRaysReadOnePairALevel) {
+    test::TempDir dir;
+    const std::string scene = near_and_far(true, true);
+    const SceneLattices smooth = levels_for(dir, scene, kMaxLodPairs);
+    const SceneLattices box = levels_for(dir, scene, kMaxLodPairs, kMaxLodWork, LatticeFilter::kBox);
+    ASSERT_EQ(smooth.paths.size(), 3u);  // levels 0 to 2: rays blend two of them
+    const Shape& s = *smooth.shapes[0];
+    const Shape& b = *box.shapes[0];
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-0.2, 2.2);
+    int shadow_sheets = 0, camera_differ = 0;
+    for (int i = 0; i < 4000; ++i) {
+        // Across the bead's box (2 x 1 x 2), footprints between its levels' cells.
+        const Vec3 o{u(rng), -1.0, u(rng)}, q{u(rng), 2.0, u(rng)};
+        for (const bool shadow : {true, false}) {
+            RayFootprint f;
+            f.width0 = 0.1 + 0.3 * (i % 7) / 7.0;
+            f.coverage_only = shadow;
+            const Ray r{o, q - o, &f};
+            Crossing cs, cb;
+            const bool hs = s.intersect(r, 0, kInfinity, cs), hb = b.intersect(r, 0, kInfinity, cb);
+            if (!shadow) {
+                camera_differ += hs != hb || (hs && cs.coverage != cb.coverage);
+                continue;
+            }
+            ASSERT_EQ(hs, hb) << i;
+            if (!hs) continue;
+            ++shadow_sheets;
+            EXPECT_EQ(cs.coverage, cb.coverage) << i;
+            EXPECT_EQ(cs.t, cb.t) << i;
+        }
+    }
+    EXPECT_GT(shadow_sheets, 200);
+    EXPECT_GT(camera_differ, 50);
 }
 
 // Levels of detail stop at the pair budget (LatticeFiltering::max_pairs): the finest level
