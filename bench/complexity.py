@@ -14,11 +14,13 @@ command itself:
      them by kind) and estimates the CPU time per visit as (lattice ms - ms of the scene without its
      instances) x threads / visits: everything the instances add, Embree traversal included.
 Then the same for the costly-primitive check class (complexity_scenes.CHECKS: 400 instances on a ball),
-with the target ratio for each. Writes OUT/complexity.json and prints a Markdown
-summary.
+with the target ratio for each; and, for the burr (ball-csg7), every way of answering it (exact at
+1 and 4 spp, lattice mode with and without levels of detail): render time, cold build time,
+PSNR against exact at 256 spp, table bytes and visits (`--only burr` runs that alone).
+Writes OUT/complexity.json and prints a Markdown summary.
 
 Usage: complexity.py LATTICE_BIN OUT_DIR [--work DIR] [--size N] [--runs N] [--threads N]
-                     [--encodings a,b] [--only name,...]"""
+                     [--encodings a,b] [--only name,...,burr] [--burr-cold]"""
 import argparse
 import json
 import os
@@ -218,6 +220,95 @@ def markdown(res):
           "ns/visit: (lattice ms - ms without instances) x threads / visits.\n")
 
 
+# The burr check: how each mode answers the costly-primitive class (ball-csg7, 400 burrs: six
+# tori minus a sphere), against a many-sample exact truth. Mode label -> render arguments.
+BURR = "ball-csg7"
+BURR_MODES = {
+    "exact 1 spp": ["--mode", "exact"],
+    "exact 4 spp": ["--mode", "exact", "--spp", "4"],
+    "lattice": ["--mode", "lattice"],
+    "lattice --filter box": ["--mode", "lattice", "--filter", "box"],
+    "lattice --lod off": ["--mode", "lattice", "--lod", "off"],
+    "auto": ["--mode", "auto"],
+}
+BURR_TRUTH_SPP = 256
+
+
+def burr_builds(a, cache, label, stats):
+    """The cold build time of the tables a lattice mode reads: measured when its first render built
+    them, and kept beside the cache (build-times.json) for later runs that find them cached."""
+    path = os.path.join(cache, "build-times.json")
+    times = json.load(open(path)) if os.path.exists(path) else {}
+    key = label + " " + ",".join(os.path.basename(f) for f in stats.get("table_files", []))
+    if stats.get("tables_built"):
+        times[key] = stats["tables_ms"] / 1000
+        json.dump(times, open(path, "w"), indent=1)
+    return times.get(key)
+
+
+def bench_burr(a):
+    """Render time, cold build time, PSNR against exact at BURR_TRUTH_SPP (stratified jitter,
+    cached by the scene's bytes) and table bytes of each BURR_MODES mode; lattice modes also their
+    table visits and notes (a fallback to sub-rays shows as a note and as what answered)."""
+    import modes  # noqa: E402 (the truth is made as the modes benchmark makes it)
+    scene = os.path.join(a.work, "scenes", BURR + ".json")
+    cache = os.path.join(a.work, "burr-cache")
+    if a.burr_cold and os.path.isdir(cache):
+        for f in os.listdir(cache):
+            os.remove(os.path.join(cache, f))
+    os.makedirs(cache, exist_ok=True)
+    truth = modes.ground_truth(a.lattice, scene, a.work, BURR_TRUTH_SPP)
+    r = {"scene": BURR, "loadavg": os.getloadavg()[0], "modes": {}}
+    images = {m: os.path.join(a.work, f"burr-{i}.png") for i, m in enumerate(BURR_MODES)}
+    args = {m: v + (["--lattice-dir", cache] if v[1] != "exact" else [])
+            for m, v in BURR_MODES.items()}
+    for m in BURR_MODES:  # a first render builds what is not cached, timed apart
+        s = render(a, scene, images[m], *args[m])
+        r["modes"][m] = {"runs_ms": [], "build_s": burr_builds(a, cache, m, s)}
+    base, base_png = without_instances(a, BURR), os.path.join(a.work, "base.png")
+    r["base_runs_ms"] = []
+    for _ in range(a.runs):  # interleaved, so that load from other processes hits all alike
+        r["base_runs_ms"].append(render(a, base, base_png)["render_ms"])
+        for m in BURR_MODES:
+            s = render(a, scene, images[m], *args[m])
+            assert s.get("tables_built", 0) == 0, "tables should have come from the cache"
+            M = r["modes"][m]
+            M["runs_ms"].append(s["render_ms"])
+            M["table_bytes"] = s.get("table_bytes", 0)
+            M["table_visits"] = s.get("table_visits", 0)
+            M["notes"] = s.get("lattice_notes", [])
+            M["how"] = "; ".join(p["how"] for p in s.get("primitives", []))
+    r["base_ms"] = statistics.median(r["base_runs_ms"])
+    for m, M in r["modes"].items():
+        M["ms"] = statistics.median(M["runs_ms"])
+        M["psnr_db"] = modes.psnr(a.lattice, images[m], truth)
+        if M["table_visits"]:  # everything the instances add, per visit (as above)
+            M["ns_per_visit_est"] = (M["ms"] - r["base_ms"]) * 1e6 * a.threads / M["table_visits"]
+    return r
+
+
+def markdown_burr(r):
+    if not r:
+        return
+    print(f"## The burr: {complexity_scenes.BALL_INSTANCES} CSG of six tori minus a sphere\n")
+    print(f"{BURR}, 512 x 512 unless --size says otherwise, 2 threads, median of the runs, "
+          f"load average {r['loadavg']:.1f}; PSNR against exact mode at {BURR_TRUTH_SPP} spp "
+          "(stratified jitter). Build s: the tables' cold build, when the first render built "
+          "them (kept beside the cache for later runs). Tables answer in lattice mode when "
+          "visits > 0 and no note says a level fell back.\n")
+    print("| mode | render ms | build s (cold) | PSNR dB | table bytes | table visits | "
+          "ns/visit (est.) | answered by | notes |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |")
+    for m, M in r["modes"].items():
+        build = f"{M['build_s']:.1f}" if M.get("build_s") is not None else "-"
+        nsv = f"{M['ns_per_visit_est']:.0f}" if "ns_per_visit_est" in M else "-"
+        print(f"| {m} | {fmt_ms(M['ms'])} | {build} | {fmt_db(M['psnr_db'])} | "
+              f"{M['table_bytes']} | {M['table_visits']} | {nsv} | {M['how'] or 'exact'} | "
+              f"{' '.join(M['notes']) or '-'} |")
+    print(f"\nWithout its instances the scene renders in {fmt_ms(r['base_ms'])} ms; ns/visit: "
+          "(render ms - that) x threads / table visits, everything the instances add.\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("lattice")
@@ -229,6 +320,8 @@ def main():
     ap.add_argument("--sigma-inv", type=int, default=1)
     ap.add_argument("--encodings", default="hash14,dense,candidates")
     ap.add_argument("--only", default="")
+    ap.add_argument("--burr-cold", action="store_true",
+                    help="empty the burr's table cache first, to time its cold build")
     a = ap.parse_args()
     a.lattice = os.path.abspath(a.lattice)
     a.visits = os.path.join(os.path.dirname(a.lattice), "lattice_visits")
@@ -238,9 +331,12 @@ def main():
     a.encodings = a.encodings.split(",")
     os.makedirs(a.cache, exist_ok=True)
     names = (a.only.split(",") if a.only
-             else list(complexity_scenes.PRIMITIVES) + list(complexity_scenes.CHECKS))
+             else list(complexity_scenes.PRIMITIVES) + list(complexity_scenes.CHECKS) + ["burr"])
+    burr = "burr" in names
+    names = [n for n in names if n != "burr"]
     check([sys.executable, os.path.join(HERE, "complexity_scenes.py"),
-           os.path.join(a.work, "scenes"), "--size", str(a.size), "--only", ",".join(names)])
+           os.path.join(a.work, "scenes"), "--size", str(a.size),
+           "--only", ",".join(names + [BURR] if burr else names)])
 
     res = {"config": {"size": a.size, "runs": a.runs, "threads": a.threads,
                       "sigma_inv": a.sigma_inv, "encodings": a.encodings,
@@ -253,11 +349,16 @@ def main():
         check_class = name in complexity_scenes.CHECKS
         cost = (complexity_scenes.CHECKS if check_class else complexity_scenes.PRIMITIVES)[name][1]
         res["checks" if check_class else "primitives"].append(bench_primitive(a, name, cost))
+    if burr:
+        print("complexity: burr", file=sys.stderr)
+        res["burr"] = bench_burr(a)
     res["config"]["seconds"] = time.time() - t0
     os.makedirs(a.out, exist_ok=True)
     json.dump(res, open(os.path.join(a.out, "complexity.json"), "w"), indent=2)
-    markdown(res)
+    if res["primitives"]:
+        markdown(res)
     markdown_checks(res)
+    markdown_burr(res.get("burr"))
 
 
 if __name__ == "__main__":

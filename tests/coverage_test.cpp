@@ -10,7 +10,10 @@
 #include <fstream>
 #include <random>
 
+#include "csg/csg_shape.h"
 #include "geometry/chain.h"
+#include "geometry/named_shapes.h"
+#include "geometry/sphere.h"
 #include "hook_primitive.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/coverage.h"
@@ -89,6 +92,57 @@ TEST(Coverage, CullingLosesNoPair) {
             EXPECT_EQ(all[next].alpha, ref.alpha);
             EXPECT_EQ(all[next].t, ref.t);
         }
+}
+
+// Three tori minus a sphere in a 4 x 4 x 4 box of cell 1 (the burr of the costly-primitive
+// bench, smaller): a CSG tree, whose pairs the build culls by its leaves.
+const CsgShape& small_burr() {
+    static const std::shared_ptr<CsgShape> csg = [] {
+        auto c = std::make_shared<CsgShape>();
+        std::vector<int> tori;
+        for (const Vec3 axis : {Vec3{1, 0.2, 0}, Vec3{0, 1, 0.3}, Vec3{0.3, 0, 1}}) {
+            const PlacedShape t = make_torus({2, 2, 2}, normalize(axis), 1.4, 0.2);
+            tori.push_back(c->add_leaf({t.shape, t.placement, 0}));
+        }
+        const int ring = c->add_node(CsgOp::kUnion, tori);
+        const int bite = c->add_leaf({std::make_shared<SphereShape>(Vec3{2, 2, 3.2}, 0.9), {}, 0});
+        c->set_root(c->add_node(CsgOp::kDifference, {ring, bite}));
+        return c;
+    }();
+    return *csg;
+}
+
+TEST(Coverage, CullingByLeavesLosesNoPair) {
+    // A CSG tree's pairs are culled by its leaves' spheres and its sub-rays evaluate the leaves
+    // near them alone: every pair's coverage is still the definition's to the bit (the whole
+    // tree, every sub-ray snapped), and no pair with enough hits is left out.
+    const TableContext ctx{{4, 4, 4}, 1.0, 1.0, &small_burr()};
+    const std::vector<CoverageSample> all = rasterize_coverage(ctx, false);
+    const BoundaryGrid grid(ctx.cells);
+    const auto before = [](const CoverageSample& x, const CoverageSample& y) {
+        return x.a != y.a ? x.a < y.a : x.b < y.b;
+    };
+    int listed_pairs = 0, unlisted = 0;
+    for (std::uint32_t a = 0; a < grid.count(); a += 2)
+        for (std::uint32_t b = 0; b < grid.count(); ++b) {
+            if (a == b || !BoundaryGrid::valid_pair(grid.faces(grid.point(a)), grid.faces(grid.point(b))))
+                continue;
+            const CoverageSample ref = pair_coverage(ctx, a, b);
+            const auto it = std::lower_bound(all.begin(), all.end(), ref, before);
+            const bool listed = it != all.end() && it->a == a && it->b == b;
+            ASSERT_EQ(listed, ref.alpha >= kCoverageMinAlpha) << a << " -> " << b;
+            if (!listed) {
+                ++unlisted;
+                continue;
+            }
+            ++listed_pairs;
+            EXPECT_EQ(it->alpha, ref.alpha) << a << " -> " << b;
+            EXPECT_EQ(it->t, ref.t) << a << " -> " << b;
+            EXPECT_EQ(it->nu, ref.nu) << a << " -> " << b;
+            EXPECT_EQ(it->nv, ref.nv) << a << " -> " << b;
+        }
+    EXPECT_GT(listed_pairs, 1000);
+    EXPECT_GT(unlisted, 1000);
 }
 
 TEST(Coverage, GuessedSnapsAreSnaps) {
@@ -533,7 +587,8 @@ std::string near_and_far(bool row, bool far_bead) {
 // The lattices scene_lattices gives a scene's one primitive, with levels of detail on, within
 // a pair and a work budget, with its cache in dir.
 SceneLattices levels_for(const test::TempDir& dir, const std::string& scene, double max_pairs,
-                         double max_work = kMaxLodWork) {
+                         double max_work = kMaxLodWork,
+                         LatticeFilter filter = LatticeFilter::kSmooth) {
     const std::string path = (dir.path() / "near-and-far.json").string();
     std::ofstream(path) << scene;
     const Scene s = load_scene(path);
@@ -541,12 +596,51 @@ SceneLattices levels_for(const test::TempDir& dir, const std::string& scene, dou
     TableSpec spec;
     spec.encoding = "coverage";
     return scene_lattices(s, cache, spec, false,
-                          {LatticeFilter::kSmooth, true, 0.01, max_pairs, max_work});
+                          {filter, true, 0.01, max_pairs, max_work});
 }
 // How many levels it reads (from a fresh cache).
 std::size_t levels_built(const std::string& scene, double max_pairs, double max_work = kMaxLodWork) {
     test::TempDir dir;
     return levels_for(dir, scene, max_pairs, max_work).paths.size();
+}
+
+// A costly primitive's shadow rays (coverage only) read its smooth-filtered tables as the box
+// filter does, one pair a level: their sheets are the box-filtered lattice's to the bit, while
+// its camera rays keep the smooth blend.
+TEST(Coverage, ACostlyPrimitivesShadowRaysReadOnePairALevel) {
+    test::TempDir dir;
+    const std::string scene = near_and_far(true, true);
+    const SceneLattices smooth = levels_for(dir, scene, kMaxLodPairs);
+    const SceneLattices box = levels_for(dir, scene, kMaxLodPairs, kMaxLodWork, LatticeFilter::kBox);
+    ASSERT_EQ(smooth.paths.size(), 3u);  // levels 0 to 2: rays blend two of them
+    const Shape& s = *smooth.shapes[0];
+    const Shape& b = *box.shapes[0];
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-0.2, 2.2);
+    int shadow_sheets = 0, camera_differ = 0;
+    for (int i = 0; i < 4000; ++i) {
+        // Across the bead's box (2 x 1 x 2), footprints between its levels' cells.
+        const Vec3 o{u(rng), -1.0, u(rng)}, q{u(rng), 2.0, u(rng)};
+        for (const bool shadow : {true, false}) {
+            RayFootprint f;
+            f.width0 = 0.1 + 0.3 * (i % 7) / 7.0;
+            f.coverage_only = shadow;
+            const Ray r{o, q - o, &f};
+            Crossing cs, cb;
+            const bool hs = s.intersect(r, 0, kInfinity, cs), hb = b.intersect(r, 0, kInfinity, cb);
+            if (!shadow) {
+                camera_differ += hs != hb || (hs && cs.coverage != cb.coverage);
+                continue;
+            }
+            ASSERT_EQ(hs, hb) << i;
+            if (!hs) continue;
+            ++shadow_sheets;
+            EXPECT_EQ(cs.coverage, cb.coverage) << i;
+            EXPECT_EQ(cs.t, cb.t) << i;
+        }
+    }
+    EXPECT_GT(shadow_sheets, 200);
+    EXPECT_GT(camera_differ, 50);
 }
 
 // Levels of detail stop at the pair budget (LatticeFiltering::max_pairs): the finest level
@@ -575,18 +669,22 @@ TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
 // of a build) a costly primitive answers by its own crossings, as a cheap one does (no tables;
 // each instance's sub-rays bounded), and says so: the level wanted, the one left out, and why.
 TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
-    const double p1 = static_cast<double>(BoundaryGrid::pair_count({4, 2, 4}));
-    const double p2 = static_cast<double>(BoundaryGrid::pair_count({8, 4, 8}));
     const std::string scene = near_and_far(true, true);
     test::TempDir probe;
     const std::string path = (probe.path() / "near-and-far.json").string();
     std::ofstream(path) << scene;
-    const double cost = load_scene(path).primitives[0].shape->intersect_cost();
-    ASSERT_GT(cost, kMaxExactCost);  // its levels are tables
-    for (const double budget : {p2 * cost, p2 * cost * 0.99, p1 * cost * 0.99, 0.0}) {
+    const Scene loaded = load_scene(path);
+    const Shape& bead = *loaded.primitives[0].shape;
+    ASSERT_GT(bead.intersect_cost(), kMaxExactCost);  // its levels are tables
+    // The builds' work (a CSG tree: the pairs near its leaves) at sigma^-1 = 2 and 4.
+    const double w1 = coverage_work({{4, 2, 4}, 0.5, 1.0, &bead});
+    const double w2 = coverage_work({{8, 4, 8}, 0.25, 1.0, &bead});
+    ASSERT_LT(w2, static_cast<double>(BoundaryGrid::pair_count({8, 4, 8})) * bead.intersect_cost());
+    ASSERT_GT(w2, w1);
+    for (const double budget : {w2, w2 * 0.99, w1 * 0.99, 0.0}) {
         test::TempDir dir;
         const SceneLattices l = levels_for(dir, scene, kMaxLodPairs, budget);
-        const bool within = budget >= p2 * cost;
+        const bool within = budget >= w2;
         EXPECT_EQ(l.paths.size(), within ? 3u : 0u) << budget;
         EXPECT_EQ(l.built, within ? 3 : 0) << budget;
         for (const double widest : l.widest_footprints)
@@ -595,7 +693,7 @@ TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
         if (within) continue;
         // The finest level wanted, what it would take, and the budget that builds it.
         const std::string& note = l.notes[0];
-        const auto minutes = static_cast<long long>(std::ceil(lod_minutes(p2 * cost)));
+        const auto minutes = static_cast<long long>(std::ceil(lod_minutes(w2)));
         for (const std::string& part :
              {std::string("near-and-far.json: primitives.bead: "),
               std::string("from sigma^-1 = 1 to sigma^-1 = 4 wanted"),
@@ -606,7 +704,7 @@ TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
     }
     // Only the near copy: level 2 alone wanted, past the budget, so crossings, not level 1.
     test::TempDir near;
-    const SceneLattices l = levels_for(near, near_and_far(true, false), kMaxLodPairs, p1 * cost);
+    const SceneLattices l = levels_for(near, near_and_far(true, false), kMaxLodPairs, w1);
     EXPECT_TRUE(l.paths.empty());
     ASSERT_EQ(l.notes.size(), 1u);
     EXPECT_NE(l.notes[0].find("level of detail sigma^-1 = 4 wanted"), std::string::npos)

@@ -74,7 +74,10 @@ std::shared_ptr<const Shape> footprint_shape(const AnswerPlan& plan,
     // Without instances (only in CSG) it answers no ray: the tables read serve CSG alike.
     if (plan.by == AnsweredBy::kSubRayCrossings && sub_ray_width > 0 && finest.ctx.primitive)
         return std::make_shared<SubRayShape>(finest.ctx, finest.table, table_error, sub_ray_width);
-    return std::make_shared<FilteredLatticeShape>(std::move(levels), filter, table_error);
+    // A costly primitive's shadow rays read one pair each: its lookups, not its records, are
+    // where the time goes.
+    const bool costly = finest.ctx.primitive && !answered_by_primitive(*finest.ctx.primitive);
+    return std::make_shared<FilteredLatticeShape>(std::move(levels), filter, table_error, costly);
 }
 
 }  // namespace lat

@@ -57,4 +57,11 @@ CoverageSample pair_coverage(const TableContext& ctx, std::uint32_t a, std::uint
 // points, the same for any thread count. ctx.primitive must be set.
 std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool progress);
 
+// About the work of rasterize_coverage, in pair tests: a pair times the primitive's
+// intersect_cost (render/modes/scene_lattices.h, kPairTestsPerCpuSecond), summed over the pairs the
+// build samples. Every pair for most primitives; for a CSG tree (culled by its leaves,
+// PieceSolid) the pairs near a leaf, each weighed by the share of the leaves near it, counted on
+// a sample of the entry points.
+double coverage_work(const TableContext& ctx);
+
 }  // namespace lat

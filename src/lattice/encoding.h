@@ -33,6 +33,8 @@ struct EncodeOptions {
     // foresee from the hits (`candidates`: lists grow with the parts near each pair) stop with
     // an InputError past it. Not part of the table: a build fits or is refused.
     std::size_t memory_budget = 0;
+    // Whether a long build (coverage: its sub-rays) shows a progress bar. Not part of the table.
+    bool progress = false;
 };
 
 struct Encoding {

@@ -98,4 +98,21 @@ std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double gro
     return out;
 }
 
+std::vector<PartSphere> piece_spheres(const Shape& shape, double cell, const Vec3& cells,
+                                      double grow, double rel_pad) {
+    const BoundingSphere box{cells * 0.5, 0.5 * length(cells)};
+    std::vector<PartSphere> out;
+    std::vector<BoundingSphere> bs;
+    for (std::size_t i = 0; i < shape.piece_count(); ++i) {
+        bs.clear();
+        shape.piece_spheres(i, bs);
+        for (BoundingSphere b : bs) {
+            b = {b.center / cell, b.radius / cell};
+            if (!(b.radius < box.radius) || !std::isfinite(length_squared(b.center))) b = box;
+            out.push_back(grown_sphere(b, static_cast<std::uint32_t>(i), grow, rel_pad));
+        }
+    }
+    return out;
+}
+
 }  // namespace lat

@@ -41,6 +41,11 @@ inline PartSphere grown_sphere(const BoundingSphere& b, std::uint32_t part, doub
 // `rel_pad` of the radius and 1e-9; grouped by part in ascending order, so a list built from
 // them is sorted by part.
 std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double grow, double rel_pad);
+// The same for the pieces of `shape` (Shape::piece_spheres; a CSG tree's leaves), numbered by
+// piece. Segments lie in the box (cells: its size in cells), so a sphere larger than the box's
+// own (a half-space's unbounded one) is replaced by that: near every segment.
+std::vector<PartSphere> piece_spheres(const Shape& shape, double cell, const Vec3& cells,
+                                      double grow, double rel_pad);
 
 // The face-grid rectangle that can hold exits of segments from p that meet the box b: the
 // central projection of b's corners onto the face plane; the whole face when unbounded.

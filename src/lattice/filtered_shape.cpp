@@ -44,8 +44,8 @@ double lod_blend(double f, double band) {
 }
 
 FilteredLatticeShape::FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
-                                           double table_error)
-    : filter_(filter) {
+                                           double table_error, bool box_shadows)
+    : filter_(filter), box_shadows_(box_shadows) {
     assert(!levels.empty() && filter != LatticeFilter::kNone);
     for (const FilterLevel& l : levels)
         if (!l.table) throw std::logic_error("a filtered lattice needs a table at every level");
@@ -216,7 +216,7 @@ void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, d
     const auto lo = static_cast<std::size_t>(std::floor(level));
     // The box filter, constant over a pair's cells, gets its smoothness from blending levels:
     // it blends them all the way (Plate 4: 33.6 dB, in the band only 32.6 dB).
-    const bool smooth = filter_ == LatticeFilter::kSmooth;
+    const bool smooth = filter_ == LatticeFilter::kSmooth && (normal || !box_shadows_);
     const double w_hi = lod_blend(level - double(lo), smooth ? kLodBlendBand : 1.0);
     // The levels of weight above 0: their pairs are found first and located in their tables
     // together, so that the cache misses of the two tables overlap.

@@ -54,9 +54,10 @@ struct FilterLevel {
 class FilteredLatticeShape final : public Shape {
 public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage (a null
-    // one is refused). table_error: Encoding::error_bound of the finest level.
+    // one is refused). table_error: Encoding::error_bound of the finest level. box_shadows:
+    // shadow rays read the box filter's one pair whatever `filter` (camera rays keep it).
     FilteredLatticeShape(std::vector<FilterLevel> levels, LatticeFilter filter,
-                         double table_error);
+                         double table_error, bool box_shadows = false);
 
     // The lattice box.
     Bounds3 bounds() const override { return bounds_; }
@@ -122,6 +123,10 @@ private:
     std::size_t cull_level_ = 0;
     LatticeFilter filter_;
     Bounds3 bounds_;
+    // Shadow rays read the pair they snap to (the box filter), not the smooth filter's 5: for a
+    // primitive costlier than kMaxExactCost (answer_plan), where lookups dominate the time
+    // (docs/filtering.md, "Costly primitives"; figures in bench/notes/complexity-log.md).
+    bool box_shadows_ = false;
     std::optional<HitTableShape> point_;  // the finest level, point-sampled
 
     const LatticeFrame& cull_frame() const { return levels_[cull_level_].frame; }

@@ -101,6 +101,7 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
         const auto t0 = std::chrono::steady_clock::now();
         EncodeOptions options = plan.options;
         options.memory_budget = static_cast<std::size_t>(0.8 * double(available_memory_bytes()));
+        options.progress = progress;
         const ByteBuffer payload = naming_the_primitive(
             plan, [&] { return plan.encoding->build(b.raster.raw, plan.context, options); });
         b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -4,9 +4,11 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <map>
 
 #include "csg/csg_shape.h"
 #include "lattice/boundary_grid.h"
+#include "lattice/coverage.h"
 #include "lattice/encoding.h"
 #include "lattice/lattice_shape.h"
 #include "util/error.h"
@@ -56,7 +58,16 @@ struct LevelCosts {
         return static_cast<double>(
             BoundaryGrid::pair_count(level_plan(scene, p, spec, j).context.cells));
     }
-    double work(int j) const { return pairs(j) * cost; }  // LatticeFiltering::max_work
+    // LatticeFiltering::max_work: the coverage build's estimate (coverage_work), once a level.
+    double work(int j) const {
+        const auto [it, added] = works.try_emplace(j, 0.0);
+        if (added) {
+            const TableContext ctx = level_plan(scene, p, spec, j).context;
+            it->second = ctx.primitive ? coverage_work(ctx) : pairs(j) * cost;
+        }
+        return it->second;
+    }
+    mutable std::map<int, double> works = {};
 };
 
 // The levels j to read, of those the footprints want: within the largest refinement and the

@@ -52,13 +52,14 @@ struct SceneLattices {
 inline constexpr double kMaxLodPairs = 134217728.0;
 // They are also built only up to a work budget (LatticeFiltering::max_work) of pair tests: pairs
 // times the primitive's intersect_cost, the work of a coverage build, whose sub-rays each pay
-// about the whole cost for a primitive without parts to cull (a CSG tree or a mesh costlier than
-// kMaxExactCost: the only ones whose levels are tables, not answered_by_primitive). A build
-// does about kPairTestsPerCpuSecond (`ball-csg7`, 73 simple tests: 12.1, 150 and 1900 CPU
-// seconds at sigma^-1 = 1, 2 and 4; 2.5 GHz Xeon, 2026-11-27), so the default budget is a
-// quarter of an hour of one core (`render --lod-budget`): that primitive's 4K level (about 36
-// minutes estimated; the first render at the default waited 20 minutes on 2 cores) is left out,
-// and it answers by its crossings. A level in the cache is read whatever the budget.
+// about the whole cost for a primitive without parts to cull (a mesh costlier than
+// kMaxExactCost); a CSG tree's sub-rays evaluate only the leaves near them, and its pairs are
+// weighed by the share of its leaves near them (coverage_work). A build does about
+// kPairTestsPerCpuSecond (`ball-csg7`, 73 simple tests, every leaf evaluated: 12.1, 150 and
+// 1900 CPU seconds at sigma^-1 = 1, 2 and 4; 2.5 GHz Xeon, 2026-11-27; culled by its leaves,
+// 5.1, 65 and 930 CPU seconds, its 4K level estimated at 11 minutes, 2026-11-29), so the default
+// budget is a quarter of an hour of one core (`render --lod-budget`). A level in the cache is
+// read whatever the budget.
 inline constexpr double kPairTestsPerCpuSecond = 1.2e6;
 inline constexpr double kLodBudgetMinutes = 15;
 // The work budget of so many minutes of one core, and back.

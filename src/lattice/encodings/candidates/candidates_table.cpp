@@ -98,20 +98,6 @@ struct Part {
     }
 };
 
-// Piece i's spheres in lattice units. Segments lie in the box, so a sphere larger than the
-// box's own (a half-space's unbounded one) is replaced by that: near every segment.
-std::vector<BoundingSphere> piece_balls(const Shape& shape, std::size_t i, double cell,
-                                        const Vec3& cells) {
-    const BoundingSphere box{cells * 0.5, 0.5 * length(cells)};
-    std::vector<BoundingSphere> balls;
-    shape.piece_spheres(i, balls);
-    for (BoundingSphere& s : balls) {
-        s = {s.center / cell, s.radius / cell};
-        if (!(s.radius < box.radius) || !std::isfinite(length_squared(s.center))) s = box;
-    }
-    return balls;
-}
-
 std::vector<Part> parts_of(const Shape& shape, double cell) {
     std::vector<Part> parts;
     const auto* chain = dynamic_cast<const ChainShape*>(&shape);
@@ -128,15 +114,6 @@ std::vector<Part> parts_of(const Shape& shape, double cell) {
         parts.push_back(p);
     }
     return parts;
-}
-
-// The culling spheres of the pieces, grown by the reach, grouped by piece in ascending order.
-std::vector<PartSphere> cull_spheres(const Shape& shape, double cell, const Vec3& cells) {
-    std::vector<PartSphere> out;
-    for (std::size_t i = 0; i < shape.piece_count(); ++i)
-        for (const BoundingSphere& b : piece_balls(shape, i, cell, cells))
-            out.push_back(grown_sphere(b, static_cast<std::uint32_t>(i), kSnapReach, 1e-9));
-    return out;
 }
 
 struct Scratch {
@@ -182,7 +159,7 @@ public:
     CandidateFinder(const TableContext& ctx, const BoundaryGrid& grid)
         : grid_(grid), parts_(parts_of(*ctx.primitive, ctx.cell)) {
         const Vec3 cells{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])};
-        cull_ = cull_spheres(*ctx.primitive, ctx.cell, cells);
+        cull_ = piece_spheres(*ctx.primitive, ctx.cell, cells, kSnapReach, 1e-9);
         for (int f = 0; f < 6; ++f) faces_[static_cast<std::size_t>(f)] = layout_face(grid, f);
     }
 

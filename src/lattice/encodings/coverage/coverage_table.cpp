@@ -76,7 +76,7 @@ struct Entry {
 // The records of a table: the rasterized hits and the coverage samples merged by pair, filed
 // by slot (a stored pair is a valid one: rasterizing skips the others), in slot order.
 std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
-                                   const PairIndex& index) {
+                                   const PairIndex& index, bool progress) {
     constexpr std::uint16_t kNoHit = CoverageTable::kNoHit;
     const std::uint64_t n = index.grid().count();
     std::vector<Entry> entries;
@@ -92,7 +92,7 @@ std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
     // Coverage samples come sorted by pair: merge them into the hits, adding the pairs whose
     // own segment misses.
     std::size_t next = 0;
-    for (const CoverageSample& c : rasterize_coverage(ctx, false)) {
+    for (const CoverageSample& c : rasterize_coverage(ctx, progress)) {
         const std::uint64_t pair = c.a * n + c.b;
         while (next < centers && entries[next].pair < pair) ++next;
         Entry* e = nullptr;
@@ -116,9 +116,9 @@ std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
 
 }  // namespace
 
-ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, const EncodeOptions&) {
+ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, const EncodeOptions& opt) {
     const PairIndex index(ctx.cells);
-    const std::vector<Entry> entries = entries_by_slot(hits, ctx, index);
+    const std::vector<Entry> entries = entries_by_slot(hits, ctx, index, opt.progress);
     std::uint64_t groups = 0, centers = 0;
     for (std::size_t i = 0; i < entries.size(); ++i) {
         groups += i == 0 || entries[i].pair / kGroupSlots != entries[i - 1].pair / kGroupSlots;
