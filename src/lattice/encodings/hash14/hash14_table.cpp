@@ -22,6 +22,15 @@ std::uint64_t bucket_of(std::uint32_t a, std::uint32_t b, std::uint64_t buckets)
     return ((h >> 32) * buckets) >> 32;
 }
 
+// lround(clamp(t, 0, 1) * 65535) (halves away from zero; NaN as 0), inline: the call into
+// libm was a tenth of the build's instructions.
+std::uint16_t quantise_t(float t) {
+    const double x = std::clamp(double(t), 0.0, 1.0) * 65535.0;
+    if (!(x >= 0)) return 0;
+    const double whole = std::trunc(x);  // x - whole is exact
+    return static_cast<std::uint16_t>(x - whole >= 0.5 ? whole + 1 : whole);
+}
+
 }  // namespace
 
 ByteBuffer Hash14Table::build(const RawHits& hits) {
@@ -65,7 +74,7 @@ ByteBuffer Hash14Table::build(const RawHits& hits) {
         std::uint64_t* off = &offset[c * parts];
         for (const RawHit& h : hits.chunks[c]) {
             const std::uint64_t bucket = bucket_of(h.a, h.b, buckets);
-            const auto t = static_cast<std::uint16_t>(std::lround(std::clamp(double(h.t), 0.0, 1.0) * 65535.0));
+            const std::uint16_t t = quantise_t(h.t);
             sorted[off[part_of(bucket)]++] = {static_cast<std::uint16_t>(h.a), static_cast<std::uint16_t>(h.b), t,
                                               h.nu, h.nv,
                                               static_cast<std::uint16_t>(bucket & ((1u << kPartBits) - 1))};
