@@ -74,10 +74,9 @@ ByteBuffer Hash14Table::build(const RawHits& hits) {
         std::uint64_t* off = &offset[c * parts];
         for (const RawHit& h : hits.chunks[c]) {
             const std::uint64_t bucket = bucket_of(h.a, h.b, buckets);
-            const std::uint16_t t = quantise_t(h.t);
-            sorted[off[part_of(bucket)]++] = {static_cast<std::uint16_t>(h.a), static_cast<std::uint16_t>(h.b), t,
-                                              h.nu, h.nv,
-                                              static_cast<std::uint16_t>(bucket & ((1u << kPartBits) - 1))};
+            const auto a = static_cast<std::uint16_t>(h.a), b = static_cast<std::uint16_t>(h.b);
+            const auto local = static_cast<std::uint16_t>(bucket & ((1u << kPartBits) - 1));
+            sorted[off[part_of(bucket)]++] = {a, b, quantise_t(h.t), h.nu, h.nv, local};
         }
     });
 
