@@ -116,20 +116,23 @@ void for_each_exit_in_cone(const Vec3& p, const PartSphere& ps, const FaceLayout
     projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
     v0 = std::max(v0, c0), v1 = std::min(v1, c1);
     const ConeRows cone(p, ps, fl);
+    // q = base + u eu + v ev, exactly (small integers and zeros): writing q's coordinates by
+    // runtime axis index instead stalls the load of q that follows on store forwarding.
+    Vec3 base{0, 0, 0}, eu{0, 0, 0}, ev{0, 0, 0};
+    base[static_cast<std::size_t>(fl.axis)] = fl.level;
+    eu[static_cast<std::size_t>(fl.ua)] = 1;
+    ev[static_cast<std::size_t>(fl.va)] = 1;
     for (int v = v0; v <= v1; ++v) {
         double ulo, uhi;
         if (!cone.row(v, ulo, uhi)) continue;
         // Clamp in double first: the interval may be unbounded or huge.
         const int ub = static_cast<int>(std::ceil(std::max(ulo, double(u0))));
         const int ue = static_cast<int>(std::floor(std::min(uhi, double(u1))));
+        const Vec3 row = base + ev * double(v);
         for (int u = ub; u <= ue; ++u) {
             const std::size_t k = static_cast<std::size_t>(v * fl.nu + u);
             if (!fl.canonical[k]) continue;
-            Vec3 q;
-            q[static_cast<std::size_t>(fl.axis)] = fl.level;
-            q[static_cast<std::size_t>(fl.ua)] = u;
-            q[static_cast<std::size_t>(fl.va)] = v;
-            visit(k, q);
+            visit(k, row + eu * double(u));
         }
     }
 }
