@@ -18,8 +18,10 @@ read as the stats are written, after the image). PSNR is against exact mode at T
 (stratified jitter) where that truth can be rendered in reasonable time (up to TRUTH_UP_TO
 hairs), cached in the work directory under the scene's bytes.
 
-Time: the full run (20 k to 4 M) takes about 10 minutes on 2 cores with its truths cached, some
-5 more the first time; --quick (20 k and 200 k, no truths above 200 k) about 1 minute.
+Time: the full run (20 k to 4 M) takes about 15 minutes on 2 idle cores with its truths cached
+(30 under a load average of 10), and the first time some 15 more for the truths (the 1 M one
+the most); --quick (20 k and 200 k) a few minutes. Lattice mode's default filter at 1 M and 4 M
+is the bulk of it.
 Writes RESULTS/scale.json (or --name) and prints a Markdown table.
 
 usage: scale.py LATTICE RESULTS [--work DIR] [--quick] [--sizes 20000,...] [--name scale]"""
@@ -142,6 +144,11 @@ def report(res):
             mb = f"{r['peak_memory_bytes'] / 2**20:.0f}" if "peak_memory_bytes" in r else "-"
             print(f"| {s['hairs']:,} | {label}{mark} | " + " | ".join(secs) +
                   f" | {mb} | {cell(r, 'psnr_db', '{:.2f}')} | {cell(r, 'loadavg', '{:.1f}')} |")
+    answers = sorted({f"{k}: {r['answers']}" for s in res["sizes"] for k, r in s["runs"].items()
+                      if "answers" in r})
+    if answers:
+        print("\nWhat answered the hairs in lattice mode (`render --stats`), at every size: " +
+              "; ".join(answers) + ".")
     failed = [(s["hairs"], k, r["failed"]) for s in res["sizes"] for k, r in s["runs"].items()
               if "failed" in r]
     if failed:
