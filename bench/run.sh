@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # make bench: runs every bench/*_bench program, writes bench/results/<name>.json (Google
 # Benchmark's JSON) and bench/results/summary.md (a readable table of all of them), then the
-# encodings, complexity, independent-tracer, modes and sampler benchmarks through the lattice command
-# (and docs/images/complexity.png).
+# encodings, complexity, independent-tracer, modes, sampler, scatter and scale benchmarks through the
+# lattice command (and docs/images/complexity.png, docs/images/scale.png).
 set -euo pipefail
 build=${1:-build}
 here=$(cd "$(dirname "$0")" && pwd)
@@ -28,6 +28,8 @@ echo "== samplers (where a pixel's samples fall, at 2 to 16 spp; the truths are 
 python3 "$here/samplers.py" "$build/bin/lattice" "$out" --work "$build/modes" > "$out/samplers.md"
 echo "== scatter (fur on a mesh, 100,000 instances)"
 python3 "$here/scatter.py" "$build/bin/lattice" "$out" > "$out/scatter.md"
+echo "== scale (hairs on the bunny, 20,000 to 4 million, exact and lattice mode; about 15 minutes)"
+python3 "$here/scale.py" "$build/bin/lattice" "$out" --work "$build/scale" > "$out/scale.md"
 echo "== MPI (2 ranks x 1 thread against 1 rank x 2 threads; docs/distributed.md)"
 if command -v mpirun > /dev/null && "$build/bin/lattice" --version | grep -q "with MPI"; then
   python3 "$here/distributed.py" "$build/bin/lattice" "$out" > "$out/distributed.md"
@@ -44,7 +46,8 @@ fi
 # (pyenv, a virtualenv) comes first in PATH.
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 "$py" "$here/plot_complexity.py" "$out/complexity.json" "$here/../docs/images/complexity.png"
-{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/modes.md" "$out/samplers.md" "$out/scatter.md" "$out/distributed.md" "$out/python_lookup.md"; } > "$out/summary.md"
+"$py" "$here/plot_scale.py" "$out/scale.json" "$here/../docs/images/scale.png" "$out/scale-before.json"
+{ python3 "$here/summarize.py" "$out"; cat "$out/encodings.md" "$out/complexity.md" "$out/embree_tracer.md" "$out/modes.md" "$out/samplers.md" "$out/scatter.md" "$out/scale.md" "$out/distributed.md" "$out/python_lookup.md"; } > "$out/summary.md"
 echo
 cat "$out/rasterize.md" >> "$out/summary.md"
 cat "$out/summary.md"

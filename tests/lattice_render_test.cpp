@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 namespace lat {
@@ -152,6 +153,32 @@ TEST_F(LatticeRender, CullingByThePrimitiveChangesNoPixel) {
             const Image8 reference = encoding == "candidates" ? render_exact(s) : render(boxed);
             EXPECT_EQ(compare_images(reference, render(culled)).max_abs_error, 0)
                 << plate << " " << encoding;
+        }
+    }
+}
+
+// Past AccelOptions::cull_part_budget a lattice instance enters the hierarchy as one primitive
+// bounded by its cull parts together, which it tests in its own space: no answer may change
+// against one primitive per part.
+TEST_F(LatticeRender, InstancesEnteredWholeChangeNoPixel) {
+    for (const char* plate : {"plate3-hair-closeup", "plate4-fuzzy-sphere-1000"}) {
+        const Scene s = small(plate, 128);
+        for (const std::string encoding : {"hash14", "candidates"}) {
+            TableSpec spec;
+            spec.encoding = encoding;
+            const SceneLattices l = scene_lattices(s, cache, spec, false);
+            ASSERT_GT(l.shapes[0]->cull_count(), 1u) << plate << " " << encoding;
+            auto render = [&](std::size_t budget) {
+                AccelOptions opt;
+                opt.cull_part_budget = budget;
+                const TracedScene rs(
+                    s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; }, opt);
+                return render_exact(rs, {}).display;
+            };
+            const Image8 parts = render(std::numeric_limits<std::size_t>::max()), whole = render(0);
+            EXPECT_EQ(compare_images(parts, whole).max_abs_error, 0) << plate << " " << encoding;
+            EXPECT_GT(compare_images(whole, Image8{128, 128, std::vector<std::uint8_t>(128 * 128 * 3)}).max_abs_error, 0)
+                << plate << " " << encoding << ": nothing was rendered";
         }
     }
 }

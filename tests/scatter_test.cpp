@@ -11,11 +11,13 @@
 
 #include "input_error.h"
 #include "render/modes/integrators.h"
+#include "scene/scatter.h"
 #include "scene/scene_loader.h"
 #include "temp_dir.h"
 #include "test_paths.h"
 #include "io/image.h"
 #include "util/hash.h"
+#include "util/memory.h"
 
 namespace lat {
 namespace {
@@ -239,6 +241,20 @@ TEST(Scatter, BadParametersAreInputErrors) {
                   .find("objects[0].box: the box holds none of the surface"), std::string::npos);
     EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5, "material": "fur", "on": 3})")
                   .find("objects[0].on: object index 3 does not exist"), std::string::npos);
+}
+
+// A count within the limit that the memory available cannot hold is refused before anything
+// is placed (on a machine with less than 49 GB available; elsewhere the test has no case).
+TEST(Scatter, CountsOverTheMemoryAvailableAreInputErrors) {
+    const std::size_t count = 49'000'000;
+    if (available_memory_bytes() == 0 || available_memory_bytes() >= count * kScatterBytesPerInstance)
+        GTEST_SKIP() << "this machine could hold " << count << " instances";
+    const std::string e = test::error_of([&] {
+        load(R"({"type": "scatter", "primitive": "hair", "count": 49000000, "material": "fur",
+                 "on": {"type": "sphere", "radius": 1, "material": "skin"}})");
+    });
+    EXPECT_NE(e.find("objects[0].count: 49000000 instances need about 49.0 GB of memory with the objects before them, over the "),
+              std::string::npos) << e;
 }
 
 TEST(Scatter, CommandWritesExplicitInstancesThatRenderTheSameImage) {

@@ -79,7 +79,7 @@ int run_render(const RenderRequest& a) {
             check_writable(a.output);
             if (!a.stats.empty()) check_writable(a.stats);
         }
-        scene = load_scene(a.scene);
+        scene = load_scene(a.scene, !a.quiet && dist::is_root() && ProgressBar::stderr_is_terminal());
         check_render_budget(scene.camera, a.spp, a.scene);
     });
     agree_on_scene(a.scene);

@@ -1,6 +1,7 @@
 #include "accel/embree_accel.h"
 
 #include <embree3/rtcore.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -14,6 +15,7 @@
 #include "accel/embree_rays.h"
 #include "accel/space_order.h"
 #include "math/float_round.h"
+#include "util/progress.h"
 
 namespace lat {
 
@@ -51,16 +53,18 @@ struct EmbreeAccel::Impl {
     // Fills objects with the objects given, in the order of a Morton curve through the centres
     // of their world boxes (empty and unbounded ones last), and bounds with those boxes.
     void number_objects(std::span<const AccelObject> given_objects, std::vector<Bounds3>& bounds) {
-        std::vector<Bounds3> given_bounds;
-        std::vector<Vec3> centres;
-        for (const AccelObject& o : given_objects) {
-            given_bounds.push_back(o.shape->placed_bounds(*o.xf));
-            const Bounds3& b = given_bounds.back();
+        std::vector<Bounds3> given_bounds(given_objects.size());
+        std::vector<Vec3> centres(given_objects.size());
+        tbb::parallel_for(std::size_t{0}, given_objects.size(), [&](std::size_t i) {
+            const AccelObject& o = given_objects[i];
+            const Bounds3& b = given_bounds[i] = o.shape->placed_bounds(*o.xf);
             const bool held = embree_can_hold(b) && !b.empty();
-            centres.push_back(held ? b.center() : Vec3{kInfinity, 0, 0});
-        }
+            centres[i] = held ? b.center() : Vec3{kInfinity, 0, 0};
+        });
         const std::vector<std::uint32_t> order = space_order(centres);
         numbered.resize(given_objects.size());
+        objects.reserve(given_objects.size());
+        bounds.reserve(given_objects.size());
         for (const std::uint32_t i : order) {
             const AccelObject& o = given_objects[i];
             numbered[i] = static_cast<std::uint32_t>(objects.size());
@@ -85,7 +89,7 @@ struct EmbreeAccel::Impl {
     static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
                                   const Placed& o);
     std::vector<DirectPrim> direct;
-    std::vector<Bounds3> direct_bounds;      // world space, per direct primitive
+    std::vector<Bounds3> direct_bounds;      // world space, per direct primitive; build only
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
     std::vector<std::uint32_t> inst_object;  // top-level geomID -> object, for instances
     struct FlatPrim {
@@ -93,6 +97,9 @@ struct EmbreeAccel::Impl {
     };
     std::vector<FlatPrim> flat;  // parts of multi-part objects placed directly in world space
     bool flatten = false;
+    // Objects of several cull parts enter as one primitive each (place_whole): past
+    // AccelOptions::cull_part_budget.
+    bool enter_whole = false;
     struct Prototype {
         const Shape* shape;
         RTCScene scene;
@@ -142,9 +149,21 @@ struct EmbreeAccel::Impl {
     bool first_visit(QueryContext* ctx, unsigned prim, const Shape& shape, const Ray& local) const {
         const DirectPrim& d = direct[prim];
         if (!d.shared) return true;
-        if (!shape.cull_meets(d.cull, local)) return false;
+        if (d.cull == kEveryPart) {
+            if (!meets_any_cull_part(shape, local)) return false;
+        } else if (!shape.cull_meets(d.cull, local)) {
+            return false;
+        }
         ctx->mark_tested(d.object);
         return true;
+    }
+    // An object entered whole (place_whole): its cull parts tested in its own space, the
+    // shape's, so that they cost the instance nothing.
+    static constexpr std::uint32_t kEveryPart = 0x7FFFFFFFu;
+    static bool meets_any_cull_part(const Shape& shape, const Ray& local) {
+        for (std::size_t c = 0; c < shape.cull_count(); ++c)
+            if (shape.cull_meets(c, local)) return true;
+        return false;
     }
 
     void record(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Crossing& c,
@@ -400,6 +419,8 @@ struct EmbreeAccel::Impl {
             for (std::uint32_t p = 0; p < o.shape->primitive_count(); ++p) flat.push_back({i, p});
         } else if (o.shape->primitive_count() > 1) {
             place_instance(i);
+        } else if (enter_whole && enters_whole(o)) {
+            place_whole(i, wb);
         } else {
             const std::size_t parts = o.shape->cull_count();
             for (std::uint32_t c = 0; c < parts; ++c) {
@@ -412,6 +433,30 @@ struct EmbreeAccel::Impl {
                 direct_bounds.push_back(b);
             }
         }
+    }
+
+    // Object i as one direct primitive bounded by the union of its cull parts' bounds; its
+    // callbacks test the parts in the shape's space (first_visit). Its culling is as tight on
+    // the ray's line, looser in the hierarchy, and its memory a ninth (a hair's 9 parts).
+    // b: its bounds (whole_bounds).
+    void place_whole(std::uint32_t i, const Bounds3& b) {
+        Placed& o = objects[i];
+        if (b.empty()) return;
+        direct.push_back({i, kEveryPart, 1, {}});  // no capsule: every line meets it
+        o.direct = true;
+        o.cheap_blocker = o.shape->intersect_cost() <= EmbreeAccel::kCheapBlockerCost;
+        direct_bounds.push_back(b);
+    }
+
+    static bool enters_whole(const Placed& o) {
+        return o.shape->primitive_count() <= 1 && o.shape->cull_count() > 1;
+    }
+    // The bounds of an object entered whole, whose world box is wb: its cull parts' together.
+    static Bounds3 whole_bounds(const Placed& o, const Bounds3& wb) {
+        Bounds3 b;
+        for (std::size_t c = 0; c < o.shape->cull_count(); ++c)
+            b = merge(b, o.shape->cull_bounds(c, *o.xf, o.widest_footprint));
+        return lat::intersect(wb, b);
     }
 
     // Object i as an Embree instance of its shape's prototype scene.
@@ -477,8 +522,26 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
         if (o.shape->primitive_count() > 1) parts += o.shape->primitive_count();
     m.flatten = opt.instancing == Instancing::kNever ||
                 (opt.instancing == Instancing::kAuto && parts <= opt.flatten_budget);
+    std::size_t cull_parts = 0;
+    for (const Placed& o : m.objects)
+        if (Impl::enters_whole(o)) cull_parts += o.shape->cull_count();
+    m.enter_whole = cull_parts > opt.cull_part_budget;
+    // Objects entered whole are bounded by their cull parts together, a bound made in
+    // parallel (place is sequential).
+    if (m.enter_whole)
+        tbb::parallel_for(std::size_t{0}, m.objects.size(), [&](std::size_t i) {
+            const Placed& o = m.objects[i];
+            const Bounds3& wb = placed_bounds[i];
+            if (Impl::enters_whole(o) && !wb.empty() && embree_can_hold(wb))
+                placed_bounds[i] = Impl::whole_bounds(o, wb);
+        });
 
-    for (std::uint32_t i = 0; i < m.objects.size(); ++i) m.place(i, placed_bounds[i]);
+    // Placing takes a tenth of the bar, Embree's build the rest.
+    ProgressBar bar("build", 1000, opt.progress, 1000);
+    for (std::uint32_t i = 0; i < m.objects.size(); ++i) {
+        m.place(i, placed_bounds[i]);
+        if (i % 4096 == 0) bar.set(100 * std::uint64_t{i} / m.objects.size());
+    }
     // Tested one after another: in the order given, as before they were numbered in space.
     std::sort(m.unbounded.begin(), m.unbounded.end(), [&](std::uint32_t a, std::uint32_t b) {
         return m.objects[a].original < m.objects[b].original;
@@ -491,7 +554,17 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
         m.attach_user_geometry(m.scene, m.flat.size(), &m, Impl::bounds_flat,
                                Impl::intersect_cb<Impl::Kind::kFlat>,
                                Impl::occluded_cb<Impl::Kind::kFlat>);
+    rtcSetSceneProgressMonitorFunction(
+        m.scene,
+        [](void* b, double done) {
+            static_cast<ProgressBar*>(b)->set(100 + static_cast<std::uint64_t>(900 * done));
+            return true;
+        },
+        &bar);
     rtcCommitScene(m.scene);
+    rtcSetSceneProgressMonitorFunction(m.scene, nullptr, nullptr);
+    m.direct_bounds = {};  // read only by the build
+    bar.finish();
     if (!m.error.empty()) throw std::runtime_error("Embree: " + m.error);
 }
 

@@ -33,6 +33,13 @@ struct AccelOptions {
     Instancing instancing = Instancing::kAuto;
     // kAuto flattens while the total number of flattened parts stays within this.
     std::size_t flatten_budget = 4'000'000;
+    // Objects culled by several parts (lattices: a box or capsule per stretch of the
+    // primitive) enter the hierarchy as one primitive per part while their parts number at
+    // most this in all, else as one primitive each, bounded by their parts together: at scale
+    // the hierarchy's memory and build time follow the number of primitives.
+    std::size_t cull_part_budget = 2'000'000;
+    // A progress bar on stderr for a build that takes longer than a second.
+    bool progress = false;
 };
 
 // A crossing found by a query: the object, under the number the caller gave it.

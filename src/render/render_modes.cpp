@@ -121,8 +121,9 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             r.prepare_ms = ms_since(t0);
             dist::mark(dist::Step::kTables);
             t0 = clock::now();
-            const TracedScene rs(scene, instance_shape, settings.accel,
-                                 r.lattices.widest_footprints);
+            AccelOptions accel = settings.accel;
+            accel.progress = settings.progress;
+            const TracedScene rs(scene, instance_shape, accel, r.lattices.widest_footprints);
             r.build_ms = ms_since(t0);
             dist::mark(dist::Step::kAccel);
             if (settings.before_render) settings.before_render();

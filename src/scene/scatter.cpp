@@ -3,10 +3,15 @@
 #include <cmath>
 #include <unordered_map>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "geometry/named_shapes.h"
 #include "geometry/surface_sampler.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
+#include "util/memory.h"
+#include "util/progress.h"
 
 namespace lat {
 namespace {
@@ -218,6 +223,19 @@ std::vector<SurfaceSample> poisson_samples(const SurfaceSampler& sampler, const 
     return kept;
 }
 
+// Refuses `count` instances that would not fit, with the `before` objects already placed, in
+// the memory available (unknown: any number).
+void require_memory_for(std::size_t count, std::size_t before, const JsonValue& v) {
+    const double need = static_cast<double>(count + before) * kScatterBytesPerInstance;
+    const std::size_t available = available_memory_bytes();
+    if (available == 0 || need <= static_cast<double>(available)) return;
+    (v.has("count") ? v.at("count") : v.at("density"))
+        .fail(std::to_string(count) + " instances need about " + human_bytes(need) +
+              " of memory with the objects before them, over the " +
+              human_bytes(static_cast<double>(available)) +
+              " available (lower the count or the density)");
+}
+
 }  // namespace
 
 Vec3 primitive_root(const Primitive& prim) {
@@ -230,7 +248,8 @@ Vec3 primitive_root(const Primitive& prim) {
 }
 
 void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser& parser,
-                    const std::vector<Primitive>& primitives, std::vector<SceneObject>& out) {
+                    const std::vector<Primitive>& primitives, std::vector<SceneObject>& out,
+                    bool progress) {
     v.allow_keys({"type", "name", "primitive", "on", "count", "density", "seed", "align", "twist",
                   "scale", "tilt_deg", "material", "box", "min_distance", "poisson", "comb"},
                  "a scatter");
@@ -238,27 +257,29 @@ void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser&
     const ScatterParams p = parse_params(v, parser, primitives, sampler->area());
     const Primitive& prim = primitives[static_cast<std::size_t>(p.primitive)];
     const Vec3 root = primitive_root(prim);
+    require_memory_for(p.count, out.size(), v);
+    // Each instance draws from its own streams (2i: its point, 2i + 1: its placement), so the
+    // instances are placed in parallel, alike for any number of threads.
     std::vector<SurfaceSample> points;
-    if (p.min_distance > 0) {
-        points = poisson_samples(*sampler, p, v);
-    } else {
-        points.reserve(p.count);
-        for (std::size_t i = 0; i < p.count; ++i) {
-            CounterRng rng(p.seed, 2 * i);
-            points.push_back(sampler->sample(rng));
+    if (p.min_distance > 0) points = poisson_samples(*sampler, p, v);
+    const std::size_t n = p.min_distance > 0 ? points.size() : p.count;
+    const std::size_t first = out.size();
+    out.resize(first + n);
+    const std::string where = v.path();
+    ProgressBar bar("place", n, progress, 1000);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+            CounterRng point_rng(p.seed, 2 * i), rng(p.seed, 2 * i + 1);
+            const SurfaceSample s = points.empty() ? sampler->sample(point_rng) : points[i];
+            SceneObject& o = out[first + i];
+            o.shape = prim.shape;
+            o.xf = placement(s, p, root, rng);
+            o.material = p.material;
+            o.primitive = p.primitive;
+            o.where = where;
         }
-    }
-    out.reserve(out.size() + points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        CounterRng rng(p.seed, 2 * i + 1);
-        SceneObject o;
-        o.shape = prim.shape;
-        o.xf = placement(points[i], p, root, rng);
-        o.material = p.material;
-        o.primitive = p.primitive;
-        o.where = v.path();
-        out.push_back(std::move(o));
-    }
+        bar.add(range.size());
+    });
 }
 
 }  // namespace lat

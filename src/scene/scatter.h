@@ -13,17 +13,22 @@
 
 namespace lat {
 
-// Far more instances than a render wants (100,000 load and build in about a second); each
-// takes some 250 bytes, so the limit keeps one scatter within half a gigabyte.
-constexpr std::size_t kMaxScatterCount = 2'000'000;
+// Far more instances than a render wants. Memory is the real limit: a scatter is refused
+// when its instances, with those placed before it, would take more than the memory available
+// at kScatterBytesPerInstance each (about the most an instance costs, loaded and traced, in
+// any mode: docs/scene-format.md).
+constexpr std::size_t kMaxScatterCount = 50'000'000;
+constexpr std::size_t kScatterBytesPerInstance = 1000;
 
 // Where an instance of the primitive stands, in its coordinates: the centre of the bottom of its
 // lattice box (or of its bounds). A scatter puts this point on the surface.
 Vec3 primitive_root(const Primitive& prim);
 
 // Expands the scatter `v` over the surface object `on` (its JSON, already parsed once as an
-// object of the scene), appending its instances to `out`.
+// object of the scene), appending its instances to `out`. progress: a bar on stderr when
+// placing them takes longer than a second.
 void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser& parser,
-                    const std::vector<Primitive>& primitives, std::vector<SceneObject>& out);
+                    const std::vector<Primitive>& primitives, std::vector<SceneObject>& out,
+                    bool progress = false);
 
 }  // namespace lat

@@ -173,7 +173,7 @@ JsonValue scatter_target(const JsonValue& sc, const JsonValue& objects,
 
 // Objects first, then scatters (which may name objects anywhere in the list) expanded into
 // instances after them.
-void load_objects(const JsonValue& objects, const ObjectParser& parser, Scene& s) {
+void load_objects(const JsonValue& objects, const ObjectParser& parser, Scene& s, bool progress) {
     std::map<std::string, std::size_t> names;
     std::vector<std::size_t> scatters;
     for (std::size_t i = 0; i < objects.size(); ++i) {
@@ -192,7 +192,7 @@ void load_objects(const JsonValue& objects, const ObjectParser& parser, Scene& s
         const JsonValue sc = objects[i];
         const JsonValue on = scatter_target(sc, objects, names, parser, s);
         ScatterGroup g{name_of(sc).value_or(""), i, s.objects.size(), 0};
-        expand_scatter(sc, on, parser, s.primitives, s.objects);
+        expand_scatter(sc, on, parser, s.primitives, s.objects, progress);
         g.count = s.objects.size() - g.first;
         s.scatters.push_back(g);
     }
@@ -200,7 +200,7 @@ void load_objects(const JsonValue& objects, const ObjectParser& parser, Scene& s
 
 }  // namespace
 
-Scene load_scene_text(const std::string& text, const std::string& file) {
+Scene load_scene_text(const std::string& text, const std::string& file, bool progress) {
     const nlohmann::json doc = parse_json_text(text, file);
     const JsonValue root(doc, "", file);
     if (!root.is_object()) root.fail("a scene file must hold a JSON object");
@@ -241,7 +241,7 @@ Scene load_scene_text(const std::string& text, const std::string& file) {
         for (const std::string& name : prims->keys())
             s.primitives.push_back(parse_primitive(prims->at(name), name, &parser));
     }
-    load_objects(root.at("objects"), parser, s);
+    load_objects(root.at("objects"), parser, s, progress);
     return s;
 }
 
@@ -255,8 +255,8 @@ const Primitive& find_primitive(const Scene& scene, const std::string& name) {
                      (known.empty() ? " (the scene defines none)" : " (it has: " + known + ")"));
 }
 
-Scene load_scene(const std::string& path) {
-    return load_scene_text(read_text_file(path, "scene file"), path);
+Scene load_scene(const std::string& path, bool progress) {
+    return load_scene_text(read_text_file(path, "scene file"), path, progress);
 }
 
 }  // namespace lat

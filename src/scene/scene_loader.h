@@ -8,8 +8,9 @@
 
 namespace lat {
 
-Scene load_scene(const std::string& path);
-Scene load_scene_text(const std::string& text, const std::string& file);
+// progress: a bar on stderr while scatters that take longer than a second are placed.
+Scene load_scene(const std::string& path, bool progress = false);
+Scene load_scene_text(const std::string& text, const std::string& file, bool progress = false);
 
 // The scene's primitive of that name; throws InputError naming the scene file and the names it
 // has.

@@ -26,12 +26,15 @@ void set_progress_sink(ProgressSink sink) {
 
 bool ProgressBar::stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
 
-ProgressBar::ProgressBar(std::string label, std::uint64_t total, bool enabled)
-    : label_(std::move(label)), total_(total == 0 ? 1 : total), enabled_(enabled) {
+ProgressBar::ProgressBar(std::string label, std::uint64_t total, bool enabled, int delay_ms)
+    : label_(std::move(label)), total_(total == 0 ? 1 : total), enabled_(enabled), delayed_(delay_ms > 0) {
     if (!enabled_) return;
-    thread_ = std::thread([this] {
+    thread_ = std::thread([this, delay_ms] {
+        for (int waited = 0; waited < delay_ms && !stop_.load(); waited += 10)
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
         while (!stop_.load()) {
             draw(false);
+            drawn_ = true;
             std::this_thread::sleep_for(std::chrono::milliseconds(100));
         }
     });
@@ -42,7 +45,7 @@ ProgressBar::~ProgressBar() { finish(); }
 void ProgressBar::finish() {
     if (!enabled_ || stop_.exchange(true)) return;
     thread_.join();
-    draw(true);
+    if (drawn_ || !delayed_) draw(true);
 }
 
 void ProgressBar::draw(bool final) const {

@@ -17,12 +17,15 @@ void set_progress_sink(ProgressSink sink);
 
 class ProgressBar {
 public:
-    ProgressBar(std::string label, std::uint64_t total, bool enabled);
+    // delay_ms: the bar is drawn only once the work has taken that long (work that ends
+    // sooner shows nothing).
+    ProgressBar(std::string label, std::uint64_t total, bool enabled, int delay_ms = 0);
     ~ProgressBar();  // finishes the bar
     ProgressBar(const ProgressBar&) = delete;
     ProgressBar& operator=(const ProgressBar&) = delete;
 
     void add(std::uint64_t n) { done_.fetch_add(n, std::memory_order_relaxed); }
+    void set(std::uint64_t n) { done_.store(n, std::memory_order_relaxed); }
     void finish();
 
     static bool stderr_is_terminal();
@@ -31,8 +34,10 @@ private:
     std::string label_;
     std::uint64_t total_;
     bool enabled_;
+    bool delayed_;
     std::atomic<std::uint64_t> done_{0};
     std::atomic<bool> stop_{false};
+    std::atomic<bool> drawn_{false};
     std::thread thread_;
 
     void draw(bool final) const;

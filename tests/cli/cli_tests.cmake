@@ -128,7 +128,7 @@ lattice_cli_error(mesh_nan_ply ${BAD}/mesh-nan-ply.json "objects\\[1\\]\\.file: 
 lattice_cli_error(mesh_bad_index ${BAD}/mesh-bad-index.json "objects\\[1\\]\\.file: .*bad-index.obj: line 4: face 1 refers to vertex 9, but 3 vertices come before it")
 lattice_cli_error(mesh_random_bytes ${BAD}/mesh-random-bytes.json "objects\\[1\\]\\.file: .*random-bytes.ply: line 1: the PLY header holds the byte .x1f, which is not text")
 lattice_cli_error(mesh_open_in_csg ${BAD}/mesh-open-in-csg.json "objects\\[0\\]\\.children\\[1\\]\\.file: an open mesh cannot be a csg leaf")
-lattice_cli_error(scatter_huge_count ${BAD}/scatter-huge-count.json "objects\\[0\\]\\.count: 1000000000 instances is over the limit of 2000000")
+lattice_cli_error(scatter_huge_count ${BAD}/scatter-huge-count.json "objects\\[0\\]\\.count: 1000000000 instances is over the limit of 50000000")
 lattice_cli_error(scatter_no_box ${BAD}/scatter-no-box.json "objects\\[0\\]: missing field 'box': a cone is unbounded")
 lattice_cli_error(scatter_bad_scale ${BAD}/scatter-bad-scale.json "objects\\[0\\]\\.scale: min is over max")
 foreach(mode exact lattice)

@@ -21,6 +21,7 @@ TracedScene::TracedScene(const Scene& scene, const InstanceShapeFn& instance_sha
         }
         shapes_.push_back(std::move(s));
     }
+    accel_objects_.reserve(scene.objects.size());
     for (std::size_t i = 0; i < scene.objects.size(); ++i)
         accel_objects_.push_back({shapes_[i].get(), &scene.objects[i].xf,
                                   widest_footprints.empty() ? kInfinity : widest_footprints[i]});
