@@ -5,14 +5,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "coverage/footprint.h"
+
 namespace lat {
 namespace {
-
-// What a ray without a footprint is taken to have: a zero one (the finest level).
-constexpr RayFootprint kNoFootprint{};
-const RayFootprint& footprint_of(const Ray& r) {
-    return r.footprint ? *r.footprint : kNoFootprint;
-}
 
 // How far (in cells of a level) a ray answered through a level can pass from the primitive: a
 // pair blended in has its ends within sqrt(2) cells of the ray's (smooth: a neighbouring grid
@@ -204,11 +200,7 @@ bool FilteredLatticeShape::to_crossing(const Sheet& s, double finer, const Ray& 
 }
 
 double FilteredLatticeShape::footprint_width(const Ray& r) const {
-    // At the box's centre along the ray.
-    const double dd = dot(r.d, r.d);
-    const double tc = dot(bounds().center() - r.o, r.d) / dd;
-    const RayFootprint& f = footprint_of(r);
-    return (f.width0 + f.spread * std::max(0.0, tc)) * std::sqrt(dd);
+    return footprint_width_at(r, bounds().center());
 }
 
 void FilteredLatticeShape::add_tables(double level, bool normal, const Ray& r, double tmin,

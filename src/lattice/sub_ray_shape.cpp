@@ -6,18 +6,12 @@
 #include <cassert>
 #include <cmath>
 
+#include "coverage/footprint.h"
 #include "geometry/ray_quad.h"
 #include "lattice/answer_plan.h"
 
 namespace lat {
 namespace {
-
-// What a ray without a footprint is taken to have: a zero one (its own line), no directions
-// across it, no bound.
-constexpr RayFootprint kNoFootprint{};
-const RayFootprint& footprint_of(const Ray& r) {
-    return r.footprint ? *r.footprint : kNoFootprint;
-}
 
 // Exact crossings of a chain of at least this many parts test the parts' boxes first.
 constexpr std::size_t kMinBoxedParts = 8;
@@ -158,11 +152,7 @@ bool SubRayShape::to_crossing(const Sheet& s, const Ray& r, double tmin, double 
 }
 
 double SubRayShape::footprint_width(const Ray& r) const {
-    // At the box's centre along the ray.
-    const double dd = dot(r.d, r.d);
-    const double tc = dot(bounds().center() - r.o, r.d) / dd;
-    const RayFootprint& f = footprint_of(r);
-    return (f.width0 + f.spread * std::max(0.0, tc)) * std::sqrt(dd);
+    return footprint_width_at(r, bounds().center());
 }
 
 bool SubRayShape::cull_meets(std::size_t i, const Ray& r) const {
