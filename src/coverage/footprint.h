@@ -1,7 +1,7 @@
 #pragma once
-// Reading a ray's footprint (math/ray.h) where a shape answers it: the one formula for its
-// width at the shape, shared by the shapes that filter (prefiltered tables) or span (sub-rays)
-// across it.
+// Reading a ray's footprint (math/ray.h) where a shape answers it, and placing the sheet the
+// shape answers with on the ray: shared by the shapes that filter (prefiltered tables) or span
+// (sub-rays) across the footprint.
 #include <algorithm>
 #include <cmath>
 
@@ -23,6 +23,28 @@ inline double footprint_width_at(const Ray& r, Vec3 p) {
     const double tc = dot(p - r.o, r.d) / dd;
     const RayFootprint& f = footprint_of(r);
     return (f.width0 + f.spread * std::max(0.0, tc)) * std::sqrt(dd);
+}
+
+// Where a sheet (its points summed weighted by their coverage, `alpha` in all) meets ray r:
+// at its mean point, which lies near the ray, not on it, at the parameter of that point's
+// projection on the ray. False when the sheet covers nothing or the point is outside
+// (tmin, tmax).
+struct SheetOnRay {
+    double t = 0;
+    Vec3 p;              // the mean point
+    float coverage = 0;  // alpha; sums that round to just under 1 are opaque (1)
+    Vec3 facing;         // the unit normal facing the ray, for sheets without normals
+};
+inline bool sheet_on_ray(Vec3 sum_p, double alpha, const Ray& r, double tmin, double tmax,
+                         SheetOnRay& out) {
+    if (alpha <= 1e-6) return false;
+    const double dd = dot(r.d, r.d);
+    out.p = sum_p / alpha;
+    out.t = dot(out.p - r.o, r.d) / dd;
+    if (!(out.t > tmin && out.t < tmax)) return false;
+    out.coverage = alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(alpha);
+    out.facing = -r.d / std::sqrt(dd);
+    return true;
 }
 
 }  // namespace lat

@@ -169,14 +169,10 @@ bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool no
 
 bool FilteredLatticeShape::to_crossing(const Sheet& s, double finer, const Ray& r, double tmin,
                                        double tmax, bool normal, Crossing& hit) const {
-    if (s.alpha <= 1e-6) return false;
-    const double dd = dot(r.d, r.d);
-    const Vec3 p = s.p / s.alpha;
-    const double t = dot(p - r.o, r.d) / dd;
-    if (!(t > tmin && t < tmax)) return false;
     // Blends of full pairs round to just under 1: they are opaque (and end the ray's traversal).
-    const float coverage = s.alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(s.alpha);
-    const Vec3 facing = -r.d / std::sqrt(dd);
+    SheetOnRay on;
+    if (!sheet_on_ray(s.p, s.alpha, r, tmin, tmax, on)) return false;
+    const auto [t, p, coverage, facing] = on;
     if (!normal) {
         hit = Crossing(t, 0, SurfacePoint{p, facing});
         hit.coverage = coverage;

@@ -124,14 +124,10 @@ void SubRayShape::add_sub_rays(const SubRayHits& h, unsigned which, Sheet& s,
 
 bool SubRayShape::to_crossing(const Sheet& s, const Ray& r, double tmin, double tmax,
                               bool normal, Crossing& hit) {
-    if (s.alpha <= 1e-6) return false;
-    const double dd = dot(r.d, r.d);
-    const Vec3 p = s.p / s.alpha;
-    const double t = dot(p - r.o, r.d) / dd;
-    if (!(t > tmin && t < tmax)) return false;
     // All four sub-rays: opaque (and the end of the ray's traversal).
-    const float coverage = s.alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(s.alpha);
-    const Vec3 facing = -r.d / std::sqrt(dd);
+    SheetOnRay on;
+    if (!sheet_on_ray(s.p, s.alpha, r, tmin, tmax, on)) return false;
+    const auto [t, p, coverage, facing] = on;
     // The sub-rays of a ray whose directions across are the world's compose with the other
     // lattices' (LayerComposite); otherwise the coverage alone, as the tables'.
     const std::uint8_t sub_rays = footprint_of(r).across ? s.sub_rays : 0;
