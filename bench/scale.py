@@ -26,11 +26,12 @@ Writes RESULTS/scale.json (or --name) and prints a Markdown table.
 
 usage: scale.py LATTICE RESULTS [--work DIR] [--quick] [--sizes 20000,...] [--name scale]"""
 import argparse
-import hashlib
 import json
 import os
 import pathlib
 import subprocess
+
+from modes import ground_truth, psnr
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 SIZES = [20_000, 200_000, 1_000_000, 4_000_000]
@@ -79,23 +80,13 @@ def render(lattice, scene, image, work, args):
     return out
 
 
-def psnr(lattice, image, truth):
-    out = subprocess.run([lattice, "compare", str(image), str(truth), "--json"], check=True,
-                         capture_output=True, text=True).stdout
-    return json.loads(out)["psnr_db"]
-
-
 def truth_for(lattice, scene, work):
-    digest = hashlib.sha256(scene.read_bytes()).hexdigest()[:16]
-    path = work / f"truth-{scene.stem}-{TRUTH_SPP}spp-{digest}.png"
-    if not path.exists():
-        tmp = work / (path.name + ".tmp.png")
-        r = render(lattice, scene, tmp, work, ["--mode", "exact", "--spp", str(TRUTH_SPP),
-                                                "--sampler", "jitter"])
-        if "failed" in r:
-            return None
-        os.replace(tmp, path)
-    return path
+    """The exact render at TRUTH_SPP, cached by the scene's bytes as the modes benchmark keeps
+    its truths (modes.ground_truth); None when it cannot be rendered."""
+    try:
+        return ground_truth(lattice, scene, work, TRUTH_SPP)
+    except subprocess.CalledProcessError:
+        return None
 
 
 def measure(lattice, hairs, work, truth_up_to):
