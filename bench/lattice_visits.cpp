@@ -17,6 +17,8 @@
 #include <string>
 
 #include "coverage/sheets.h"
+#include "geometry/lattice_source.h"
+#include "geometry/parts.h"
 #include "io/image.h"
 #include "render/modes/integrators.h"
 #include "render/modes/scene_lattices.h"
@@ -29,10 +31,15 @@ struct Counts {
     std::atomic<std::uint64_t> intersect{0}, occluded{0}, spans{0}, shading{0};
 };
 
-class CountingShape final : public lat::Shape, public lat::SheetSource {
+class CountingShape final : public lat::Shape,
+                            public lat::SheetSource,
+                            public lat::Parts,
+                            public lat::CullParts,
+                            public lat::LatticeSource {
 public:
     CountingShape(std::shared_ptr<const lat::Shape> s, Counts& c)
-        : s_(std::move(s)), sheets_(lat::sheet_source(*s_)), c_(c) {}
+        : s_(std::move(s)), sheets_(lat::sheet_source(*s_)), parts_(*s_), cull_(*s_), source_(*s_),
+          c_(c) {}
 
     lat::Bounds3 bounds() const override { return s_->bounds(); }
     bool intersect(const lat::Ray& r, double tmin, double tmax, lat::Crossing& hit) const override {
@@ -62,47 +69,52 @@ public:
     }
     double surface_tolerance() const override { return s_->surface_tolerance(); }
     bool inside(lat::Vec3 p) const override { return s_->inside(p); }
-    std::size_t primitive_count() const override { return s_->primitive_count(); }
+    std::size_t part_count() const override { return parts_.part_count(); }
     // What the accelerator weighs (shadow rays' kept blockers) as the shape's own.
-    double intersect_cost() const override { return s_->intersect_cost(); }
-    lat::Bounds3 primitive_bounds(std::size_t i) const override { return s_->primitive_bounds(i); }
-    lat::Bounds3 primitive_bounds(std::size_t i, const lat::Transform& xf) const override {
-        return s_->primitive_bounds(i, xf);
+    double intersect_cost() const override { return source_.intersect_cost(); }
+    bool names_surface(const lat::Crossing& c) const override { return source_.names_surface(c); }
+    std::uint32_t surface_count() const override { return source_.surface_count(); }
+    lat::Bounds3 part_bounds(std::size_t i) const override { return parts_.part_bounds(i); }
+    lat::Bounds3 part_bounds(std::size_t i, const lat::Transform& xf) const override {
+        return parts_.part_bounds(i, xf);
     }
     lat::Bounds3 placed_bounds(const lat::Transform& xf) const override {
         return s_->placed_bounds(xf);
     }
-    bool intersect_primitive(std::size_t i, const lat::Ray& r, double tmin, double tmax,
-                             lat::Crossing& hit) const override {
+    bool intersect_part(std::size_t i, const lat::Ray& r, double tmin, double tmax,
+                        lat::Crossing& hit) const override {
         c_.intersect.fetch_add(1, std::memory_order_relaxed);
-        return s_->intersect_primitive(i, r, tmin, tmax, hit);
+        return parts_.intersect_part(i, r, tmin, tmax, hit);
     }
-    bool occluded_primitive(std::size_t i, const lat::Ray& r, double tmin,
-                            double tmax) const override {
+    bool occluded_part(std::size_t i, const lat::Ray& r, double tmin, double tmax) const override {
         c_.occluded.fetch_add(1, std::memory_order_relaxed);
-        return s_->occluded_primitive(i, r, tmin, tmax);
+        return parts_.occluded_part(i, r, tmin, tmax);
     }
-    void primitive_spans(std::size_t i, const lat::Ray& r, lat::SpanList& out) const override {
+    void part_spans(std::size_t i, const lat::Ray& r, lat::SpanList& out) const override {
         c_.spans.fetch_add(1, std::memory_order_relaxed);
-        s_->primitive_spans(i, r, out);
+        parts_.part_spans(i, r, out);
     }
-    void primitive_spheres(std::size_t i, std::vector<lat::BoundingSphere>& out) const override {
-        s_->primitive_spheres(i, out);
+    void part_spheres(std::size_t i, std::vector<lat::BoundingSphere>& out) const override {
+        parts_.part_spheres(i, out);
     }
-    std::size_t cull_count() const override { return s_->cull_count(); }
+    std::size_t cull_count() const override { return cull_.cull_count(); }
     lat::Bounds3 cull_bounds(std::size_t i, const lat::Transform& xf, double widest) const override {
-        return s_->cull_bounds(i, xf, widest);
+        return cull_.cull_bounds(i, xf, widest);
     }
     bool cull_meets(std::size_t i, const lat::Ray& r) const override {
-        return s_->cull_meets(i, r);
+        return cull_.cull_meets(i, r);
     }
-    std::uint32_t tag(const lat::Crossing& c, std::uint32_t fallback) const override {
-        return s_->tag(c, fallback);
+    bool cull_capsule(std::size_t i, const lat::Transform& xf, double widest,
+                      lat::Capsule& out) const override {
+        return cull_.cull_capsule(i, xf, widest, out);
     }
 
 private:
     std::shared_ptr<const lat::Shape> s_;
     const lat::SheetSource* sheets_;  // s_'s, if it has one: forwarded unchanged
+    lat::ShapeParts parts_;           // s_'s parts, cull parts and lattice answers, forwarded
+    lat::ShapeCull cull_;
+    lat::ShapeSource source_;
     Counts& c_;
 };
 

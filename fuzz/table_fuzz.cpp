@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/lattice_source.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/certify.h"
 #include "lattice/table_file.h"
@@ -60,7 +61,7 @@ void exercise(const std::string& path) {
             if (t.table->kind() == lat::LatticeTable::Kind::kCandidates) {
                 if (t.table->candidates(a, b, list))
                     for (int k = 0; k < list.count; ++k)
-                        if (list.parts[k] >= prim.shape->primitive_count()) __builtin_trap();
+                        if (list.parts[k] >= lat::ShapeSource(*prim.shape).piece_count()) __builtin_trap();
             } else if (t.table->lookup(a, b, hit) && !std::isfinite(hit.t)) {
                 __builtin_trap();
             }

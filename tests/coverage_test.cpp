@@ -12,6 +12,7 @@
 
 #include "csg/csg_shape.h"
 #include "geometry/chain.h"
+#include "geometry/lattice_source.h"
 #include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
 #include "hook_primitive.h"
@@ -675,11 +676,11 @@ TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
     std::ofstream(path) << scene;
     const Scene loaded = load_scene(path);
     const Shape& bead = *loaded.primitives[0].shape;
-    ASSERT_GT(bead.intersect_cost(), kMaxExactCost);  // its levels are tables
+    ASSERT_GT(ShapeSource(bead).intersect_cost(), kMaxExactCost);  // its levels are tables
     // The builds' work (a CSG tree: the pairs near its leaves) at sigma^-1 = 2 and 4.
     const double w1 = coverage_work({{4, 2, 4}, 0.5, 1.0, &bead});
     const double w2 = coverage_work({{8, 4, 8}, 0.25, 1.0, &bead});
-    ASSERT_LT(w2, static_cast<double>(BoundaryGrid::pair_count({8, 4, 8})) * bead.intersect_cost());
+    ASSERT_LT(w2, static_cast<double>(BoundaryGrid::pair_count({8, 4, 8})) * ShapeSource(bead).intersect_cost());
     ASSERT_GT(w2, w1);
     for (const double budget : {w2, w2 * 0.99, w1 * 0.99, 0.0}) {
         test::TempDir dir;

@@ -6,6 +6,7 @@
 
 #include "csg/csg_shape.h"
 #include "geometry/halfspace.h"
+#include "geometry/lattice_source.h"
 #include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
 
@@ -125,7 +126,7 @@ TEST(CsgTree, TreesAsLeavesKeepTheirOwnLists) {
 TEST(CsgTree, LeavesAwayFromALineCanBeSwitchedOff) {
     const auto csg = sample_tree();
     ASSERT_EQ(csg->piece_count(), 4u);
-    EXPECT_FALSE(csg->pieces_are_union());
+    EXPECT_FALSE(ShapeSource(*csg).pieces_are_union());
     std::mt19937 rng(9);
     std::uniform_real_distribution<double> u(-2, 2);
     int switched_off = 0;
@@ -174,8 +175,57 @@ TEST(CsgTree, SubtractedSurfaceNormalPointsOutOfTheResult) {
     ASSERT_TRUE(csg->intersect(r, 2.5, kInfinity, c));
     EXPECT_NEAR(c.t, 3.2, 1e-12);
     EXPECT_TRUE(c.flipped());
-    EXPECT_EQ(csg->tag(c, 0), 2u);
+    EXPECT_EQ(csg->surface_materials()[c.leaf_index()], 2u);
     EXPECT_NEAR(length(csg->normal(r, c) - Vec3{1, 0, 0}), 0, 1e-12);
+}
+
+// The materials of a tree's surfaces: its leaves' tags, and for a leaf that is itself a tree
+// (an instance of a CSG primitive), the inner tree's own where they have one, else the leaf's.
+TEST(CsgTree, NestedTreesNumberTheirSurfacesMaterials) {
+    auto inner = std::make_shared<CsgShape>();
+    const int own = inner->add_leaf({std::make_shared<SphereShape>(Vec3{0, 0, 0}, 1.0), {}, 7});
+    const int none = inner->add_leaf(
+        {std::make_shared<SphereShape>(Vec3{0.5, 0, 0}, 0.7), {}, kNoMaterial});
+    inner->set_root(inner->add_node(CsgOp::kUnion, {own, none}));
+    auto outer = std::make_shared<CsgShape>();
+    const int ball = outer->add_leaf({std::make_shared<SphereShape>(Vec3{3, 0, 0}, 0.5), {}, 1});
+    const int tree = outer->add_leaf({inner, {}, 2, 0});
+    outer->set_root(outer->add_node(CsgOp::kUnion, {ball, tree}));
+    const std::vector<std::uint32_t> want{1, 7, 2};
+    const auto got = outer->surface_materials();
+    EXPECT_EQ(std::vector<std::uint32_t>(got.begin(), got.end()), want);
+    EXPECT_TRUE(csg_surface_materials(SphereShape({0, 0, 0}, 1)).empty());
+
+    // A ray through the inner tree's second sphere alone names the surface of material 2 (the
+    // leaf's: that sphere has none).
+    Crossing c;
+    ASSERT_TRUE(outer->intersect({{0.9, 0, -5}, {0, 0, 1}}, 0, kInfinity, c));
+    EXPECT_EQ(outer->surface_materials()[c.leaf_index()], 2u);
+
+    // Swapped for a shape that numbers the primitive's surfaces as the tree does, the instance
+    // leaf keeps their materials; for a shape of one surface, it takes the leaf's tag.
+    // (As a `candidates` lattice of the tree does: the tree's crossings, not a tree itself.)
+    class NumbersTwo final : public Shape, public LatticeSource {
+    public:
+        Bounds3 bounds() const override { return {{-1, -1, -1}, {1, 1, 1}}; }
+        bool intersect(const Ray&, double, double, Crossing&) const override { return false; }
+        void spans(const Ray&, SpanList&) const override {}
+        Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
+        bool inside(Vec3) const override { return false; }
+        bool names_surface(const Crossing& c) const override { return c.leaf < 2; }
+        std::uint32_t surface_count() const override { return 2; }
+        double intersect_cost() const override { return 1; }
+    };
+    const auto same =
+        csg_with_primitive_shapes(*outer, [&](int) { return std::make_shared<NumbersTwo>(); });
+    ASSERT_TRUE(same);
+    const auto kept = csg_surface_materials(*same);
+    EXPECT_EQ(std::vector<std::uint32_t>(kept.begin(), kept.end()), want);
+    const auto one = csg_with_primitive_shapes(
+        *outer, [&](int) { return std::make_shared<SphereShape>(Vec3{0, 0, 0}, 1.0); });
+    const auto tagged = csg_surface_materials(*one);
+    EXPECT_EQ(std::vector<std::uint32_t>(tagged.begin(), tagged.end()),
+              (std::vector<std::uint32_t>{1, 2}));
 }
 
 TEST(CsgTree, BoundsFollowTheOperators) {

@@ -209,9 +209,9 @@ TEST_P(EveryEncoding, ForgedPayloadsAreRefusedOrSafe) {
                     TableHit hit;
                     CandidateList list;
                     if (!answer(*t.table, x, y, hit, list)) continue;
-                    ASSERT_LE(static_cast<std::size_t>(list.count), hook().primitive_count());
+                    ASSERT_LE(static_cast<std::size_t>(list.count), hook().part_count());
                     for (int k = 0; k < list.count; ++k)
-                        ASSERT_LT(list.parts[k], hook().primitive_count());
+                        ASSERT_LT(list.parts[k], hook().part_count());
                     ASSERT_TRUE(std::isfinite(hit.t) && std::isfinite(hit.normal.x)) << at;
                 }
         }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "geometry/chain.h"
+#include "geometry/lattice_source.h"
 #include "io/image_compare.h"
 #include "lattice/encodings/candidates/candidates_table.h"
 #include "lattice/cache/table_cache.h"
@@ -213,9 +214,9 @@ Image8 render_candidates(const Scene& s) {
 
 // A primitive that counts how it is asked: with some leaves switched off (pieces_spans), or
 // whole (the lattice's fallback when a span leaves the ray's chord).
-class CountingTree final : public Shape {
+class CountingTree final : public Shape, public LatticeSource, public Pieces {
 public:
-    explicit CountingTree(const Shape& tree) : tree_(tree) {}
+    explicit CountingTree(const Shape& tree) : tree_(tree), source_(tree) {}
     mutable int whole = 0, pieces = 0;
 
     Bounds3 bounds() const override { return tree_.bounds(); }
@@ -226,18 +227,20 @@ public:
     void spans(const Ray& r, SpanList& out) const override { ++whole, tree_.spans(r, out); }
     Vec3 normal(const Ray& r, const Crossing& c) const override { return tree_.normal(r, c); }
     bool inside(Vec3 p) const override { return tree_.inside(p); }
-    std::uint32_t surface_count() const override { return tree_.surface_count(); }
-    std::size_t piece_count() const override { return tree_.piece_count(); }
+    bool names_surface(const Crossing& c) const override { return c.part == 0; }
+    std::uint32_t surface_count() const override { return source_.surface_count(); }
+    double intersect_cost() const override { return 1.0; }
+    std::size_t piece_count() const override { return source_.piece_count(); }
     void piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override {
-        tree_.piece_spheres(i, out);
+        source_.piece_spheres(i, out);
     }
-    bool pieces_are_union() const override { return tree_.pieces_are_union(); }
     void pieces_spans(std::span<const std::uint32_t> on, const Ray& r, SpanList& out) const override {
-        ++pieces, tree_.pieces_spans(on, r, out);
+        ++pieces, source_.pieces_spans(on, r, out);
     }
 
 private:
     const Shape& tree_;
+    ShapeSource source_;  // the tree's (a CSG tree's: not the union of its pieces)
 };
 
 TEST(EncodingCandidates, CsgPrimitivesListTheirLeaves) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geometry/chain.h"
+#include "geometry/parts.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/face_cones.h"
 #include "lattice/octahedral.h"
@@ -79,9 +80,9 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, Expected> per_ray(const Shape&
             Crossing best;
             double tmax = 1.0 + 1e-12;
             bool hit = false;
-            for (std::size_t i = 0; i < s.primitive_count(); ++i) {
+            for (std::size_t i = 0; i < ShapeParts(s).part_count(); ++i) {
                 Crossing c;
-                if (s.intersect_primitive(i, r, 0.0, tmax, c)) tmax = c.t, best = c, hit = true;
+                if (ShapeParts(s).intersect_part(i, r, 0.0, tmax, c)) tmax = c.t, best = c, hit = true;
             }
             if (inside) best = nearest_crossing(s, r), hit = true;
             if (!hit) continue;

@@ -11,6 +11,7 @@
 #include "accel/embree_accel.h"
 #include "csg/csg_shape.h"
 #include "geometry/chain.h"
+#include "geometry/lattice_source.h"
 #include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
 #include "coverage/sheets.h"
@@ -167,7 +168,7 @@ TEST(FilteredCloseUps, CameraRaysGetTheirSubRaysCrossings) {
 // {3, 2} of lanes k = i n + j: a pair's live lanes are blocked when its first live one is.
 void expect_sheets_are_their_sub_rays_crossings(const Shape& prim, bool shadow,
                                                  int least_checked) {
-    const bool paired = shadow && prim.intersect_cost() > kMaxExactCost;
+    const bool paired = shadow && ShapeSource(prim).intersect_cost() > kMaxExactCost;
     const HookLattice h = hook_lattice(prim);
     const int n = kExactSubRays;
     const Bounds3 box{{0, 0, 0}, Vec3{4, 2, 4}};
@@ -249,8 +250,8 @@ const CsgShape& six_tori() {
 }
 
 TEST(FilteredCloseUps, SheetsAreTheirSubRaysCrossings) {
-    ASSERT_LT(hook().primitive_count(), 8u);
-    ASSERT_GE(long_hook().primitive_count(), 8u);
+    ASSERT_LT(hook().part_count(), 8u);
+    ASSERT_GE(long_hook().part_count(), 8u);
     ASSERT_LE(bitten_tori().intersect_cost(), kMaxExactCost);
     ASSERT_GT(six_tori().intersect_cost(), kMaxExactCost);
     for (const bool shadow : {false, true}) {
@@ -728,7 +729,7 @@ TEST(FilteredCloseUps, MeshesAnswerExactlyAndTreesCostTheirLeaves) {
             triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
         }
     const TriangleMeshShape sheet(positions, triangles);
-    ASSERT_GT(static_cast<double>(sheet.primitive_count()), kMaxExactCost);
+    ASSERT_GT(static_cast<double>(sheet.part_count()), kMaxExactCost);
     EXPECT_LE(sheet.intersect_cost(), kMaxExactCost);
     EXPECT_TRUE(answered_by_primitive(sheet));
     EXPECT_GT(differing_answers(sheet), 500);

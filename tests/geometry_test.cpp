@@ -8,6 +8,7 @@
 #include "geometry/capped_cylinder.h"
 #include "geometry/chain.h"
 #include "geometry/halfspace.h"
+#include "geometry/lattice_source.h"
 #include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
 #include "math/transform.h"
@@ -131,17 +132,17 @@ TEST(Chain, UnionOfPartsMergesSpans) {
     EXPECT_DOUBLE_EQ(c.t, 9);
     EXPECT_EQ(c.part >> 2, 2u);  // the cylinder, numbered after the two spheres
     EXPECT_NEAR(length(chain.normal({{-10, 0, 2}, {1, 0, 0}}, c) - Vec3{-1, 0, 0}), 0, 1e-15);
-    EXPECT_EQ(chain.primitive_count(), 3u);
+    EXPECT_EQ(chain.part_count(), 3u);
     EXPECT_TRUE(chain.inside({0, 0, 4.9}));
     EXPECT_FALSE(chain.inside({0.9, 0, 4.9}));
     // Its pieces (exact lattices) are its parts, and it is their union: the top sphere alone
     // is the span from 3 to 5, all three the capsule.
-    EXPECT_TRUE(chain.pieces_are_union());
+    EXPECT_TRUE(ShapeSource(chain).pieces_are_union());
     const Ray up{{0, 0, -10}, {0, 0, 1}};
     const std::uint32_t top[] = {1}, all[] = {0, 1, 2};
     SpanList one, three;
-    chain.pieces_spans(top, up, one);
-    chain.pieces_spans(all, up, three);
+    ShapeSource(chain).pieces_spans(top, up, one);
+    ShapeSource(chain).pieces_spans(all, up, three);
     ASSERT_EQ(one.size(), 1u);
     EXPECT_DOUBLE_EQ(one[0].in.t, 13);
     EXPECT_DOUBLE_EQ(one[0].out.t, 15);
@@ -199,12 +200,12 @@ TEST(Capsule, ChainCapsulesHoldTheirPartsAndJointSpheresAreContained) {
         parts.push_back(std::make_unique<CappedCylinderShape>(
             spheres[static_cast<std::size_t>(c.from)].center,
             spheres[static_cast<std::size_t>(c.to)].center, c.radius));
-    ASSERT_EQ(parts.size(), chain.primitive_count());
+    ASSERT_EQ(parts.size(), chain.part_count());
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> u(-1, 6);
-    for (std::size_t i = 0; i < chain.primitive_count(); ++i) {
+    for (std::size_t i = 0; i < chain.part_count(); ++i) {
         Capsule c;
-        ASSERT_TRUE(chain.primitive_capsule(i, c));
+        ASSERT_TRUE(chain.part_capsule(i, c));
         int inside = 0;
         for (int k = 0; k < 20000; ++k) {
             const Vec3 p{u(rng), u(rng), u(rng)};
@@ -215,9 +216,9 @@ TEST(Capsule, ChainCapsulesHoldTheirPartsAndJointSpheresAreContained) {
         EXPECT_GT(inside, 5) << i;
     }
     Capsule joint, cyl, thin;
-    chain.primitive_capsule(1, joint);  // the sphere at (1, 2, 3), radius 0.5
-    chain.primitive_capsule(3, cyl);    // the cylinder from sphere 0 to sphere 1, radius 0.5
-    chain.primitive_capsule(4, thin);   // radius 0.4: cannot hold the 0.5 sphere
+    chain.part_capsule(1, joint);  // the sphere at (1, 2, 3), radius 0.5
+    chain.part_capsule(3, cyl);    // the cylinder from sphere 0 to sphere 1, radius 0.5
+    chain.part_capsule(4, thin);   // radius 0.4: cannot hold the 0.5 sphere
     EXPECT_TRUE(cyl.contains(joint));
     EXPECT_FALSE(thin.contains(joint));
     EXPECT_TRUE(joint.contains(joint));
@@ -292,7 +293,7 @@ TEST(Torus, RingSpheresHoldTheSolid) {
     for (const auto& [major, minor] : {std::pair{3.0, 0.35}, {1.0, 0.6}, {2.0, 0.01}}) {
         const PlacedShape t = make_torus({0, 0, 0}, {0, 0, 1}, major, minor);
         std::vector<BoundingSphere> spheres;
-        t.shape->primitive_spheres(0, spheres);
+        ShapeParts(*t.shape).part_spheres(0, spheres);
         double volume = 0;
         for (const BoundingSphere& s : spheres) volume += 4.0 / 3 * M_PI * std::pow(s.radius, 3);
         const double box = std::pow(0.5 * length(t.shape->bounds().extent()), 3) * 4.0 / 3 * M_PI;

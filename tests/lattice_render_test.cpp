@@ -2,6 +2,7 @@
 // to exact and gets closer when refined; lattices shadow each other in Plate 2, not in Plate 1.
 #include <gtest/gtest.h>
 
+#include "geometry/parts.h"
 #include "io/image_compare.h"
 #include "lattice/encoding.h"
 #include "lattice/lattice_shape.h"
@@ -129,15 +130,16 @@ TEST_F(LatticeRender, CullingByThePrimitiveChangesNoPixel) {
                 const TableCache::Entry e = cache.get(plan, false);
                 culled[i] = make_lattice_shape(e.table, plan.context, plan.error_bound());
                 boxed[i] = make_lattice_shape(e.table, plan.context, kInfinity);
-                const std::size_t parts = culled[i]->cull_count();
+                const ShapeCull cull(*culled[i]);
+                const std::size_t parts = cull.cull_count();
                 double volume = 0;
                 for (std::size_t c = 0; c < parts; ++c) {
-                    const Bounds3 b = culled[i]->cull_bounds(c, Transform{}, kInfinity);
+                    const Bounds3 b = cull.cull_bounds(c, Transform{}, kInfinity);
                     volume += b.extent().x * b.extent().y * b.extent().z;
                 }
                 const Vec3 box = culled[i]->bounds().extent();
                 if (encoding != "candidates") {  // they cull by their parts in any case
-                    EXPECT_EQ(boxed[i]->cull_count(), 1u) << plate << " " << encoding;
+                    EXPECT_EQ(ShapeCull(*boxed[i]).cull_count(), 1u) << plate << " " << encoding;
                 }
                 if (thin) {
                     EXPECT_EQ(parts, 1u) << plate << " " << encoding;
@@ -167,7 +169,7 @@ TEST_F(LatticeRender, InstancesEnteredWholeChangeNoPixel) {
             TableSpec spec;
             spec.encoding = encoding;
             const SceneLattices l = scene_lattices(s, cache, spec, false);
-            ASSERT_GT(l.shapes[0]->cull_count(), 1u) << plate << " " << encoding;
+            ASSERT_GT(ShapeCull(*l.shapes[0]).cull_count(), 1u) << plate << " " << encoding;
             auto render = [&](std::size_t budget) {
                 AccelOptions opt;
                 opt.cull_part_budget = budget;
@@ -219,8 +221,8 @@ TEST_F(LatticeRender, TurnedInstancesAreCulledByTheirPlacedParts) {
         const Transform& xf = s.objects[0].xf;
         auto volume = [](const Bounds3& b) { return b.extent().x * b.extent().y * b.extent().z; };
         double culled_volume = 0;
-        for (std::size_t c = 0; c < culled->cull_count(); ++c)
-            culled_volume += volume(culled->cull_bounds(c, xf, kInfinity));
+        for (std::size_t c = 0; c < ShapeCull(*culled).cull_count(); ++c)
+            culled_volume += volume(ShapeCull(*culled).cull_bounds(c, xf, kInfinity));
         // Two halves of the lattice box, each bounded in world space (as before the placed
         // parts were used), gave 0.47 (hash14) and 0.25 (candidates) of the turned box's bounds.
         const double limit = encoding == "candidates" ? 0.2 : 0.4;

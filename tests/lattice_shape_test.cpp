@@ -114,7 +114,7 @@ Ray grazing(const LatticeFrame& frame, std::size_t i, const Transform& xf, const
 }
 
 // The accelerator rejects rays by a cull part's capsule placed in world space before mapping
-// them into the lattice's space (Shape::cull_capsule), kept in float (FloatCapsule): both must
+// them into the lattice's space (CullParts::cull_capsule), kept in float (FloatCapsule): both must
 // accept every line the shape's own test accepts, under rotations, uniform and non-uniform
 // scales, a shear (condition number near 400) and far translations, for lines found within
 // rounding of the capsules' surfaces, with origins near, 10^9 and 10^13 away; and they do reject

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "geometry/chain.h"
+#include "geometry/parts.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/encoding.h"
 #include "lattice/encodings/hash14/hash14_table.h"
@@ -70,8 +71,8 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, double> brute_force(const Shap
             const Vec3 p{double(pa.x), double(pa.y), double(pa.z)}, q{double(pb.x), double(pb.y), double(pb.z)};
             Crossing c;
             double best = kInfinity;
-            for (std::size_t i = 0; i < s.primitive_count(); ++i)
-                if (s.intersect_primitive(i, {p * lg.cell, (q - p) * lg.cell}, 0.0, 1.0 + 1e-12, c))
+            for (std::size_t i = 0; i < ShapeParts(s).part_count(); ++i)
+                if (ShapeParts(s).intersect_part(i, {p * lg.cell, (q - p) * lg.cell}, 0.0, 1.0 + 1e-12, c))
                     best = std::min(best, c.t);
             if (best <= 1.0) hits[{a, b}] = best;
         }

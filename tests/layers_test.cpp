@@ -15,6 +15,7 @@
 #include "accel/embree_accel.h"
 #include "coverage/layer_composite.h"
 #include "coverage/sheets.h"
+#include "geometry/parts.h"
 #include "render/core/shading.h"
 
 namespace lat {
@@ -22,7 +23,7 @@ namespace {
 
 // A unit square at height z, met by a ray with coverage alpha, as a prefiltered lattice's sheet
 // is; culled by `parts` boxes, so that a traversal meets each object several times.
-class Sheet final : public Shape {
+class Sheet final : public Shape, public CullParts {
 public:
     Sheet(double z, float alpha, std::size_t parts, double tolerance = 0)
         : z_(z), alpha_(alpha), parts_(parts), tolerance_(tolerance) {}
@@ -40,6 +41,7 @@ public:
     Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
     bool inside(Vec3) const override { return false; }
     double surface_tolerance() const override { return tolerance_; }
+    bool cull_meets(std::size_t, const Ray&) const override { return true; }
     std::size_t cull_count() const override { return parts_; }
     // Boxes reaching farther and farther back along the ray, so that a traversal meets other
     // objects between the parts of one (more than the ring of tested objects holds).
@@ -242,7 +244,7 @@ double specular_integral(double normal_length) {
 // A lattice whose sub-rays meet it at two depths (SheetSource): half of them on a unit square
 // at height z, the other half at z + dz, each sheet with its sub-rays' normals (k sheet's
 // k-th: turned k + 1 about x); culled by several boxes, as Sheet.
-class TwoSheets final : public Shape, public SheetSource {
+class TwoSheets final : public Shape, public SheetSource, public CullParts {
 public:
     // reach: how far back along the ray each cull box reaches beyond the one before.
     TwoSheets(double z, double dz, double reach = 6) : z_(z), dz_(dz), reach_(reach) {}
@@ -275,6 +277,7 @@ public:
     void spans(const Ray&, SpanList&) const override {}
     Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
     bool inside(Vec3) const override { return false; }
+    bool cull_meets(std::size_t, const Ray&) const override { return true; }
     std::size_t cull_count() const override { return 3; }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf, double) const override {
         return xf.bounds(
@@ -286,7 +289,7 @@ private:
 };
 
 // Met by a ray and never crossed, culled by two boxes: it fills the ring of tested objects.
-class Nothing final : public Shape {
+class Nothing final : public Shape, public CullParts {
 public:
     explicit Nothing(double z) : z_(z) {}
     Bounds3 bounds() const override { return {{-1, -1, z_ - 0.01}, {1, 1, z_ + 0.01}}; }
@@ -294,6 +297,7 @@ public:
     void spans(const Ray&, SpanList&) const override {}
     Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
     bool inside(Vec3) const override { return false; }
+    bool cull_meets(std::size_t, const Ray&) const override { return true; }
     std::size_t cull_count() const override { return 2; }
     Bounds3 cull_bounds(std::size_t, const Transform& xf, double) const override {
         return xf.bounds(bounds());

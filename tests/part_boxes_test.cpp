@@ -14,18 +14,33 @@
 namespace lat {
 namespace {
 
-// A primitive of boxes only: PartBoxes asks for nothing else.
-class Boxes final : public Shape {
+// A shape of parts that are boxes only (part_count, part_bounds): PartBoxes asks for nothing
+// else.
+class BoxParts : public Shape, public Parts {
 public:
-    std::vector<Bounds3> parts;
-    Bounds3 bounds() const override { return {{0, 0, 0}, {7, 7, 20}}; }
+    using Parts::part_bounds;
     bool intersect(const Ray&, double, double, Crossing&) const override { return false; }
     void spans(const Ray&, SpanList&) const override {}
     Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
     bool inside(Vec3) const override { return false; }
-    using Shape::primitive_bounds;
-    std::size_t primitive_count() const override { return parts.size(); }
-    Bounds3 primitive_bounds(std::size_t i) const override { return parts[i]; }
+    Bounds3 part_bounds(std::size_t i, const Transform& xf) const override {
+        return xf.bounds(part_bounds(i));
+    }
+    bool intersect_part(std::size_t, const Ray&, double, double, Crossing&) const override {
+        return false;
+    }
+    bool occluded_part(std::size_t, const Ray&, double, double) const override { return false; }
+    void part_spans(std::size_t, const Ray&, SpanList&) const override {}
+    void part_spheres(std::size_t, std::vector<BoundingSphere>&) const override {}
+};
+
+class Boxes final : public BoxParts {
+public:
+    using BoxParts::part_bounds;
+    std::vector<Bounds3> parts;
+    Bounds3 bounds() const override { return {{0, 0, 0}, {7, 7, 20}}; }
+    std::size_t part_count() const override { return parts.size(); }
+    Bounds3 part_bounds(std::size_t i) const override { return parts[i]; }
 };
 
 // The exact answer, in long double, on the unpadded box.
@@ -60,7 +75,7 @@ TEST(PartBoxes, FloatTestNeverRejectsAPartTheRayMeets) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(0, 1);
     const Boxes prim = random_boxes(rng, 200, 0.3, 1.5);
-    const PartBoxes boxes(prim, prim.bounds());
+    const PartBoxes boxes(ShapeParts(prim), prim.bounds());
     int met = 0;
     for (int n = 0; n < 20000; ++n) {
         const Bounds3& target = prim.parts[static_cast<std::size_t>(n) % prim.parts.size()];
@@ -92,7 +107,7 @@ TEST(PartBoxes, ListedPartsFourAtATimeAnswerAsOneAtATime) {
     std::mt19937 rng(9);
     std::uniform_real_distribution<double> u(0, 1);
     const Boxes prim = random_boxes(rng, 40, 0.3, 1.5);
-    const PartBoxes boxes(prim, prim.bounds());
+    const PartBoxes boxes(ShapeParts(prim), prim.bounds());
     std::uniform_int_distribution<std::uint32_t> pick(0, static_cast<std::uint32_t>(prim.parts.size() - 1));
     int met = 0, missed = 0;
     for (int n = 0; n < 5000; ++n) {
@@ -126,7 +141,7 @@ TEST(PartBoxes, NearPartsKeepEveryPartAParallelRayWithinGrowMeets) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(0, 1);
     const Boxes prim = random_boxes(rng, 60, 0.2, 1.0);
-    const PartBoxes boxes(prim, prim.bounds(), true);  // 60 parts: through the tree
+    const PartBoxes boxes(ShapeParts(prim), prim.bounds(), true);  // 60 parts: through the tree
     std::vector<std::uint32_t> near(prim.parts.size());
     int kept = 0, met = 0;
     for (int n = 0; n < 20000; ++n) {
@@ -164,7 +179,7 @@ TEST(PartBoxes, NearPartsFourAtATimeAreTheOneBoxTests) {
     std::uniform_real_distribution<double> u(0, 1);
     for (std::size_t parts = 1; parts <= 9; ++parts) {
         const Boxes prim = random_boxes(rng, static_cast<int>(parts), 0.5, 2.0);
-        const PartBoxes boxes(prim, prim.bounds());
+        const PartBoxes boxes(ShapeParts(prim), prim.bounds());
         std::vector<std::uint32_t> near(parts), one_by_one;
         std::size_t kept = 0;
         for (int n = 0; n < 4000; ++n) {
@@ -198,7 +213,7 @@ TEST(PartBoxes, NearPartsThroughTheTreeAreTheFlatScans) {
     std::size_t few = 0, many = 0;  // tree searches finding up to 16 parts (insertion), or more
     for (const int parts : {int(PartBoxes::kTreeFrom) + 1, 100, 1000, 5000}) {
         const Boxes prim = random_boxes(rng, parts, parts > 500 ? 0.1 : 0.4, 1.0);
-        const PartBoxes boxes(prim, prim.bounds(), true);
+        const PartBoxes boxes(ShapeParts(prim), prim.bounds(), true);
         std::vector<std::uint32_t> near(prim.parts.size()), flat;
         std::size_t kept = 0;
         for (int n = 0; n < 3000; ++n) {
@@ -249,7 +264,7 @@ TEST(PartBoxes, DegenerateBoxesMakeATreeThatAnswersAsTheFlatScan) {
             const double h = nested ? 0.001 * (i + 1) : 0.5;
             prim.parts.push_back({c - Vec3{h, h, h}, c + Vec3{h, h, h}});
         }
-        const PartBoxes boxes(prim, prim.bounds(), true);
+        const PartBoxes boxes(ShapeParts(prim), prim.bounds(), true);
         std::vector<std::uint32_t> near(prim.parts.size());
         for (int n = 0; n < 200; ++n) {
             const Vec3 p = c + Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * 6.0;
@@ -275,24 +290,20 @@ TEST(PartBoxes, DegenerateBoxesMakeATreeThatAnswersAsTheFlatScan) {
 TEST(PartBoxes, AnUnboundedPartLeavesTheTreeAnsweringAsTheFlatScan) {
     std::mt19937 rng(19);
     std::uniform_real_distribution<double> u(0, 1);
-    class Unbounded final : public Shape {
+    class Unbounded final : public BoxParts {
     public:
+        using BoxParts::part_bounds;
         Boxes inner;
         Bounds3 bounds() const override { return inner.bounds(); }
-        bool intersect(const Ray&, double, double, Crossing&) const override { return false; }
-        void spans(const Ray&, SpanList&) const override {}
-        Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
-        bool inside(Vec3) const override { return false; }
-        using Shape::primitive_bounds;
-        std::size_t primitive_count() const override { return inner.parts.size() + 1; }
-        Bounds3 primitive_bounds(std::size_t i) const override {
+        std::size_t part_count() const override { return inner.parts.size() + 1; }
+        Bounds3 part_bounds(std::size_t i) const override {
             return i == 7 ? Bounds3{Vec3{-kInfinity, 0, 0}, Vec3{kInfinity, 1, 1}}
                           : inner.parts[i < 7 ? i : i - 1];
         }
     } prim;
     prim.inner = random_boxes(rng, 60, 0.4, 1.0);
-    const PartBoxes boxes(prim, prim.bounds(), true);
-    std::vector<std::uint32_t> near(prim.primitive_count());
+    const PartBoxes boxes(ShapeParts(prim), prim.bounds(), true);
+    std::vector<std::uint32_t> near(prim.part_count());
     for (int n = 0; n < 500; ++n) {
         const Vec3 p = Vec3{u(rng), u(rng), u(rng)} * Vec3{7, 7, 20};
         const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
@@ -300,7 +311,7 @@ TEST(PartBoxes, AnUnboundedPartLeavesTheTreeAnsweringAsTheFlatScan) {
         const std::size_t count = boxes.near_parts(r, 0.1, 0.0, near);
         const PartBoxes::Ray4 slabs(boxes, r);
         std::vector<std::uint32_t> flat;
-        for (std::uint32_t i = 0; i < prim.primitive_count(); ++i)
+        for (std::uint32_t i = 0; i < prim.part_count(); ++i)
             if (slabs.meets_grown4(i / 4, slabs.range(0.0, kInfinity),
                                    PartBoxes::Ray4::grow(0.1)) >>
                     (i % 4) &
@@ -332,7 +343,7 @@ struct WavyHairBoxes {
     WavyHairBoxes(double fx, double fy, double r)
         : wavy(fx, fy, r),
           hair(wavy.spheres, wavy.cylinders),
-          boxes(hair, {{0, 0, 0}, {7, 7, 20}}) {}
+          boxes(ShapeParts(hair), {{0, 0, 0}, {7, 7, 20}}) {}
 };
 
 // A union's first crossing over its parts, box-tested first (what filtered lattices blend in),
@@ -343,7 +354,7 @@ TEST(PartBoxes, FirstCrossingOverAllPartsIsTheUnions) {
     std::uniform_real_distribution<double> u(0, 1);
     const WavyHairBoxes h(0.7, 0.5, 0.3);
     const auto& [spheres, hair, boxes] = std::tie(h.wavy.spheres, h.hair, h.boxes);
-    std::vector<std::uint32_t> all(hair.primitive_count());
+    std::vector<std::uint32_t> all(hair.part_count());
     for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
     int hits = 0;
     for (int n = 0; n < 20000; ++n) {
@@ -355,7 +366,7 @@ TEST(PartBoxes, FirstCrossingOverAllPartsIsTheUnions) {
         const double tmin = n % 4 == 0 ? 0.5 : 0.0, tmax = n % 5 == 0 ? 2.0 : kInfinity;
         Crossing want, got;
         const bool w = hair.intersect(r, tmin, tmax, want);
-        const bool g = boxes.first_crossing(hair, all, r, tmin, tmax, got);
+        const bool g = boxes.first_crossing(ShapeParts(hair), all, r, tmin, tmax, got);
         ASSERT_EQ(w, g) << "ray " << n;
         if (!w) continue;
         ++hits;
@@ -377,11 +388,11 @@ TEST(PartBoxes, ListsOfEveryLengthAnswerAsALoopOverTheirParts) {
     int boxed_hits = 0, short_hits = 0;
     for (int n = 0; n < 20000; ++n) {
         std::vector<std::uint32_t> listed;
-        const std::size_t length = 1 + static_cast<std::size_t>(n) % hair.primitive_count();
-        for (std::uint32_t i = 0; i < hair.primitive_count(); ++i)
-            if (u(rng) < double(length) / double(hair.primitive_count())) listed.push_back(i);
+        const std::size_t length = 1 + static_cast<std::size_t>(n) % hair.part_count();
+        for (std::uint32_t i = 0; i < hair.part_count(); ++i)
+            if (u(rng) < double(length) / double(hair.part_count())) listed.push_back(i);
         if (listed.empty())
-            listed.push_back(static_cast<std::uint32_t>(n % int(hair.primitive_count())));
+            listed.push_back(static_cast<std::uint32_t>(n % int(hair.part_count())));
         const ChainSphere& aim = spheres[static_cast<std::size_t>(n) % spheres.size()];
         const Vec3 d = normalize(Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
         const Vec3 jitter = Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * 1.2;
@@ -393,11 +404,11 @@ TEST(PartBoxes, ListsOfEveryLengthAnswerAsALoopOverTheirParts) {
         double until = tmax;
         for (const std::uint32_t part : listed) {
             Crossing c;
-            if (hair.intersect_primitive(part, r, tmin, until, c)) want = c, until = c.t, w = true;
-            blocks = blocks || hair.occluded_primitive(part, r, tmin, tmax);
+            if (hair.intersect_part(part, r, tmin, until, c)) want = c, until = c.t, w = true;
+            blocks = blocks || hair.occluded_part(part, r, tmin, tmax);
         }
-        ASSERT_EQ(w, boxes.first_crossing(hair, listed, r, tmin, tmax, got)) << "ray " << n;
-        ASSERT_EQ(blocks, boxes.any_occludes(hair, listed, r, tmin, tmax)) << "ray " << n;
+        ASSERT_EQ(w, boxes.first_crossing(ShapeParts(hair), listed, r, tmin, tmax, got)) << "ray " << n;
+        ASSERT_EQ(blocks, boxes.any_occludes(ShapeParts(hair), listed, r, tmin, tmax)) << "ray " << n;
         if (!w) continue;
         (listed.size() > PartBoxes::kFewParts ? boxed_hits : short_hits) += 1;
         ASSERT_EQ(want.t, got.t) << "ray " << n;

@@ -158,7 +158,7 @@ TEST(RayQuad, ChainLanesAreTheScalarLoopsOverParts) {
     for (int n = 0; n < 4000; ++n) {
         // Any order of any parts: ties go to the earlier listed part in both.
         std::vector<std::uint32_t> parts;
-        for (std::uint32_t i = 0; i < hook.primitive_count(); ++i)
+        for (std::uint32_t i = 0; i < hook.part_count(); ++i)
             if (rng() % 3 != 0) parts.push_back(i);
         std::shuffle(parts.begin(), parts.end(), rng);
         const Vec3 target = lerp(box.lo, box.hi, 0.5 + 0.3 * (double(rng() % 101) / 50 - 1));

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "geometry/parts.h"
 #include "scene/scene_loader.h"
 #include "test_paths.h"
 #include "util/error.h"
@@ -61,7 +62,7 @@ TEST(SceneLoader, ValidSceneLoads) {
     EXPECT_EQ(s.camera.width, 32);
     EXPECT_EQ(s.objects.size(), 5u);
     EXPECT_EQ(s.objects[3].primitive, 0);
-    EXPECT_EQ(s.primitives[0].shape->primitive_count(), 3u);
+    EXPECT_EQ(ShapeParts(*s.primitives[0].shape).part_count(), 3u);
     ASSERT_TRUE(s.primitives[0].lattice.has_value());
     EXPECT_EQ(s.primitives[0].lattice->cells[2], 3);
 }

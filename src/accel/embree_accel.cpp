@@ -14,6 +14,7 @@
 #include "accel/embree_query.h"
 #include "accel/embree_rays.h"
 #include "accel/space_order.h"
+#include "geometry/lattice_source.h"
 #include "math/float_round.h"
 #include "util/progress.h"
 
@@ -68,14 +69,15 @@ struct EmbreeAccel::Impl {
         for (const std::uint32_t i : order) {
             const AccelObject& o = given_objects[i];
             numbered[i] = static_cast<std::uint32_t>(objects.size());
-            objects.push_back({o.shape, sheet_source(*o.shape), o.xf, o.xf->inverse_map(),
+            objects.push_back({o.shape, sheet_source(*o.shape), parts_of(*o.shape),
+                               cull_parts_of(*o.shape), o.xf, o.xf->inverse_map(),
                                o.widest_footprint, i, o.xf->is_identity(),
                                keeps_directions_across(*o.xf)});
             bounds.push_back(given_bounds[i]);
         }
     }
     // The top-level user geometry of single-part objects: one primitive per cull part
-    // (Shape::cull_count).
+    // (CullParts::cull_count).
     // Read on every callback, so kept small: 36 bytes, the bounds (read only while Embree
     // builds) apart. Its loads are the callbacks' main cost (cache misses): with the capsule in
     // double beside the bounds, its test saved grass 4 % of its time; this way, 5 %.
@@ -83,7 +85,7 @@ struct EmbreeAccel::Impl {
         std::uint32_t object;
         std::uint32_t cull : 31;   // the object's cull part
         std::uint32_t shared : 1;  // one of several cull parts of its object
-        FloatCapsule capsule;      // Shape::cull_capsule, if it has one
+        FloatCapsule capsule;      // CullParts::cull_capsule, if it has one
     };
     static_assert(sizeof(DirectPrim) == 36);
     static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
@@ -100,15 +102,11 @@ struct EmbreeAccel::Impl {
     // Objects of several cull parts enter as one primitive each (place_whole): past
     // AccelOptions::cull_part_budget.
     bool enter_whole = false;
-    struct Prototype {
-        const Shape* shape;
-        RTCScene scene;
-    };
-    std::map<const Shape*, Prototype> prototypes;
+    std::map<const Parts*, RTCScene> prototypes;  // one scene per shape of several parts
     std::string error;
 
     ~Impl() {
-        for (auto& [s, p] : prototypes) rtcReleaseScene(p.scene);
+        for (auto& [parts, s] : prototypes) rtcReleaseScene(s);
         if (scene) rtcReleaseScene(scene);
         if (device) rtcReleaseDevice(device);
     }
@@ -146,12 +144,14 @@ struct EmbreeAccel::Impl {
         if (!d.shared) return true;
         return !ctx->tested_already(d.object) && d.capsule.meets_line(ctx->ray.o, ctx->ray.d);
     }
-    bool first_visit(QueryContext* ctx, unsigned prim, const Shape& shape, const Ray& local) const {
+    bool first_visit(QueryContext* ctx, unsigned prim, const Ray& local) const {
         const DirectPrim& d = direct[prim];
         if (!d.shared) return true;
+        // Only shapes of several cull parts share them.
+        const CullParts& cull = *objects[d.object].cull;
         if (d.cull == kEveryPart) {
-            if (!meets_any_cull_part(shape, local)) return false;
-        } else if (!shape.cull_meets(d.cull, local)) {
+            if (!meets_any_cull_part(cull, local)) return false;
+        } else if (!cull.cull_meets(d.cull, local)) {
             return false;
         }
         ctx->mark_tested(d.object);
@@ -160,9 +160,9 @@ struct EmbreeAccel::Impl {
     // An object entered whole (place_whole): its cull parts tested in its own space, the
     // shape's, so that they cost the instance nothing.
     static constexpr std::uint32_t kEveryPart = 0x7FFFFFFFu;
-    static bool meets_any_cull_part(const Shape& shape, const Ray& local) {
-        for (std::size_t c = 0; c < shape.cull_count(); ++c)
-            if (shape.cull_meets(c, local)) return true;
+    static bool meets_any_cull_part(const CullParts& cull, const Ray& local) {
+        for (std::size_t c = 0; c < cull.cull_count(); ++c)
+            if (cull.cull_meets(c, local)) return true;
         return false;
     }
 
@@ -204,10 +204,10 @@ struct EmbreeAccel::Impl {
         const Target t = self->template target<K>(args->primID, inst);
         if constexpr (K == Kind::kDirect)
             if (!self->may_visit(ctx, args->primID)) return;
-        const Shape& shape = *self->objects[t.object].shape;
+        const Placed& o = self->objects[t.object];
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
-            if (!self->first_visit(ctx, args->primID, shape, local)) return;
+            if (!self->first_visit(ctx, args->primID, local)) return;
         self->hand_across(ctx, t.object);
         assert(ctx->hit);         // rtcIntersect1 runs only for intersect and intersect_layers
         assert(!ctx->shadow());  // shadow rays: occluded_cb, blocks_transmittance
@@ -221,8 +221,8 @@ struct EmbreeAccel::Impl {
                 return self->add_sheets(ctx, rh, t.object, local, tmin, tmax, geom, prim);
         Crossing c;
         const bool hit = K == Kind::kDirect
-                             ? shape.intersect(local, tmin, tmax, c)
-                             : shape.intersect_primitive(t.part, local, tmin, tmax, c);
+                             ? o.shape->intersect(local, tmin, tmax, c)
+                             : o.parts->intersect_part(t.part, local, tmin, tmax, c);
         // A shape of several parts (chains, meshes) is opaque: only a whole shape (a lattice)
         // answers with partial sheets.
         assert(!ctx->sink || c.coverage >= 1.0f || !hit);
@@ -262,13 +262,13 @@ struct EmbreeAccel::Impl {
     // blocks it, opaque or with the partial crossings met so far letting too little through
     // (then written to the query's hit, as intersect_layers reads it).
     template <Kind K>
-    bool blocks_transmittance(QueryContext* ctx, Target t, const Shape& shape, const Ray& local,
+    bool blocks_transmittance(QueryContext* ctx, Target t, const Placed& o, const Ray& local,
                               double tmin) const {
         assert(ctx->hit && ctx->shadow());
         Crossing c;
         const bool hit = K == Kind::kDirect
-                             ? shape.intersect(local, tmin, ctx->tmax, c)
-                             : shape.intersect_primitive(t.part, local, tmin, ctx->tmax, c);
+                             ? o.shape->intersect(local, tmin, ctx->tmax, c)
+                             : o.parts->intersect_part(t.part, local, tmin, ctx->tmax, c);
         if (!hit) return false;
         const AccelHit h = caller_hit(c.t, t.object, c);
         if (c.coverage < 1.0f && !ctx->sink->add_shadow(h)) return false;
@@ -288,7 +288,7 @@ struct EmbreeAccel::Impl {
         const double tmin = occlusion_tmin(&ctx, ctx.self, local);
         const Target t{ctx.self, 0};
         if (ctx.shadow())
-            ctx.found = blocks_transmittance<Kind::kDirect>(&ctx, t, *o.shape, local, tmin);
+            ctx.found = blocks_transmittance<Kind::kDirect>(&ctx, t, o, local, tmin);
         else
             ctx.found = o.shape->occluded(local, tmin, ctx.tmax);
         if (ctx.found) ctx.blocker = blocker_of<Kind::kDirect>(t);
@@ -315,18 +315,18 @@ struct EmbreeAccel::Impl {
         if (!last || last->trust == 0 || last->object >= objects.size()) return false;
         const Placed& o = objects[last->object];
         const bool whole = last->part == EmbreeAccel::kWhole;
-        assert(whole ? o.cheap_blocker : last->part < o.shape->primitive_count());
+        assert(whole ? o.cheap_blocker : o.parts && last->part < o.parts->part_count());
         if (whole && last->object == ctx.self) return false;
         const Ray local = object_ray(o, ctx);
         const double tmin = occlusion_tmin(&ctx, last->object, local);
         bool blocked;
         if (ctx.shadow()) {  // a transmittance: a partial crossing it meets is kept
             const Target t{last->object, whole ? 0 : last->part};
-            blocked = whole ? blocks_transmittance<Kind::kDirect>(&ctx, t, *o.shape, local, tmin)
-                            : blocks_transmittance<Kind::kFlat>(&ctx, t, *o.shape, local, tmin);
+            blocked = whole ? blocks_transmittance<Kind::kDirect>(&ctx, t, o, local, tmin)
+                            : blocks_transmittance<Kind::kFlat>(&ctx, t, o, local, tmin);
         } else {
             blocked = whole ? o.shape->occluded(local, tmin, ctx.tmax)
-                            : o.shape->occluded_primitive(last->part, local, tmin, ctx.tmax);
+                            : o.parts->occluded_part(last->part, local, tmin, ctx.tmax);
         }
         if (blocked) {
             last->trust = EmbreeAccel::kMaxTrust;
@@ -356,19 +356,19 @@ struct EmbreeAccel::Impl {
         if constexpr (K == Kind::kDirect)
             if (t.object == ctx->self || !self->may_visit(ctx, args->primID)) return;
         if (ctx->tested_first.same(tested_as<K>(t))) return;
-        const Shape& shape = *self->objects[t.object].shape;
+        const Placed& o = self->objects[t.object];
         const Ray& local = self->local_ray(ctx, t.object);
         if constexpr (K == Kind::kDirect)
-            if (!self->first_visit(ctx, args->primID, shape, local)) return;
+            if (!self->first_visit(ctx, args->primID, local)) return;
         self->hand_across(ctx, t.object);
         const double tmin = self->occlusion_tmin(ctx, t.object, local);
         bool hit;
         if (ctx->shadow())
-            hit = self->blocks_transmittance<K>(ctx, t, shape, local, tmin);
+            hit = self->blocks_transmittance<K>(ctx, t, o, local, tmin);
         else if constexpr (K == Kind::kDirect)
-            hit = shape.occluded(local, tmin, ctx->tmax);
+            hit = o.shape->occluded(local, tmin, ctx->tmax);
         else
-            hit = shape.occluded_primitive(t.part, local, tmin, ctx->tmax);
+            hit = o.parts->occluded_part(t.part, local, tmin, ctx->tmax);
         if (hit) {
             ctx->found = true;
             ctx->blocker = self->template blocker_of<K>(t);
@@ -380,7 +380,7 @@ struct EmbreeAccel::Impl {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
         const FlatPrim fp = self->flat[args->primID];
         const Placed& o = self->objects[fp.object];
-        *args->bounds_o = to_rtc_bounds(o.shape->primitive_bounds(fp.part, *o.xf));
+        *args->bounds_o = to_rtc_bounds(o.parts->part_bounds(fp.part, *o.xf));
     }
 
     static void bounds_direct(const RTCBoundsFunctionArguments* args) {
@@ -389,8 +389,8 @@ struct EmbreeAccel::Impl {
     }
 
     static void bounds_proto(const RTCBoundsFunctionArguments* args) {
-        const auto* shape = static_cast<const Shape*>(args->geometryUserPtr);
-        *args->bounds_o = to_rtc_bounds(shape->primitive_bounds(args->primID));
+        const auto* parts = static_cast<const Parts*>(args->geometryUserPtr);
+        *args->bounds_o = to_rtc_bounds(parts->part_bounds(args->primID));
     }
 
     // One user geometry of n primitives with these callbacks, attached to scene s.
@@ -415,21 +415,22 @@ struct EmbreeAccel::Impl {
         if (wb.empty()) return;
         if (!embree_can_hold(wb)) {
             unbounded.push_back(i);
-        } else if (o.shape->primitive_count() > 1 && flatten) {
-            for (std::uint32_t p = 0; p < o.shape->primitive_count(); ++p) flat.push_back({i, p});
-        } else if (o.shape->primitive_count() > 1) {
+        } else if (part_count(o) > 1 && flatten) {
+            for (std::uint32_t p = 0; p < o.parts->part_count(); ++p) flat.push_back({i, p});
+        } else if (part_count(o) > 1) {
             place_instance(i);
         } else if (enter_whole && enters_whole(o)) {
             place_whole(i, wb);
         } else {
-            const std::size_t parts = o.shape->cull_count();
+            const ShapeCull cull(*o.shape);
+            const std::size_t parts = cull.cull_count();
             for (std::uint32_t c = 0; c < parts; ++c) {
-                Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);
+                Bounds3 b = cull.cull_bounds(c, *o.xf, o.widest_footprint);
                 if (parts == 1) b = lat::intersect(wb, b);  // a lone part: within the object's box
                 if (b.empty()) continue;
                 direct.push_back(direct_prim(i, c, parts > 1, o));
                 o.direct = true;
-                o.cheap_blocker = o.shape->intersect_cost() <= EmbreeAccel::kCheapBlockerCost;
+                o.cheap_blocker = cheap_to_test(o);
                 direct_bounds.push_back(b);
             }
         }
@@ -444,18 +445,31 @@ struct EmbreeAccel::Impl {
         if (b.empty()) return;
         direct.push_back({i, kEveryPart, 1, {}});  // no capsule: every line meets it
         o.direct = true;
-        o.cheap_blocker = o.shape->intersect_cost() <= EmbreeAccel::kCheapBlockerCost;
+        o.cheap_blocker = cheap_to_test(o);
         direct_bounds.push_back(b);
     }
 
+    static std::size_t part_count(const Placed& o) { return o.parts ? o.parts->part_count() : 1; }
+    static std::size_t cull_count(const Placed& o) { return o.cull ? o.cull->cull_count() : 1; }
+    // Asked of consecutive objects, which mostly share their shape (instances), once a shape.
+    const Shape* cost_asked = nullptr;
+    bool cost_cheap = false;
+    bool cheap_to_test(const Placed& o) {
+        if (o.shape != cost_asked) {
+            cost_asked = o.shape;
+            cost_cheap = ShapeSource(*o.shape).intersect_cost() <= EmbreeAccel::kCheapBlockerCost;
+        }
+        return cost_cheap;
+    }
+
     static bool enters_whole(const Placed& o) {
-        return o.shape->primitive_count() <= 1 && o.shape->cull_count() > 1;
+        return part_count(o) <= 1 && cull_count(o) > 1;
     }
     // The bounds of an object entered whole, whose world box is wb: its cull parts' together.
     static Bounds3 whole_bounds(const Placed& o, const Bounds3& wb) {
         Bounds3 b;
-        for (std::size_t c = 0; c < o.shape->cull_count(); ++c)
-            b = merge(b, o.shape->cull_bounds(c, *o.xf, o.widest_footprint));
+        for (std::size_t c = 0; c < o.cull->cull_count(); ++c)
+            b = merge(b, o.cull->cull_bounds(c, *o.xf, o.widest_footprint));
         return lat::intersect(wb, b);
     }
 
@@ -463,7 +477,7 @@ struct EmbreeAccel::Impl {
     void place_instance(std::uint32_t i) {
         const Placed& o = objects[i];
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
-        rtcSetGeometryInstancedScene(g, prototype_scene(o.shape));
+        rtcSetGeometryInstancedScene(g, prototype_scene(o.parts));
         const Affine& a = o.xf->forward();
         float xfm[12];
         for (int r = 0; r < 3; ++r) {
@@ -480,15 +494,15 @@ struct EmbreeAccel::Impl {
         inst_object[id] = i;
     }
 
-    RTCScene prototype_scene(const Shape* shape) {
-        auto it = prototypes.find(shape);
-        if (it != prototypes.end()) return it->second.scene;
+    RTCScene prototype_scene(const Parts* parts) {
+        auto it = prototypes.find(parts);
+        if (it != prototypes.end()) return it->second;
         RTCScene s = rtcNewScene(device);
         rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
-        attach_user_geometry(s, shape->primitive_count(), const_cast<Shape*>(shape), bounds_proto,
+        attach_user_geometry(s, parts->part_count(), const_cast<Parts*>(parts), bounds_proto,
                              intersect_cb<Kind::kProto>, occluded_cb<Kind::kProto>);
         rtcCommitScene(s);
-        prototypes[shape] = {shape, s};
+        prototypes[parts] = s;
         return s;
     }
 };
@@ -501,7 +515,7 @@ EmbreeAccel::Impl::DirectPrim EmbreeAccel::Impl::direct_prim(std::uint32_t objec
                                                              std::uint32_t cull, bool shared,
                                                              const Placed& o) {
     DirectPrim d{object, cull, shared, {}};
-    if (Capsule c; shared && o.shape->cull_capsule(cull, *o.xf, o.widest_footprint, c))
+    if (Capsule c; shared && o.cull->cull_capsule(cull, *o.xf, o.widest_footprint, c))
         d.capsule = FloatCapsule::holding(c);
     return d;
 }
@@ -519,12 +533,12 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
 
     std::size_t parts = 0;
     for (const Placed& o : m.objects)
-        if (o.shape->primitive_count() > 1) parts += o.shape->primitive_count();
+        if (Impl::part_count(o) > 1) parts += Impl::part_count(o);
     m.flatten = opt.instancing == Instancing::kNever ||
                 (opt.instancing == Instancing::kAuto && parts <= opt.flatten_budget);
     std::size_t cull_parts = 0;
     for (const Placed& o : m.objects)
-        if (Impl::enters_whole(o)) cull_parts += o.shape->cull_count();
+        if (Impl::enters_whole(o)) cull_parts += Impl::cull_count(o);
     m.enter_whole = cull_parts > opt.cull_part_budget;
     // Objects entered whole are bounded by their cull parts together, a bound made in
     // parallel (place is sequential).

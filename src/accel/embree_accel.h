@@ -18,7 +18,7 @@ struct AccelObject {
     const Shape* shape = nullptr;
     const Transform* xf = nullptr;  // object -> world; must outlive the accelerator
     // The widest footprint (object units) of the rays the object is traced with, for shapes
-    // whose culling narrows with it (Shape::cull_bounds; lattices answered by sub-rays): each
+    // whose culling narrows with it (CullParts::cull_bounds; lattices answered by sub-rays): each
     // instance gets its own, from how near the camera it stands. Infinity: any.
     double widest_footprint = kInfinity;
 };

@@ -14,6 +14,7 @@
 #include "coverage/layer_sink.h"
 #include "coverage/sheets.h"
 #include "coverage/sub_rays.h"
+#include "geometry/parts.h"
 
 namespace lat::embree_detail {
 
@@ -25,6 +26,8 @@ namespace lat::embree_detail {
 struct Placed {
     const Shape* shape;
     const SheetSource* sheets;  // the shape's, if it has more than its closest crossing to give
+    const Parts* parts;         // the shape's, if it has several parts (geometry/parts.h)
+    const CullParts* cull;      // the shape's, if it is culled by parts of its own
     const Transform* xf;        // object -> world
     Affine inverse;       // xf's inverse map
     double widest_footprint;

@@ -65,11 +65,19 @@ void combine_spans(const SpanList& a, const SpanList& b, CsgOp op, SpanList& out
 }
 
 int CsgShape::add_leaf(CsgLeaf leaf) {
+    const std::span<const std::uint32_t> inner = csg_surface_materials(*leaf.shape);
+    return add_leaf(std::move(leaf), inner);
+}
+
+int CsgShape::add_leaf(CsgLeaf leaf, std::span<const std::uint32_t> inner) {
     const Bounds3 b = leaf.shape->placed_bounds(leaf.xf);
-    const std::uint32_t first = surfaces_, count = leaf.shape->surface_count();
+    const ShapeSource source(*leaf.shape);
+    const std::uint32_t first = surfaces_, count = source.surface_count();
     assert(count >= 1 && room_for(*leaf.shape));
     surfaces_ += count;
-    leaves_.push_back({std::move(leaf), b, count > 1, first});
+    for (std::uint32_t k = 0; k < count; ++k)
+        materials_.push_back(inner.size() == count && inner[k] != kNoMaterial ? inner[k] : leaf.tag);
+    leaves_.push_back({std::move(leaf), source, b, count > 1, first});
     return -static_cast<int>(leaves_.size());
 }
 
@@ -133,7 +141,14 @@ std::shared_ptr<CsgShape> CsgShape::with_primitive_shapes(const PrimitiveShapeFn
     for (const Leaf& l : leaves_) {
         CsgLeaf leaf = l.leaf;
         if (leaf.primitive >= 0) leaf.shape = shape(leaf.primitive);
-        out->add_leaf(std::move(leaf));
+        // A shape that numbers the primitive's surfaces (a `candidates` lattice of a tree)
+        // keeps their materials.
+        const std::uint32_t count = ShapeSource(*leaf.shape).surface_count();
+        const std::span<const std::uint32_t> kept(materials_.data() + l.first_surface,
+                                                  l.source.surface_count());
+        const std::span<const std::uint32_t> inner =
+            count == kept.size() ? kept : csg_surface_materials(*leaf.shape);
+        out->add_leaf(std::move(leaf), inner);
     }
     out->nodes_ = nodes_;
     out->set_root(root_);
@@ -184,7 +199,7 @@ void CsgShape::eval(int ref, const Ray& r, SpanList& out, const LeafSet* on) con
 
 double CsgShape::intersect_cost() const {
     double cost = 0;
-    for (const Leaf& l : leaves_) cost += l.leaf.shape ? l.leaf.shape->intersect_cost() : 1.0;
+    for (const Leaf& l : leaves_) cost += l.leaf.shape ? l.source.intersect_cost() : 1.0;
     return cost;
 }
 
@@ -215,11 +230,11 @@ void CsgShape::piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) co
         out.push_back({{0, 0, 0}, kInfinity});
         return;
     }
-    const Shape& shape = *leaf.leaf.shape;
+    const ShapeParts& parts = leaf.source.parts();
     const Transform& xf = leaf.leaf.xf;
     const double stretch = xf.max_stretch();
     const std::size_t first = out.size();
-    for (std::size_t j = 0; j < shape.primitive_count(); ++j) shape.primitive_spheres(j, out);
+    for (std::size_t j = 0; j < parts.part_count(); ++j) parts.part_spheres(j, out);
     for (std::size_t k = first; k < out.size(); ++k)
         out[k] = {xf.point(out[k].center), out[k].radius * stretch};
 }
@@ -237,13 +252,7 @@ CsgShape::Located CsgShape::locate(const Crossing& c) const {
 bool CsgShape::names_surface(const Crossing& c) const {
     if (c.leaf_index() >= surfaces_) return false;
     const Located at = locate(c);
-    return at.leaf->leaf.shape->names_surface(at.in_leaf);
-}
-
-std::uint32_t CsgShape::tag(const Crossing& c, std::uint32_t fallback) const {
-    const Located at = locate(c);
-    const std::uint32_t t = at.leaf->leaf.shape->tag(at.in_leaf, at.leaf->leaf.tag);
-    return t == kNoMaterial ? fallback : t;
+    return at.leaf->source.names_surface(at.in_leaf);
 }
 
 Vec3 CsgShape::normal(const Ray& r, const Crossing& c) const {
@@ -257,7 +266,7 @@ Vec3 CsgShape::normal(const Ray& r, const Crossing& c) const {
 
 bool CsgShape::cheap_normal(const Crossing& c) const {
     const Located at = locate(c);
-    return at.leaf->leaf.shape->cheap_normal(at.in_leaf);
+    return at.leaf->source.cheap_normal(at.in_leaf);
 }
 
 SurfacePoint CsgShape::surface(const Ray& r, const Crossing& c) const {
@@ -280,6 +289,22 @@ bool CsgShape::inside(int ref, Vec3 p) const {
     bool v = inside(n.children[0], p);
     for (std::size_t k = 1; k < n.children.size(); ++k) v = apply(n.op, v, inside(n.children[k], p));
     return v;
+}
+
+std::span<const std::uint32_t> csg_surface_materials(const Shape& s) {
+    const auto* csg = dynamic_cast<const CsgShape*>(&s);
+    return csg ? csg->surface_materials() : std::span<const std::uint32_t>{};
+}
+
+std::vector<int> csg_leaf_primitives(const Shape& s) {
+    const auto* csg = dynamic_cast<const CsgShape*>(&s);
+    return csg ? csg->leaf_primitives() : std::vector<int>{};
+}
+
+std::shared_ptr<const Shape> csg_with_primitive_shapes(const Shape& s,
+                                                       const CsgShape::PrimitiveShapeFn& shape) {
+    const auto* csg = dynamic_cast<const CsgShape*>(&s);
+    return csg ? csg->with_primitive_shapes(shape) : nullptr;
 }
 
 }  // namespace lat

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "geometry/lattice_source.h"
 #include "geometry/shape.h"
 #include "math/transform.h"
 
@@ -15,7 +16,7 @@ enum class CsgOp { kUnion, kIntersection, kDifference };
 
 // A leaf tag meaning "no material of its own": the object's material applies.
 inline constexpr std::uint32_t kNoMaterial = 0xFFFFFFFFu;
-// Surfaces one tree can number (Shape::surface_count): a crossing's leaf field below its flip
+// Surfaces one tree can number (LatticeSource::surface_count): a crossing's leaf field below its flip
 // bit. Instances of CSG primitives as leaves multiply them.
 inline constexpr std::uint32_t kMaxCsgSurfaces = Crossing::kFlipBit - 1;
 
@@ -26,13 +27,15 @@ struct CsgLeaf {
     int primitive = -1;     // for an instance of a scene primitive: its index
 };
 
-class CsgShape final : public Shape {
+class CsgShape final : public Shape, public LatticeSource, public Pieces {
 public:
     // Children are references returned by add_leaf / add_node. Nodes are n-ary: union and
     // intersection of all children; difference is the first child minus all the others.
     int add_leaf(CsgLeaf leaf);  // requires room_for(*leaf.shape)
     // Whether the tree can number the surfaces of one more leaf of this shape.
-    bool room_for(const Shape& s) const { return s.surface_count() <= kMaxCsgSurfaces - surfaces_; }
+    bool room_for(const Shape& s) const {
+        return ShapeSource(s).surface_count() <= kMaxCsgSurfaces - surfaces_;
+    }
     int add_node(CsgOp op, std::vector<int> children);
     // Ends construction; the tree must be non-empty.
     void set_root(int ref);
@@ -43,6 +46,11 @@ public:
     // no leaf is an instance.
     using PrimitiveShapeFn = std::function<std::shared_ptr<const Shape>(int primitive)>;
     std::shared_ptr<CsgShape> with_primitive_shapes(const PrimitiveShapeFn& shape) const;
+
+    // The material of each surface the leaf field of its crossings numbers (kNoMaterial: the
+    // object's): a leaf's tag, or, for a leaf that is itself a tree, its own surfaces'
+    // materials where they have one.
+    std::span<const std::uint32_t> surface_materials() const { return materials_; }
 
     Bounds3 bounds() const override;
     // The tree's bounds from its leaves' own placed bounds: tighter than the box of the box.
@@ -64,12 +72,10 @@ public:
     // The tree evaluates every leaf whose bounds the ray meets: their costs, summed.
     double intersect_cost() const override;
     void piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
-    bool pieces_are_union() const override { return false; }
     void pieces_spans(std::span<const std::uint32_t> on, const Ray& r,
                       SpanList& out) const override;
     // The largest of the leaves' (lattices have one), in this shape's units.
     double surface_tolerance() const override { return tolerance_; }
-    std::uint32_t tag(const Crossing& c, std::uint32_t fallback) const override;
 
 private:
     // A crossing's leaf field numbers surfaces: one per leaf, except that a leaf whose shape
@@ -77,11 +83,15 @@ private:
     // lattice) has a range, so that normals and materials are those of the surface crossed.
     struct Leaf {
         CsgLeaf leaf;
+        ShapeSource source;           // leaf.shape's
         Bounds3 bounds;               // in CSG coordinates
         bool numbered;                // its shape names several surfaces
         std::uint32_t first_surface;  // its numbers: [first_surface, + its surface_count())
     };
     std::uint32_t surfaces_ = 0;
+    std::vector<std::uint32_t> materials_;  // per surface number (surface_materials)
+    // add_leaf, with the materials of the leaf's own surfaces (empty: the leaf's tag for all).
+    int add_leaf(CsgLeaf leaf, std::span<const std::uint32_t> inner);
     // The leaf of crossing c, and c as that leaf reported it (its flip bit cleared: this
     // tree's flips count them all).
     struct Located {
@@ -112,5 +122,16 @@ private:
 // out = a op b for sorted, disjoint span lists; boundaries that b contributes to a difference
 // get their flip bit toggled. Zero-length results are dropped.
 void combine_spans(const SpanList& a, const SpanList& b, CsgOp op, SpanList& out);
+
+// The materials of a CSG tree's surfaces (CsgShape::surface_materials); empty for any other
+// shape, whose crossings take the object's material.
+std::span<const std::uint32_t> csg_surface_materials(const Shape& s);
+// The scene primitives that a CSG tree's instance leaves refer to (with repeats); none for any
+// other shape.
+std::vector<int> csg_leaf_primitives(const Shape& s);
+// A copy of a CSG tree whose instance leaves trace shape(primitive) instead (lattice mode);
+// null for any other shape, or a tree without instance leaves.
+std::shared_ptr<const Shape> csg_with_primitive_shapes(const Shape& s,
+                                                       const CsgShape::PrimitiveShapeFn& shape);
 
 }  // namespace lat

@@ -47,11 +47,11 @@ Bounds3 AlgebraicShape::placed_bounds(const Transform& xf) const {
 // the chord 2 ring sin(pi / 2n) of it; n ~ 3 pi ring / ball keeps that chord near a third of the
 // ball (at most 128 spheres): candidate lists of the CSG of tori then leave out 8 % more leaves
 // than with a chord near the ball.
-void AlgebraicShape::primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
-    if (!has_extent_ || extent_.ring <= 0) {
-        if (has_extent_) out.push_back({{0, 0, 0}, extent_.ball});
-        else Shape::primitive_spheres(i, out);
-        return;
+bool AlgebraicShape::bounding_spheres(std::vector<BoundingSphere>& out) const {
+    if (!has_extent_) return false;
+    if (extent_.ring <= 0) {
+        out.push_back({{0, 0, 0}, extent_.ball});
+        return true;
     }
     const double want = std::ceil(3 * std::numbers::pi * extent_.ring / extent_.ball);  // or inf
     const int n = static_cast<int>(std::clamp(want, 3.0, 128.0));
@@ -61,6 +61,7 @@ void AlgebraicShape::primitive_spheres(std::size_t i, std::vector<BoundingSphere
         const double a = 2 * std::numbers::pi * k / n;
         out.push_back({{extent_.ring * std::cos(a), extent_.ring * std::sin(a), 0}, r});
     }
+    return true;
 }
 
 // The solid lies within `ball` of the ring: in the slab |z| <= ball and, there, at a distance

@@ -2,12 +2,13 @@
 // Surfaces f(x, y, z) = 0 of degree <= 4 (paper 3.2.1), f < 0 inside, intersected in closed
 // form: the ray is restricted to a univariate polynomial and solved by solve_quartic (or the
 // quadratic formula for quadrics). Normals are the normalised gradient.
+#include "geometry/lattice_source.h"
 #include "geometry/poly3.h"
 #include "geometry/shape.h"
 
 namespace lat {
 
-class AlgebraicShape final : public Shape {
+class AlgebraicShape final : public Shape, public LatticeSource {
 public:
     // bounds: a box known to hold the whole surface (infinite if unbounded); centre: a point
     // near the surface, used to move the ray origin close before solving (the main source of
@@ -24,6 +25,8 @@ public:
 
     const Poly3& polynomial() const { return f_; }
     int degree() const { return degree_; }
+    // Its one surface, part 0.
+    bool names_surface(const Crossing& c) const override { return c.part == 0; }
     bool cheap_normal(const Crossing&) const override { return degree_ <= 2; }
     // In spheres' tests: a quartic's closed-form solve takes about 12 times a sphere's, a
     // cubic's 9 (quartic_bench: 174, 132 and 14.8 ns a ray).
@@ -32,8 +35,8 @@ public:
     Bounds3 bounds() const override { return bounds_; }
     Bounds3 placed_bounds(const Transform& xf) const override;
     // With a ring extent, a ring of spheres along the circle (a torus's box sphere holds its
-    // hole and more); else the sphere around the box.
-    void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
+    // hole and more), or the one ball; without, none tighter than the box's.
+    bool bounding_spheres(std::vector<BoundingSphere>& out) const override;
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     void spans(const Ray& r, SpanList& out) const override;
     Vec3 normal(const Ray& r, const Crossing& c) const override;

@@ -1,4 +1,5 @@
 #pragma once
+#include "geometry/lattice_source.h"
 #include "geometry/shape.h"
 
 namespace lat {
@@ -10,7 +11,7 @@ struct FanHits;
 
 // A finite cylinder of radius r whose axis runs from a to b, with flat ends.
 // Crossing::part: 0 the side, 1 the end at a, 2 the end at b.
-class CappedCylinderShape final : public Shape {
+class CappedCylinderShape final : public Shape, public LatticeSource {
 public:
     CappedCylinderShape(Vec3 a, Vec3 b, double radius);
 
@@ -21,6 +22,7 @@ public:
     Vec3 normal(const Ray& r, const Crossing& c) const override;
     // The side (0) and the two caps (1, 2).
     bool names_surface(const Crossing& c) const override { return c.part <= 2; }
+    double intersect_cost() const override { return 1.0; }
     bool inside(Vec3 p) const override;
 
     // The span of the ray's line inside the cylinder, if any (t0 < t1, parts as above).

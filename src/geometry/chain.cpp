@@ -13,7 +13,7 @@ ChainShape::ChainShape(std::vector<ChainSphere> spheres, std::vector<ChainCylind
     for (const ChainCylinder& c : cylinders_)
         cyl_parts_.emplace_back(spheres_[static_cast<std::size_t>(c.from)].center,
                                 spheres_[static_cast<std::size_t>(c.to)].center, c.radius);
-    for (std::size_t i = 0; i < primitive_count(); ++i) {
+    for (std::size_t i = 0; i < part_count(); ++i) {
         bounds_ = merge(bounds_, part(i).bounds());
         all_parts_.push_back(static_cast<std::uint32_t>(i));
     }
@@ -24,9 +24,9 @@ const Shape& ChainShape::part(std::size_t i) const {
     return cyl_parts_[i - sphere_parts_.size()];
 }
 
-Bounds3 ChainShape::primitive_bounds(std::size_t i) const { return part(i).bounds(); }
+Bounds3 ChainShape::part_bounds(std::size_t i) const { return part(i).bounds(); }
 
-void ChainShape::primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
+void ChainShape::part_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
     if (i < sphere_parts_.size()) {
         out.push_back({sphere_parts_[i].center(), sphere_parts_[i].radius()});
         return;
@@ -49,7 +49,7 @@ bool ChainShape::intersect(const Ray& r, double tmin, double tmax, Crossing& hit
 }
 
 bool ChainShape::occluded(const Ray& r, double tmin, double tmax) const {
-    for (std::size_t i = 0; i < primitive_count(); ++i)
+    for (std::size_t i = 0; i < part_count(); ++i)
         if (part(i).occluded(r, tmin, tmax)) return true;
     return false;
 }
@@ -80,7 +80,7 @@ unsigned ChainShape::blocked_lanes(std::span<const std::uint32_t> parts, const R
     return blocked;
 }
 
-void ChainShape::primitive_spans(std::size_t i, const Ray& r, SpanList& out) const {
+void ChainShape::part_spans(std::size_t i, const Ray& r, SpanList& out) const {
     const std::size_t before = out.size();
     part(i).spans(r, out);
     for (std::size_t k = before; k < out.size(); ++k) {
@@ -91,7 +91,7 @@ void ChainShape::primitive_spans(std::size_t i, const Ray& r, SpanList& out) con
 
 void ChainShape::spans(const Ray& r, SpanList& out) const {
     const std::size_t first = out.size();
-    for (std::size_t i = 0; i < primitive_count(); ++i) primitive_spans(i, r, out);
+    for (std::size_t i = 0; i < part_count(); ++i) part_spans(i, r, out);
     merge_span_union(out, first);
 }
 
@@ -99,7 +99,7 @@ Vec3 ChainShape::normal(const Ray& r, const Crossing& c) const {
     return part(c.part >> 2).normal(r, {c.t, c.part & 3u, 0});
 }
 
-bool ChainShape::primitive_capsule(std::size_t i, Capsule& out) const {
+bool ChainShape::part_capsule(std::size_t i, Capsule& out) const {
     if (i < spheres_.size()) {
         out = {spheres_[i].center, spheres_[i].center, spheres_[i].radius};
     } else {
@@ -111,9 +111,11 @@ bool ChainShape::primitive_capsule(std::size_t i, Capsule& out) const {
 }
 
 bool ChainShape::inside(Vec3 p) const {
-    for (std::size_t i = 0; i < primitive_count(); ++i)
+    for (std::size_t i = 0; i < part_count(); ++i)
         if (part(i).inside(p)) return true;
     return false;
 }
+
+const ChainShape* as_chain(const Shape& s) { return dynamic_cast<const ChainShape*>(&s); }
 
 }  // namespace lat

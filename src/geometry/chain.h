@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "geometry/capped_cylinder.h"
+#include "geometry/lattice_source.h"
+#include "geometry/parts.h"
 #include "geometry/sphere.h"
 
 namespace lat {
@@ -21,13 +23,13 @@ struct ChainCylinder {
 
 // Parts are numbered spheres first, then cylinders. Crossing::part = part << 2 | sub, where
 // sub is the cylinder's surface (0 side, 1 and 2 the ends) and 0 for spheres.
-class ChainShape final : public Shape {
+class ChainShape final : public Shape, public Parts, public LatticeSource {
 public:
     ChainShape(std::vector<ChainSphere> spheres, std::vector<ChainCylinder> cylinders);
 
     const std::vector<ChainSphere>& spheres() const { return spheres_; }
     const std::vector<ChainCylinder>& cylinders() const { return cylinders_; }
-    // Its parts' indices, 0 to primitive_count() - 1, in the order intersect() tests them.
+    // Its parts' indices, 0 to part_count() - 1, in the order intersect() tests them.
     std::span<const std::uint32_t> all_parts() const { return all_parts_; }
 
     Bounds3 bounds() const override { return bounds_; }
@@ -37,17 +39,22 @@ public:
     Vec3 normal(const Ray& r, const Crossing& c) const override;
     // A part's index in the high bits, its own part number in the low two.
     bool names_surface(const Crossing& c) const override {
-        return (c.part >> 2) < primitive_count() && part(c.part >> 2).names_surface({c.t, c.part & 3u, 0});
+        const std::size_t i = c.part >> 2, spheres = sphere_parts_.size();
+        if (i >= part_count()) return false;
+        return i < spheres ? (c.part & 3u) == 0
+                           : cyl_parts_[i - spheres].names_surface({c.t, c.part & 3u, 0});
     }
     bool inside(Vec3 p) const override;
+    // Its parts, tested one by one.
+    double intersect_cost() const override { return static_cast<double>(part_count()); }
 
-    std::size_t primitive_count() const override { return sphere_parts_.size() + cyl_parts_.size(); }
-    Bounds3 primitive_bounds(std::size_t i) const override;
-    Bounds3 primitive_bounds(std::size_t i, const Transform& xf) const override {
+    std::size_t part_count() const override { return sphere_parts_.size() + cyl_parts_.size(); }
+    Bounds3 part_bounds(std::size_t i) const override;
+    Bounds3 part_bounds(std::size_t i, const Transform& xf) const override {
         return part(i).placed_bounds(xf);
     }
     // Inline and through the parts' concrete types: the rasterizer's innermost call.
-    bool intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
+    bool intersect_part(std::size_t i, const Ray& r, double tmin, double tmax,
                              Crossing& hit) const override {
         const bool found = i < sphere_parts_.size()
                                ? sphere_parts_[i].intersect(r, tmin, tmax, hit)
@@ -56,16 +63,16 @@ public:
         return found;
     }
     // Part i against two rays from one origin (geometry/ray_fan.h): the lanes (bits 0, 1) that
-    // intersect_primitive finds a crossing for, with the part's own surface number in out.part.
+    // intersect_part finds a crossing for, with the part's own surface number in out.part.
     unsigned intersect_fan(std::size_t i, const RayFan& f, FanHits& out) const {
         return i < sphere_parts_.size() ? sphere_parts_[i].intersect_fan(f, out)
                                         : cyl_parts_[i - sphere_parts_.size()].intersect_fan(f, out);
     }
-    void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
-    void primitive_spans(std::size_t i, const Ray& r, SpanList& out) const override;
+    void part_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
+    void part_spans(std::size_t i, const Ray& r, SpanList& out) const override;
     // Spheres are capsules; so is the flat-ended cylinder's rim, within r of its axis segment.
-    bool primitive_capsule(std::size_t i, Capsule& out) const override;
-    bool occluded_primitive(std::size_t i, const Ray& r, double tmin, double tmax) const override {
+    bool part_capsule(std::size_t i, Capsule& out) const override;
+    bool occluded_part(std::size_t i, const Ray& r, double tmin, double tmax) const override {
         return part(i).occluded(r, tmin, tmax);
     }
 
@@ -84,11 +91,16 @@ private:
     std::vector<SphereShape> sphere_parts_;
     std::vector<CappedCylinderShape> cyl_parts_;
     Bounds3 bounds_;
-    // 0 to primitive_count() - 1 (std::views::iota does not build with clang 14, the fuzzing
+    // 0 to part_count() - 1 (std::views::iota does not build with clang 14, the fuzzing
     // compiler, and g++ 12's library).
     std::vector<std::uint32_t> all_parts_;
 
     const Shape& part(std::size_t i) const;
 };
+
+// The chain s is, if it is one: the typed view that the rasterizer, coverage builds, sub-rays
+// and the particle baseline take to trace the common primitive through its concrete parts,
+// four or two rays at a time and without virtual calls in their innermost loops.
+const ChainShape* as_chain(const Shape& s);
 
 }  // namespace lat

@@ -60,12 +60,6 @@ void merge_span_union(SpanList& spans, std::size_t first) {
     spans.resize(w);
 }
 
-void Shape::pieces_spans(std::span<const std::uint32_t> on, const Ray& r, SpanList& out) const {
-    const std::size_t first = out.size();
-    for (const std::uint32_t i : on) primitive_spans(i, r, out);
-    merge_span_union(out, first);
-}
-
 Crossing nearest_crossing(const Shape& shape, const Ray& r) {
     SpanList spans;
     shape.spans(r, spans);

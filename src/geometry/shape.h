@@ -1,6 +1,8 @@
 #pragma once
 // The solid-shape interface: every leaf of the scene (quartic, sphere, sphere/cylinder chain,
-// lattice instance) and every CSG tree implements it in its own coordinates.
+// lattice instance) and every CSG tree implements it in its own coordinates. It holds only
+// geometry: what the accelerator, lattice tables and coverage ask besides, a shape offers
+// through the opt-in interfaces named at the end of the class.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -155,122 +157,17 @@ public:
     virtual double span_tolerance() const { return surface_tolerance(); }
     // Whether p is inside the solid (boundary counts as either).
     virtual bool inside(Vec3 p) const = 0;
-    // Whether c's part (and CSG leaf) name a surface of this shape, so that normal() may be
-    // asked for it: crossings read from files (lattice tables) are checked with it first.
-    virtual bool names_surface(const Crossing& c) const { return c.part == 0; }
-    // How many surfaces the leaf field of this shape's crossings can name, each with its own
-    // normal and material (a CSG tree: one per surface of its leaves); 1 for shapes whose
-    // crossings need no such name.
-    virtual std::uint32_t surface_count() const { return 1; }
-    // Whether normal() at c is a few flops (a plane, quadric, sphere or cylinder), not the
-    // gradient of a quartic: `dense` tables store a hit's part, to re-evaluate its normal at
-    // every lookup, only where that is cheap.
-    virtual bool cheap_normal(const Crossing&) const { return true; }
-
-    // About how many simple tests (a sphere's or a cylinder's) one intersect() makes: what a
-    // lattice weighs before tracing its primitive exactly where its tables could answer
-    // (lattice/answer_plan.h). By default its primitives, tested one by one.
-    virtual double intersect_cost() const { return static_cast<double>(primitive_count()); }
-
-    // Shapes made of many parts (sphere/cylinder chains) expose them so the accelerator can
-    // build a hierarchy over them; by default the shape is one primitive.
-    virtual std::size_t primitive_count() const { return 1; }
-    virtual Bounds3 primitive_bounds(std::size_t) const { return bounds(); }
-    // The bounds of a primitive placed by xf.
-    virtual Bounds3 primitive_bounds(std::size_t, const Transform& xf) const {
-        return placed_bounds(xf);
-    }
     // The bounds of the shape placed by xf; round shapes override this to be tighter than the
     // box around the transformed box.
     virtual Bounds3 placed_bounds(const Transform& xf) const { return xf.bounds(bounds()); }
-    virtual bool intersect_primitive(std::size_t, const Ray& r, double tmin, double tmax,
-                                     Crossing& hit) const {
-        return intersect(r, tmin, tmax, hit);
-    }
-    virtual bool occluded_primitive(std::size_t, const Ray& r, double tmin, double tmax) const {
-        return occluded(r, tmin, tmax);
-    }
-    virtual void primitive_spans(std::size_t, const Ray& r, SpanList& out) const { spans(r, out); }
-
-    // Spheres that together enclose primitive i (for culling by cones, as rasterization does);
-    // by default the sphere around its box. Long parts give several smaller spheres.
-    virtual void primitive_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
-        const Bounds3 b = primitive_bounds(i);
-        out.push_back({b.center(), 0.5 * length(b.extent())});
-    }
-
-    // A capsule holding primitive i, when the shape knows one (chains do): lattices cull with
-    // them, grown by how far their answers can stray.
-    virtual bool primitive_capsule(std::size_t, Capsule&) const { return false; }
-
-    // Pieces: what an exact lattice (`candidates`) lists per grid-point pair, the pieces of the
-    // shape that a ray near the pair's segment can meet; the others are switched off for the
-    // ray. By default the pieces are the primitives and the shape is their union, so a listed
-    // piece is intersected on its own (intersect_primitive). Shapes that are not the union of
-    // their pieces (CSG: its leaves) say so and answer pieces_spans.
-    virtual std::size_t piece_count() const { return primitive_count(); }
-    // Spheres that together enclose the solid of piece i.
-    virtual void piece_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
-        primitive_spheres(i, out);
-    }
-    virtual bool pieces_are_union() const { return true; }
-    // Appends the spans of r's whole line through the solid made of the pieces `on` (ascending)
-    // with every other piece empty: the shape's own spans wherever the solids of the pieces
-    // switched off are away from the line.
-    virtual void pieces_spans(std::span<const std::uint32_t> on, const Ray& r, SpanList& out) const;
-
-    // Culling parts: regions the accelerator prunes rays with, for shapes it answers as a whole
-    // (a lattice gives parts hugging its primitive, much tighter than its lattice box). A ray
-    // gets a crossing from this shape only if its line meets one of them, and a shadow ray is
-    // occluded only if it does. By default one part, the bounds.
-    virtual std::size_t cull_count() const { return 1; }
-    // The bounds of cull part i placed by xf. widest: the widest footprint (shape units) of the
-    // rays this placement is traced with (AccelObject::widest_footprint; infinity: any). A shape
-    // whose reach grows with the footprint (a lattice's sub-rays) culls narrower for
-    // narrower ones; its queries then take the same bound from their ray's footprint
-    // (RayFootprint::widest).
-    virtual Bounds3 cull_bounds(std::size_t, const Transform& xf, double /*widest*/) const {
-        return placed_bounds(xf);
-    }
-    // Whether the line of r (shape coordinates) can meet cull part i, for a line that meets its
-    // bounds: a cheap test that saves the shape's own.
-    virtual bool cull_meets(std::size_t, const Ray&) const { return true; }
-    // A capsule that every line cull_meets(i, .) accepts meets, placed by xf (world space), if
-    // the cull part has one: the accelerator rejects rays by it before mapping them into the
-    // shape's space (about half the rays meeting a cull part's box miss its capsule).
-    // widest as for cull_bounds.
-    virtual bool cull_capsule(std::size_t, const Transform&, double /*widest*/, Capsule&) const {
-        return false;
-    }
-
-    // CSG trees carry a material tag per leaf; other shapes answer with the fallback.
-    virtual std::uint32_t tag(const Crossing&, std::uint32_t fallback) const { return fallback; }
+    // What else a shape can do is offered through opt-in interfaces, asked for where needed:
+    // Parts and CullParts (geometry/parts.h) for the accelerator, LatticeSource and Pieces
+    // (geometry/lattice_source.h) for lattice tables and CSG, SheetSource (coverage/sheets.h)
+    // for partial coverage.
 };
 
 // Spans from `first` on, possibly overlapping: sorted and merged into their union.
 void merge_span_union(SpanList& spans, std::size_t first);
-
-// The first crossing in (tmin, tmax) of the union of the listed parts of s, each intersected
-// with intersect_primitive in list order (ties go to the earlier part). S: the shape's own type
-// where the caller knows it, so that its parts' tests inline.
-template <class S, class Parts>
-bool first_crossing_of_parts(const S& s, const Parts& parts, const Ray& r, double tmin,
-                             double tmax, Crossing& hit) {
-    bool found = false;
-    for (const auto part : parts) {
-        Crossing c;
-        if (s.intersect_primitive(part, r, tmin, tmax, c)) tmax = c.t, hit = c, found = true;
-    }
-    return found;
-}
-
-// Whether any of the listed primitives of s blocks r within (tmin, tmax) (occluded_primitive).
-template <class S, class Parts>
-bool any_part_occludes(const S& s, const Parts& parts, const Ray& r, double tmin, double tmax) {
-    for (const auto part : parts)
-        if (s.occluded_primitive(part, r, tmin, tmax)) return true;
-    return false;
-}
 
 // The first crossing of a span list with tmin < t < tmax, if any.
 bool first_crossing(const SpanList& spans, double tmin, double tmax, Crossing& hit);

@@ -113,4 +113,6 @@ unsigned SphereShape::occluded_quad(const RayQuad& q, unsigned live) const {
     return blocked;
 }
 
+const SphereShape* as_sphere(const Shape& s) { return dynamic_cast<const SphereShape*>(&s); }
+
 }  // namespace lat

@@ -40,4 +40,8 @@ private:
     double r_;
 };
 
+// The sphere s is, if it is one: the typed view for what needs its centre and radius (the
+// texture baseline's atlas).
+const SphereShape* as_sphere(const Shape& s);
+
 }  // namespace lat

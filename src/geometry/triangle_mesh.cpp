@@ -111,7 +111,7 @@ Vec3 TriangleMeshShape::shading_normal(std::size_t tri, double u, double v) cons
     return dot(n, f) < 0 ? -n : n;  // file normals may wind either way: follow the face
 }
 
-bool TriangleMeshShape::intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
+bool TriangleMeshShape::intersect_part(std::size_t i, const Ray& r, double tmin, double tmax,
                                             Crossing& hit) const {
     const Triangle& tri = triangles_[i];
     double t, u, v;
@@ -122,19 +122,19 @@ bool TriangleMeshShape::intersect_primitive(std::size_t i, const Ray& r, double 
     return true;
 }
 
-bool TriangleMeshShape::occluded_primitive(std::size_t i, const Ray& r, double tmin,
+bool TriangleMeshShape::occluded_part(std::size_t i, const Ray& r, double tmin,
                                            double tmax) const {
     Crossing unused;
-    return intersect_primitive(i, r, tmin, tmax, unused);
+    return intersect_part(i, r, tmin, tmax, unused);
 }
 
-Bounds3 TriangleMeshShape::primitive_bounds(std::size_t i) const {
+Bounds3 TriangleMeshShape::part_bounds(std::size_t i) const {
     Bounds3 b;
     for (const std::uint32_t k : triangles_[i]) b = merge(b, positions_[k]);
     return b;
 }
 
-Bounds3 TriangleMeshShape::primitive_bounds(std::size_t i, const Transform& xf) const {
+Bounds3 TriangleMeshShape::part_bounds(std::size_t i, const Transform& xf) const {
     Bounds3 b;
     for (const std::uint32_t k : triangles_[i]) b = merge(b, xf.point(positions_[k]));
     return b;
@@ -145,7 +145,7 @@ bool TriangleMeshShape::intersect(const Ray& r, double tmin, double tmax, Crossi
     double best = tmax;
     bvh_.traverse(r, tmin, &best, [&](std::uint32_t i) {
         Crossing c;
-        if (intersect_primitive(i, r, tmin, best, c)) {
+        if (intersect_part(i, r, tmin, best, c)) {
             hit = c;
             best = c.t;
             found = true;
@@ -158,7 +158,7 @@ bool TriangleMeshShape::intersect(const Ray& r, double tmin, double tmax, Crossi
 bool TriangleMeshShape::occluded(const Ray& r, double tmin, double tmax) const {
     bool found = false;
     bvh_.traverse(r, tmin, &tmax, [&](std::uint32_t i) {
-        found = occluded_primitive(i, r, tmin, tmax);
+        found = occluded_part(i, r, tmin, tmax);
         return found;
     });
     return found;
@@ -167,6 +167,15 @@ bool TriangleMeshShape::occluded(const Ray& r, double tmin, double tmax) const {
 // Ray parity with orientation: each crossing enters (the ray runs against the outward normal)
 // or leaves. A ray through a shared edge or vertex may cross two triangles at one point; such
 // twins going the same way count once, while an enter and a leave there (a graze) both count.
+void TriangleMeshShape::part_spans(std::size_t, const Ray& r, SpanList& out) const {
+    spans(r, out);
+}
+
+void TriangleMeshShape::part_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
+    const Bounds3 b = part_bounds(i);
+    out.push_back({b.center(), 0.5 * length(b.extent())});
+}
+
 void TriangleMeshShape::spans(const Ray& r, SpanList& out) const {
     if (!closed_) return;  // an open mesh bounds no solid (the scene reader keeps it out of CSG)
     struct Hit {
@@ -222,6 +231,10 @@ bool TriangleMeshShape::inside(Vec3 p) const {
     for (const Span& sp : s)
         if (sp.in.t <= 0 && sp.out.t >= 0) return true;
     return false;
+}
+
+const TriangleMeshShape* as_mesh(const Shape& s) {
+    return dynamic_cast<const TriangleMeshShape*>(&s);
 }
 
 }  // namespace lat

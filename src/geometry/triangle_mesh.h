@@ -10,7 +10,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "geometry/lattice_source.h"
 #include "geometry/mesh_bvh.h"
+#include "geometry/parts.h"
 #include "geometry/shape.h"
 
 namespace lat {
@@ -20,7 +22,7 @@ namespace lat {
 // barycentrics), so that a ray through a shared edge is never lost between two triangles.
 bool intersect_triangle(const Ray& r, Vec3 a, Vec3 b, Vec3 c, double& t, double& u, double& v);
 
-class TriangleMeshShape final : public Shape {
+class TriangleMeshShape final : public Shape, public Parts, public LatticeSource {
 public:
     using Triangle = std::array<std::uint32_t, 3>;
     // Inputs must be valid (finite, indices in range: io/mesh_file.h checks files). `normals`:
@@ -49,12 +51,16 @@ public:
     double intersect_cost() const override {
         return 2.0 * std::bit_width(triangles_.size()) + 4;
     }
-    std::size_t primitive_count() const override { return triangles_.size(); }
-    Bounds3 primitive_bounds(std::size_t i) const override;
-    Bounds3 primitive_bounds(std::size_t i, const Transform& xf) const override;
-    bool intersect_primitive(std::size_t i, const Ray& r, double tmin, double tmax,
+    std::size_t part_count() const override { return triangles_.size(); }
+    Bounds3 part_bounds(std::size_t i) const override;
+    Bounds3 part_bounds(std::size_t i, const Transform& xf) const override;
+    bool intersect_part(std::size_t i, const Ray& r, double tmin, double tmax,
                              Crossing& hit) const override;
-    bool occluded_primitive(std::size_t i, const Ray& r, double tmin, double tmax) const override;
+    bool occluded_part(std::size_t i, const Ray& r, double tmin, double tmax) const override;
+    // The whole mesh's spans: a triangle bounds no solid on its own.
+    void part_spans(std::size_t i, const Ray& r, SpanList& out) const override;
+    // The sphere around the triangle's box.
+    void part_spheres(std::size_t i, std::vector<BoundingSphere>& out) const override;
 
 private:
     std::vector<Vec3> positions_;
@@ -68,5 +74,9 @@ private:
     void compute_normals(bool smooth);
     void check_closed();
 };
+
+// The mesh s is, if it is one: the typed view for what needs its triangles or whether it is
+// closed (the texture baseline's atlas; CSG, which takes only closed meshes).
+const TriangleMeshShape* as_mesh(const Shape& s);
 
 }  // namespace lat

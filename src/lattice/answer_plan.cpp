@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "geometry/chain.h"
+#include "geometry/lattice_source.h"
 #include "lattice/sub_ray_shape.h"
 
 namespace lat {
@@ -10,7 +11,7 @@ namespace {
 
 // Why auto mode answers a primitive by its sub-rays (answered_by_primitive).
 std::string cheap_reason(const Shape& primitive) {
-    const double cost = primitive.intersect_cost();
+    const double cost = ShapeSource(primitive).intersect_cost();
     if (cost <= kMaxExactCost)
         return "cheap to intersect: " + std::to_string(static_cast<long long>(std::ceil(cost))) +
                " simple tests, at most " + std::to_string(static_cast<int>(kMaxExactCost));
@@ -38,8 +39,8 @@ std::string_view answer_name(AnsweredBy by) {
 }
 
 bool answered_by_primitive(const Shape& primitive) {
-    return dynamic_cast<const ChainShape*>(&primitive) != nullptr ||
-           primitive.intersect_cost() <= kMaxExactCost;
+    return as_chain(primitive) != nullptr ||
+           ShapeSource(primitive).intersect_cost() <= kMaxExactCost;
 }
 
 AnswerPlan plan_answer(const AnswerQuery& q, const std::function<const Shape*()>& primitive) {

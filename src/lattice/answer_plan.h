@@ -35,7 +35,7 @@ enum class AnsweredBy {
 std::string_view answer_name(AnsweredBy by);
 
 // Primitives other than chains whose exact intersection costs more than this many simple tests
-// (Shape::intersect_cost) are answered by their tables in auto mode, when the levels their
+// (LatticeSource::intersect_cost) are answered by their tables in auto mode, when the levels their
 // footprints want are within the build budget: past it a sub-ray costs more than a table's
 // blend of pairs, and the tables are ahead of exact mode at equal time
 // (bench/notes/filtering-constants.md).

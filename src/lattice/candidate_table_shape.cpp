@@ -10,9 +10,10 @@ CandidateTableShape::CandidateTableShape(std::shared_ptr<const LatticeTable> tab
                                          const TableContext& ctx)
     : table_(std::move(table)),
       primitive_(ctx.primitive),
+      source_(*ctx.primitive),
       frame_(ctx, 0.0),  // answers are the primitive's own crossings
-      boxes_(*ctx.primitive, frame_.box()),
-      union_(ctx.primitive->pieces_are_union()) {
+      boxes_(source_.parts(), frame_.box()),
+      union_(source_.pieces_are_union()) {
     assert(primitive_ && table_->kind() == LatticeTable::Kind::kCandidates);
 }
 
@@ -24,7 +25,7 @@ bool CandidateTableShape::candidates(const Ray& r, CandidateList& list,
 bool CandidateTableShape::listed_spans(const Ray& r, const CandidateList& list,
                                        const LatticeFrame::Snap& s, SpanList& out) const {
     const std::size_t first = out.size();
-    primitive_->pieces_spans(list.span(), r, out);
+    source_.pieces_spans(list.span(), r, out);
     if (out.size() == first) return true;  // no spans: no chord to keep them in
     LatticeFrame::Chord c;
     if (!frame_.chord(s.o, s.d, c)) return false;
@@ -46,7 +47,7 @@ bool CandidateTableShape::intersect(const Ray& r, double tmin, double tmax, Cros
     LatticeFrame::Snap s;
     if (!candidates(r, list, s)) return false;
     if (!union_) return tree_crossing(r, list, s, tmin, tmax, hit);
-    return boxes_.first_crossing(*primitive_, list.span(), r, tmin, tmax, hit);
+    return boxes_.first_crossing(source_.parts(), list.span(), r, tmin, tmax, hit);
 }
 
 bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const {
@@ -57,7 +58,7 @@ bool CandidateTableShape::occluded(const Ray& r, double tmin, double tmax) const
         Crossing c;  // a tree's occlusion is its first crossing (CsgShape has no cheaper one)
         return tree_crossing(r, list, s, tmin, tmax, c);
     }
-    return boxes_.any_occludes(*primitive_, list.span(), r, tmin, tmax);
+    return boxes_.any_occludes(source_.parts(), list.span(), r, tmin, tmax);
 }
 
 void CandidateTableShape::spans(const Ray& r, SpanList& out) const {
@@ -75,7 +76,7 @@ void CandidateTableShape::spans(const Ray& r, SpanList& out) const {
     const PartBoxes::Ray4 slabs(boxes_, r);
     const PartBoxes::Ray4::Range range = slabs.range(-kInfinity, kInfinity);
     slabs.any_listed(list.span(), range, [&](std::uint32_t part) {
-        primitive_->primitive_spans(part, r, out);
+        source_.parts().part_spans(part, r, out);
         return false;
     });
     merge_span_union(out, first);  // the union of the candidate parts' spans

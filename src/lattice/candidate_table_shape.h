@@ -1,6 +1,6 @@
 #pragma once
 // An exact lattice: the table (encoding `candidates`) names, per snapped pair, the pieces of the
-// primitive (Shape::piece_count) that a ray snapping to it can meet, and those are intersected
+// primitive (Pieces::piece_count) that a ray snapping to it can meet, and those are intersected
 // exactly with the real ray. Images equal exact mode; the cost of a ray depends on how many
 // pieces lie near it, not on how many the primitive has.
 //
@@ -13,12 +13,14 @@
 // should one leave it (the pieces left on reach outside the box), the primitive answers whole.
 #include <memory>
 
+#include "geometry/lattice_source.h"
+#include "geometry/parts.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/part_boxes.h"
 
 namespace lat {
 
-class CandidateTableShape final : public Shape {
+class CandidateTableShape final : public Shape, public LatticeSource, public CullParts {
 public:
     // ctx.primitive must be set and outlive the shape.
     CandidateTableShape(std::shared_ptr<const LatticeTable> table, const TableContext& ctx);
@@ -32,12 +34,11 @@ public:
     }
     bool inside(Vec3 p) const override { return primitive_->inside(p); }
     // Crossings are the primitive's own: it names their surfaces and materials.
-    std::uint32_t surface_count() const override { return primitive_->surface_count(); }
-    bool names_surface(const Crossing& c) const override { return primitive_->names_surface(c); }
-    bool cheap_normal(const Crossing& c) const override { return primitive_->cheap_normal(c); }
-    std::uint32_t tag(const Crossing& c, std::uint32_t fallback) const override {
-        return primitive_->tag(c, fallback);
-    }
+    std::uint32_t surface_count() const override { return source_.surface_count(); }
+    bool names_surface(const Crossing& c) const override { return source_.names_surface(c); }
+    bool cheap_normal(const Crossing& c) const override { return source_.cheap_normal(c); }
+    // One table lookup, and the few pieces near the ray.
+    double intersect_cost() const override { return 1.0; }
     std::size_t cull_count() const override { return frame_.cull_count(); }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf, double) const override {
         return frame_.cull_bounds(i, xf);
@@ -50,10 +51,11 @@ public:
 private:
     std::shared_ptr<const LatticeTable> table_;
     const Shape* primitive_;
+    ShapeSource source_;  // the primitive's
     LatticeFrame frame_;
     PartBoxes boxes_;  // rejects candidates whose box the ray misses (lattice/part_boxes.h)
 
-    bool union_;  // primitive_->pieces_are_union()
+    bool union_;  // source_.pieces_are_union()
 
     // The pieces the ray can meet, and the ray's chord through the box; false when none.
     bool candidates(const Ray& r, CandidateList& list, LatticeFrame::Snap& s) const;

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "geometry/chain.h"
+#include "geometry/lattice_source.h"
 #include "geometry/scratch_spans.h"
 #include "lattice/face_cones.h"
 #include "lattice/lattice_shape.h"
@@ -50,23 +51,23 @@ void trace_sub_ray(const S& shape, double h, const SubRay& s, const Parts& parts
 }
 
 // A solid that is not the union of its parts (a CSG tree), evaluated with its listed pieces (its
-// leaves, ascending) on and the others empty (Shape::pieces_spans): along a sub-ray that the
+// leaves, ascending) on and the others empty (Pieces::pieces_spans): along a sub-ray that the
 // pieces switched off keep away from, the primitive's own crossings, bit for bit (the same
 // leaves evaluated the same way, the same first crossing of their combined spans).
 struct PieceSolid {
-    const Shape& shape;
+    const ShapeSource& source;
 };
 
 template <class Parts>
 void trace_sub_ray(const PieceSolid& solid, double h, const SubRay& s, const Parts& on, Tally& n) {
     const Ray r{s.p * h, (s.q - s.p) * h};
     ScratchSpans spans;
-    solid.shape.pieces_spans(on, r, *spans);
+    solid.source.pieces_spans(on, r, *spans);
     Crossing bc;
     if (!first_crossing(*spans, 0.0, 1.0 + 1e-12, bc)) return;
     ++n.hits;
     n.psum += lerp(s.p, s.q, bc.t);
-    n.nsum += solid.shape.normal(r, bc);
+    n.nsum += solid.source.shape().normal(r, bc);
 }
 
 // Whether snap takes the sub-ray to the pair (a, b): the definition.
@@ -80,7 +81,7 @@ bool snaps_to(const LatticeFrame& frame, double h, const SubRay& s, std::uint32_
 // of each). Sub-rays that the renderer would snap to another pair (their exit rounds
 // elsewhere, or they clip to other faces) are not the pair's rays, and are left out of its share.
 template <class Parts>
-CoverageSample sample_pair(const Shape& shape, const LatticeFrame& frame, const BoundaryGrid& grid,
+CoverageSample sample_pair(const ShapeParts& shape, const LatticeFrame& frame, const BoundaryGrid& grid,
                            double h, std::uint32_t a, std::uint32_t b, const Parts& parts) {
     const PairRays pr(grid, grid.point(a), grid.point(b));
     Tally n;
@@ -123,9 +124,10 @@ SubRay coverage_ray(const BoundaryGrid& grid, const GridPoint& p, const GridPoin
 CoverageSample pair_coverage(const TableContext& ctx, std::uint32_t a, std::uint32_t b) {
     const BoundaryGrid grid(ctx.cells);
     const LatticeFrame frame(ctx, kInfinity);
-    std::vector<std::uint32_t> all(ctx.primitive->primitive_count());
+    const ShapeParts parts(*ctx.primitive);
+    std::vector<std::uint32_t> all(parts.part_count());
     std::iota(all.begin(), all.end(), 0u);
-    return sample_pair(*ctx.primitive, frame, grid, ctx.cell, a, b, all);
+    return sample_pair(parts, frame, grid, ctx.cell, a, b, all);
 }
 
 namespace {
@@ -159,24 +161,24 @@ struct PairWork {
 
 class PairSampler {
 public:
-    // by_pieces: the lists of parts given to sample are of pieces (Shape::piece_count), each
+    // by_pieces: the lists of parts given to sample are of pieces (Pieces::piece_count), each
     // culled by its spheres (capsules of length 0, shadows of their own).
-    PairSampler(const Shape& shape, const LatticeFrame& frame, const BoundaryGrid& grid, double h,
-                bool by_pieces)
+    PairSampler(const ShapeSource& shape, const LatticeFrame& frame, const BoundaryGrid& grid,
+                double h, bool by_pieces)
         : frame_(frame), grid_(grid), h_(h) {
         if (by_pieces) {
             const auto& n = grid.cells();
             const Vec3 cells{double(n[0]), double(n[1]), double(n[2])};
-            for (const PartSphere& ps : piece_spheres(shape, h, cells, 0.0, 1e-9)) {
+            for (const PartSphere& ps : piece_spheres(shape.shape(), h, cells, 0.0, 1e-9)) {
                 while (piece_first_.size() <= ps.part) piece_first_.push_back(capsules_.size());
                 capsules_.push_back({ps.c, ps.c, ps.r + 1e-6});
             }
             piece_first_.push_back(capsules_.size());
             return;
         }
-        for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
+        for (std::size_t i = 0; i < shape.parts().part_count(); ++i) {
             Capsule c;
-            if (!shape.primitive_capsule(i, c)) {
+            if (!shape.parts().part_capsule(i, c)) {
                 capsules_.clear();
                 break;
             }
@@ -298,17 +300,17 @@ struct Scratch {
 class PairCuller {
 public:
     explicit PairCuller(const TableContext& ctx)
-        : grid_(ctx.cells), by_pieces_(!ctx.primitive->pieces_are_union() &&
-                                       ctx.primitive->piece_count() > 1) {
-        const Shape& shape = *ctx.primitive;
+        : grid_(ctx.cells) {
+        const ShapeSource shape(*ctx.primitive);
+        by_pieces_ = !shape.pieces_are_union() && shape.piece_count() > 1;
         const Vec3 cells{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])};
-        cull_ = by_pieces_ ? piece_spheres(shape, ctx.cell, cells, 1.0, 1e-9)
-                           : part_spheres(shape, ctx.cell, 1.0, 1e-9);
+        cull_ = by_pieces_ ? piece_spheres(shape.shape(), ctx.cell, cells, 1.0, 1e-9)
+                           : part_spheres(shape.shape(), ctx.cell, 1.0, 1e-9);
         for (int f = 0; f < 6; ++f) faces_[static_cast<std::size_t>(f)] = layout_face(grid_, f);
     }
 
     const BoundaryGrid& grid() const { return grid_; }
-    // Whether the parts are the primitive's pieces (Shape::piece_count), not its primitives.
+    // Whether the parts are the primitive's pieces (Pieces::piece_count), not its parts.
     bool by_pieces() const { return by_pieces_; }
 
     // visit(b, parts) for every pair (a, b) that some culling sphere keeps, with the parts
@@ -345,14 +347,14 @@ private:
 }  // namespace
 
 std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool progress) {
-    const Shape& shape = *ctx.primitive;
+    const ShapeSource shape(*ctx.primitive);
     const PairCuller culler(ctx);
     const BoundaryGrid& grid = culler.grid();
     const LatticeFrame frame(ctx, kInfinity);
     const PairSampler sampler(shape, frame, grid, ctx.cell, culler.by_pieces());
     // Chains (the common primitive) are traced through their concrete type, without virtual
     // calls in the innermost loop.
-    const auto* chain = dynamic_cast<const ChainShape*>(&shape);
+    const ChainShape* chain = as_chain(shape.shape());
 
     const std::uint32_t npoints = grid.count();
     constexpr std::uint32_t kBlock = 32;
@@ -369,7 +371,7 @@ std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool pro
                 const CoverageSample c =
                     chain                ? sampler.sample(*chain, a, b, parts, s.work)
                     : culler.by_pieces() ? sampler.sample(PieceSolid{shape}, a, b, parts, s.work)
-                                         : sampler.sample(shape, a, b, parts, s.work);
+                                         : sampler.sample(shape.parts(), a, b, parts, s.work);
                 if (c.alpha >= kCoverageMinAlpha) out.push_back(c);
             });
         std::sort(out.begin(), out.end(), [](const CoverageSample& x, const CoverageSample& y) {
@@ -387,7 +389,7 @@ std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool pro
 }
 
 double coverage_work(const TableContext& ctx) {
-    const Shape& shape = *ctx.primitive;
+    const ShapeSource shape(*ctx.primitive);
     const double cost = std::max(1.0, shape.intersect_cost());
     const double all_pairs = static_cast<double>(BoundaryGrid::pair_count(ctx.cells));
     const PairCuller culler(ctx);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "geometry/lattice_source.h"
+
 namespace lat {
 
 FaceLayout layout_face(const BoundaryGrid& grid, int f) {
@@ -85,12 +87,13 @@ bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0,
     return v0 <= v1;
 }
 
-std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double grow, double rel_pad) {
+std::vector<PartSphere> part_spheres(const Shape& s, double cell, double grow, double rel_pad) {
+    const ShapeParts shape(s);
     std::vector<PartSphere> out;
     std::vector<BoundingSphere> bs;
-    for (std::size_t i = 0; i < shape.primitive_count(); ++i) {
+    for (std::size_t i = 0; i < shape.part_count(); ++i) {
         bs.clear();
-        shape.primitive_spheres(i, bs);
+        shape.part_spheres(i, bs);
         for (const BoundingSphere& b : bs)
             out.push_back(grown_sphere({b.center / cell, b.radius / cell},
                                        static_cast<std::uint32_t>(i), grow, rel_pad));
@@ -98,8 +101,9 @@ std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double gro
     return out;
 }
 
-std::vector<PartSphere> piece_spheres(const Shape& shape, double cell, const Vec3& cells,
+std::vector<PartSphere> piece_spheres(const Shape& s, double cell, const Vec3& cells,
                                       double grow, double rel_pad) {
+    const ShapeSource shape(s);
     const BoundingSphere box{cells * 0.5, 0.5 * length(cells)};
     std::vector<PartSphere> out;
     std::vector<BoundingSphere> bs;

@@ -36,12 +36,12 @@ inline PartSphere grown_sphere(const BoundingSphere& b, std::uint32_t part, doub
     return {b.center, (b.radius + grow) * (1 + rel_pad) + 1e-9, part};
 }
 
-// The culling spheres of every part of `shape` (Shape::primitive_spheres), in lattice units
+// The culling spheres of every part of `shape` (Parts::part_spheres), in lattice units
 // (cell: the primitive units of one), grown by `grow` cells and padded against rounding by
 // `rel_pad` of the radius and 1e-9; grouped by part in ascending order, so a list built from
 // them is sorted by part.
 std::vector<PartSphere> part_spheres(const Shape& shape, double cell, double grow, double rel_pad);
-// The same for the pieces of `shape` (Shape::piece_spheres; a CSG tree's leaves), numbered by
+// The same for the pieces of `shape` (Pieces::piece_spheres; a CSG tree's leaves), numbered by
 // piece. Segments lie in the box (cells: its size in cells), so a sphere larger than the box's
 // own (a half-space's unbounded one) is replaced by that: near every segment.
 std::vector<PartSphere> piece_spheres(const Shape& shape, double cell, const Vec3& cells,

@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "geometry/parts.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/hit_table_shape.h"
 
@@ -51,7 +52,7 @@ struct FilterLevel {
     TableContext ctx;
 };
 
-class FilteredLatticeShape final : public Shape {
+class FilteredLatticeShape final : public Shape, public CullParts {
 public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage (a null
     // one is refused). table_error: Encoding::error_bound of the finest level. box_shadows:

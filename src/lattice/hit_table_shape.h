@@ -6,11 +6,12 @@
 // is also a CSG leaf (one span per ray) and shadows itself.
 #include <memory>
 
+#include "geometry/parts.h"
 #include "lattice/lattice_shape.h"
 
 namespace lat {
 
-class HitTableShape final : public Shape {
+class HitTableShape final : public Shape, public CullParts {
 public:
     HitTableShape(std::shared_ptr<const LatticeTable> table, const TableContext& ctx,
                   double reach);

@@ -30,7 +30,12 @@ LatticeFrame::LatticeFrame(const TableContext& ctx, double reach, double beyond_
 // tested too, a few dot products before any snapping: on the fur plates four in five rays
 // that met the boxes found no stored hit.
 void LatticeFrame::make_cull_parts(const Shape* primitive, double reach, const Bounds3& region) {
-    const std::size_t n = primitive ? primitive->primitive_count() : 0;
+    if (!primitive) {
+        cull_.push_back({region, 0, 0});
+        return;
+    }
+    const ShapeParts parts(*primitive);
+    const std::size_t n = parts.part_count();
     if (!std::isfinite(reach) || n == 0) {
         cull_.push_back({region, 0, 0});
         return;
@@ -42,8 +47,8 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach, const B
     for (std::size_t i = 0; i < n; ++i) {
         Piece p;
         p.part = static_cast<std::uint32_t>(i);
-        p.box = lat::intersect(expand(primitive->primitive_bounds(i), reach), region);
-        capsules = capsules && primitive->primitive_capsule(i, p.capsule);
+        p.box = lat::intersect(expand(parts.part_bounds(i), reach), region);
+        capsules = capsules && parts.part_capsule(i, p.capsule);
         p.capsule.r += reach;
         if (!p.box.empty()) pieces.push_back(p);
     }
@@ -61,7 +66,7 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach, const B
     capsules = capsules && !few.empty() && few.size() <= kMaxCullParts;
     if (capsules) pieces = std::move(few);
     if (!capsules && n <= kMaxPlacedParts) {
-        primitive_ = primitive;
+        primitive_ = parts;
         reach_ = reach;
     }
     for (Piece& p : pieces) p.key = p.box.center()[axis];
@@ -172,7 +177,7 @@ Bounds3 LatticeFrame::placed_parts(const CullPart& p, const Transform& xf, doubl
     const double grow = (reach_ - narrower) * xf.max_stretch();
     Bounds3 placed;
     for (std::uint32_t k = p.part_first; k < p.part_first + p.part_count; ++k)
-        placed = merge(placed, expand(primitive_->primitive_bounds(parts_[k], xf), grow));
+        placed = merge(placed, expand(primitive_->part_bounds(parts_[k], xf), grow));
     return placed;
 }
 

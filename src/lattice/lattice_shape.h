@@ -7,8 +7,10 @@
 //   CandidateTableShape  the table names the primitive's parts the ray can meet, which are
 //                        intersected exactly with the real ray (lattice/candidate_table_shape.h).
 #include <memory>
+#include <optional>
 #include <vector>
 
+#include "geometry/parts.h"
 #include "geometry/shape.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/table.h"
@@ -16,7 +18,7 @@
 namespace lat {
 
 // The box, its boundary grid, the snapping of rays to grid point pairs, and the parts a
-// lattice is culled with (Shape::cull_count): what both lattice shapes share.
+// lattice is culled with (CullParts::cull_count): what both lattice shapes share.
 class LatticeFrame {
 public:
     // reach: how far from the primitive (primitive units) the ray's point at an answer can lie,
@@ -29,13 +31,13 @@ public:
     const Bounds3& box() const { return box_; }
     double cell() const { return cell_; }
 
-    // See Shape::cull_count, cull_bounds and cull_meets.
+    // See CullParts::cull_count, cull_bounds and cull_meets.
     // narrower: for rays known to need less reach, by how much (at most the reach) to narrow
     // the capsules and boxes (still around the parts grown by the rest, capsules being convex).
     std::size_t cull_count() const { return cull_.size(); }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf, double narrower = 0) const;
     bool cull_meets(std::size_t i, const Ray& r, double narrower = 0) const;
-    // See Shape::cull_capsule: a cull part of one capsule has it.
+    // See CullParts::cull_capsule: a cull part of one capsule has it.
     bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out, double narrower = 0) const;
 
     // The ray's line in lattice units, and its snapped entry and exit points.
@@ -84,7 +86,7 @@ private:
     std::vector<CullPart> cull_;
     std::vector<Capsule> capsules_;
     std::vector<std::uint32_t> parts_;
-    const Shape* primitive_ = nullptr;
+    std::optional<ShapeParts> primitive_;  // its parts, when placed_parts bounds by them
     double reach_ = 0;
     // How much culling can be narrowed by: the reach, where the parts are clipped to the box
     // grown by at least as much (a filtered lattice's sub-rays), else 0: clipped to the box

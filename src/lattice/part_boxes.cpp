@@ -21,11 +21,11 @@ Bounds3 padded(const Bounds3& b) {
 
 }  // namespace
 
-PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box, bool tree)
+PartBoxes::PartBoxes(const ShapeParts& primitive, const Bounds3& box, bool tree)
     : center_(box.center()) {
     const double d = length(box.extent()) + max_component(abs(box.lo)) + max_component(abs(box.hi));
-    for (std::size_t i = 0; i < primitive.primitive_count(); ++i) {
-        const Bounds3 b = padded(primitive.primitive_bounds(i));
+    for (std::size_t i = 0; i < primitive.part_count(); ++i) {
+        const Bounds3 b = padded(primitive.part_bounds(i));
         exact_.push_back(b);
         // Coordinates relative to the box centre, like the float ray's origin.
         const Bounds3 f = expand(b, kPad * d);
@@ -45,7 +45,7 @@ PartBoxes::PartBoxes(const Shape& primitive, const Bounds3& box, bool tree)
     if (tree && f_.size() > kTreeFrom) build_tree();
 }
 
-bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint32_t> parts,
+bool PartBoxes::first_crossing(const ShapeParts& primitive, std::span<const std::uint32_t> parts,
                                const Ray& r, double tmin, double tmax, Crossing& hit) const {
     if (parts.size() <= kFewParts)
         return first_crossing_of_parts(primitive, parts, r, tmin, tmax, hit);
@@ -55,7 +55,7 @@ bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint
     slabs.any_listed(parts, range, [&](std::uint32_t part) {
         // A part met before a crossing of its four narrowed the range: tested again.
         if (found && !slabs.meets(part, range)) return false;
-        if (primitive.intersect_primitive(part, r, tmin, tmax, hit)) {
+        if (primitive.intersect_part(part, r, tmin, tmax, hit)) {
             tmax = hit.t;
             range = slabs.range(tmin, tmax);
             found = true;
@@ -65,12 +65,12 @@ bool PartBoxes::first_crossing(const Shape& primitive, std::span<const std::uint
     return found;
 }
 
-bool PartBoxes::any_occludes(const Shape& primitive, std::span<const std::uint32_t> parts,
+bool PartBoxes::any_occludes(const ShapeParts& primitive, std::span<const std::uint32_t> parts,
                              const Ray& r, double tmin, double tmax) const {
     if (parts.size() <= kFewParts) return any_part_occludes(primitive, parts, r, tmin, tmax);
     const Ray4 slabs(*this, r);
     return slabs.any_listed(parts, slabs.range(tmin, tmax), [&](std::uint32_t part) {
-        return primitive.occluded_primitive(part, r, tmin, tmax);
+        return primitive.occluded_part(part, r, tmin, tmax);
     });
 }
 

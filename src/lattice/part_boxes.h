@@ -23,7 +23,7 @@
 #include <span>
 #include <vector>
 
-#include "geometry/shape.h"
+#include "geometry/parts.h"
 
 namespace lat {
 
@@ -33,16 +33,16 @@ class PartBoxes {
 public:
     // box: the lattice box (primitive units) that every part and every crossing lies in. tree:
     // build the tree near_parts searches (more than kTreeFrom parts; `candidates` never asks).
-    PartBoxes(const Shape& primitive, const Bounds3& box, bool tree = false);
+    PartBoxes(const ShapeParts& primitive, const Bounds3& box, bool tree = false);
 
     // The first crossing in (tmin, tmax) of the union of the listed parts of primitive (the
     // one the boxes were made for): each part whose box the ray meets within the range left
     // is intersected, in list order (ties go to the earlier part, as in a loop over them all);
     // lists of at most kFewParts skip the boxes.
-    bool first_crossing(const Shape& primitive, std::span<const std::uint32_t> parts, const Ray& r,
+    bool first_crossing(const ShapeParts& primitive, std::span<const std::uint32_t> parts, const Ray& r,
                         double tmin, double tmax, Crossing& hit) const;
     // Whether any listed part of primitive blocks r within (tmin, tmax).
-    bool any_occludes(const Shape& primitive, std::span<const std::uint32_t> parts, const Ray& r,
+    bool any_occludes(const ShapeParts& primitive, std::span<const std::uint32_t> parts, const Ray& r,
                       double tmin, double tmax) const;
     // Lists up to this long are intersected without their boxes: for so few parts, preparing
     // the four-lane test costs more than the exact tests it saves (Plate 4 in `candidates`, hair

@@ -86,6 +86,11 @@ struct Scratch {
     HitArena arena;
 };
 
+// The primitive as a Shape, for the tracer's loops over its parts (a chain's concrete type, or
+// any shape's ShapeParts).
+const Shape& whole_shape(const ChainShape& chain) { return chain; }
+const Shape& whole_shape(const ShapeParts& parts) { return parts.shape(); }
+
 // Everything about the lattice that does not depend on the entry point.
 class Tracer {
 public:
@@ -226,7 +231,7 @@ private:
             const Ray r{p * h_, (e.q - p) * h_};
             Crossing c;
             const double tmax = std::min(s.best_t[e.k], 1.0 + 1e-12);
-            if (shape.intersect_primitive(part, r, 0.0, tmax, c)) keep(e.k, c);
+            if (shape.intersect_part(part, r, 0.0, tmax, c)) keep(e.k, c);
         }
         s.batch.clear();
     }
@@ -242,7 +247,7 @@ private:
             // p lies in the closed solid (on its surface, where a primitive touches the box): the
             // hit is p itself, with the surface there the crossing nearest to it.
             t = 0.0f;
-            c = nearest_crossing(shape, r);
+            c = nearest_crossing(whole_shape(shape), r);
         }
         const Oct o = oct_encode(shape.normal(r, c), kRawNormalBits);
         if (c.part > RawHit::kMaxPart || c.leaf_index() > RawHit::kMaxLeaf) refuse_part(c);
@@ -320,7 +325,8 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
     const Tracer tracer(shape, ctx);
     // Chains (the common primitive) are traced through their concrete type, without virtual
     // calls in the innermost loop.
-    const auto* chain = dynamic_cast<const ChainShape*>(&shape);
+    const ChainShape* chain = as_chain(shape);
+    const ShapeParts parts(shape);
 
     const std::uint32_t npoints = tracer.grid().count();
     const std::uint32_t nblocks = (npoints + kBlock - 1) / kBlock;
@@ -340,7 +346,7 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
         for (std::uint32_t a = blk * kBlock; a < a_end; ++a) {
             if (a % opt.entry_stride != 0) continue;
             if (chain) tracer.trace_entry(*chain, a, opt.keep_hits, s, cnt);
-            else tracer.trace_entry(shape, a, opt.keep_hits, s, cnt);
+            else tracer.trace_entry(parts, a, opt.keep_hits, s, cnt);
         }
         if (opt.keep_hits) block_hits[blk] = s.arena.end_block();
         block_counts[blk] = cnt;

@@ -41,10 +41,10 @@ SubRayShape::SubRayShape(const TableContext& ctx, std::shared_ptr<const LatticeT
     // A chain's crossing is the first of its parts' in order (ChainShape::intersect), so any
     // superset of the parts a sub-ray can meet, in order, gives it bit for bit. Boxes pay for
     // their set-up on a long chain, not on a short one (kMinBoxedParts).
-    chain_ = dynamic_cast<const ChainShape*>(primitive_);
-    if (chain_ && chain_->primitive_count() >= kMinBoxedParts)
-        part_boxes_ = std::make_unique<const PartBoxes>(*chain_, box(), true);
-    paired_shadows_ = !chain_ && primitive_->intersect_cost() > kMaxExactCost;
+    chain_ = as_chain(*primitive_);
+    if (chain_ && chain_->part_count() >= kMinBoxedParts)
+        part_boxes_ = std::make_unique<const PartBoxes>(ShapeParts(*chain_), box(), true);
+    paired_shadows_ = !chain_ && ShapeSource(*primitive_).intersect_cost() > kMaxExactCost;
 }
 
 void SubRayShape::spans(const Ray& r, SpanList& out) const {
@@ -178,7 +178,7 @@ void SubRayShape::sub_ray_hits(double width, bool normal, const Ray& r, double t
     thread_local std::vector<std::uint32_t> near;
     std::span<const std::uint32_t> parts;
     if (part_boxes_) {
-        const std::size_t all = chain_->primitive_count();
+        const std::size_t all = chain_->part_count();
         if (near.size() < all) near.resize(all);
         const std::span<std::uint32_t> out(near.data(), all);
         parts = {near.data(), part_boxes_->near_parts(r, farthest_sub_ray(width), tmin, out)};

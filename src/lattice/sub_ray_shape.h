@@ -13,6 +13,7 @@
 #include "coverage/sheets.h"
 #include "coverage/sub_rays.h"
 #include "geometry/chain.h"
+#include "geometry/parts.h"
 #include "lattice/hit_table_shape.h"
 #include "lattice/part_boxes.h"
 
@@ -40,7 +41,7 @@ inline constexpr double kSheetDepth = 1;
 // How far from a ray its farthest sub-ray lies, for a footprint this wide.
 double farthest_sub_ray(double width);
 
-class SubRayShape final : public Shape, public SheetSource {
+class SubRayShape final : public Shape, public SheetSource, public CullParts {
 public:
     // ctx: the lattice (box and cells) whose frame culls, and the primitive (ctx.primitive,
     // which must outlive the shape). table: the lattice's point-sampled table, which answers

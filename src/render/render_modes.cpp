@@ -42,7 +42,7 @@ std::uint64_t instance_geometry_bytes(const Scene& scene) {
         const auto p = static_cast<std::size_t>(scene.objects[i].primitive);
         if (counted[p]) continue;
         counted[p] = true;
-        if (const auto* c = dynamic_cast<const ChainShape*>(scene.primitives[p].shape.get()))
+        if (const auto& s = scene.primitives[p].shape; const ChainShape* c = s ? as_chain(*s) : nullptr)
             bytes += c->spheres().size() * sizeof(ChainSphere) + c->cylinders().size() * sizeof(ChainCylinder);
     }
     return bytes;

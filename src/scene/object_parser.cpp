@@ -192,7 +192,7 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
     if (type == "instance" && override_material == kNoMaterial)
         v.at("type").fail("a primitive cannot contain instances");
     Leaf leaf = parse_leaf(v, type);
-    if (const auto* m = dynamic_cast<const TriangleMeshShape*>(leaf.shape.get()); m && !m->closed())
+    if (const TriangleMeshShape* m = as_mesh(*leaf.shape); m && !m->closed())
         v.at("file").fail(
             "an open mesh cannot be a csg leaf: it bounds no solid (a closed mesh has every edge "
             "shared by exactly two triangles, wound the same way)");

@@ -203,7 +203,7 @@ ParticleSet make_particles(const Scene& scene) {
     for (const std::size_t oi : instance_objects(scene)) {
         const SceneObject& o = scene.objects[oi];
         const Primitive& prim = scene.primitives[static_cast<std::size_t>(o.primitive)];
-        const auto* chain = dynamic_cast<const ChainShape*>(prim.shape.get());
+        const ChainShape* chain = prim.shape ? as_chain(*prim.shape) : nullptr;
         if (!chain)
             throw InputError(located_message(scene.file, o.where,
                                              "particle mode needs a sphere/cylinder chain primitive; '" +

@@ -11,11 +11,11 @@
 namespace lat {
 namespace {
 
-const SphereShape* as_sphere(const SceneObject& o) {
-    return o.primitive < 0 ? dynamic_cast<const SphereShape*>(o.shape.get()) : nullptr;
+const SphereShape* sphere_of(const SceneObject& o) {
+    return o.primitive < 0 ? as_sphere(*o.shape) : nullptr;
 }
-const TriangleMeshShape* as_mesh(const SceneObject& o) {
-    return o.primitive < 0 ? dynamic_cast<const TriangleMeshShape*>(o.shape.get()) : nullptr;
+const TriangleMeshShape* mesh_of(const SceneObject& o) {
+    return o.primitive < 0 ? as_mesh(*o.shape) : nullptr;
 }
 
 class SphereAtlas final : public TextureAtlas {
@@ -173,12 +173,12 @@ Vec3 uv_to_direction(double u, double v) {
 }
 
 bool has_texture_atlas(const SceneObject& base) {
-    return as_sphere(base) || as_mesh(base);
+    return sphere_of(base) || mesh_of(base);
 }
 
 std::unique_ptr<TextureAtlas> make_texture_atlas(const SceneObject& base, int width) {
-    if (const SphereShape* s = as_sphere(base)) return std::make_unique<SphereAtlas>(*s, width);
-    const TriangleMeshShape* m = as_mesh(base);
+    if (const SphereShape* s = sphere_of(base)) return std::make_unique<SphereAtlas>(*s, width);
+    const TriangleMeshShape* m = mesh_of(base);
     assert(m);
     return std::make_unique<MeshAtlas>(*m, base.xf, width);
 }

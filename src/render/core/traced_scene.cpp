@@ -3,6 +3,7 @@
 #include <cassert>
 
 #include "csg/csg_shape.h"
+#include "geometry/lattice_source.h"
 
 namespace lat {
 
@@ -15,11 +16,24 @@ TracedScene::TracedScene(const Scene& scene, const InstanceShapeFn& instance_sha
         std::shared_ptr<const Shape> s = o.shape;
         if (o.primitive >= 0 && instance_shape) {
             s = instance_shape(o.primitive);
-        } else if (const auto* csg = dynamic_cast<const CsgShape*>(o.shape.get());
-                   csg && instance_shape) {
-            if (auto swapped = csg->with_primitive_shapes(instance_shape)) s = swapped;  // CSG leaves
+        } else if (o.shape && instance_shape) {
+            if (auto swapped = csg_with_primitive_shapes(*o.shape, instance_shape)) s = swapped;
         }
         shapes_.push_back(std::move(s));
+    }
+    // Asked once for each run of objects with the same shape and primitive (instances).
+    const Shape* asked = nullptr;
+    int asked_primitive = -1;
+    std::span<const std::uint32_t> m;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+        if (!shapes_[i]) continue;
+        if (shapes_[i].get() != asked || scene.objects[i].primitive != asked_primitive) {
+            asked = shapes_[i].get(), asked_primitive = scene.objects[i].primitive;
+            m = surface_materials(i, *asked);
+        }
+        if (m.empty()) continue;
+        surface_materials_.resize(scene.objects.size());
+        surface_materials_[i] = m;
     }
     accel_objects_.reserve(scene.objects.size());
     for (std::size_t i = 0; i < scene.objects.size(); ++i)
@@ -47,13 +61,37 @@ bool TracedScene::intersect_layers(const Ray& r, double tmin, double tmax, std::
     return found;
 }
 
+// A CSG tree's own materials, as traced (exactly, or with its instance leaves swapped for their
+// lattices); for an instance of a CSG primitive, the primitive's, when the traced shape numbers
+// its surfaces as the tree does (a `candidates` lattice; a lattice of one surface names that
+// one), else none: a lattice that does not tell the surfaces apart takes the object's material.
+std::span<const std::uint32_t> TracedScene::surface_materials(std::size_t i,
+                                                              const Shape& traced) const {
+    const SceneObject& o = scene_.objects[i];
+    const std::span<const std::uint32_t> own = csg_surface_materials(traced);
+    if (!own.empty() || o.primitive < 0) return own;
+    const Shape* primitive = scene_.primitives[static_cast<std::size_t>(o.primitive)].shape.get();
+    const std::span<const std::uint32_t> of_primitive =
+        primitive ? csg_surface_materials(*primitive) : std::span<const std::uint32_t>{};
+    return ShapeSource(traced).surface_count() == of_primitive.size() ? of_primitive
+                                                                      : std::span<const std::uint32_t>{};
+}
+
+std::uint32_t TracedScene::material(std::uint32_t object, const Crossing& c) const {
+    const std::uint32_t fallback = scene_.objects[object].material;
+    if (surface_materials_.empty()) return fallback;
+    const std::span<const std::uint32_t> m = surface_materials_[object];
+    const std::uint32_t s = c.leaf_index();
+    return s < m.size() && m[s] != kNoMaterial ? m[s] : fallback;
+}
+
 void TracedScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const {
     const SceneObject& o = scene_.objects[h.object];
     const Shape& shape = *shapes_[h.object];
     hit.t = h.t;
     hit.object = h.object;
     hit.part = h.crossing.part;
-    hit.material = shape.tag(h.crossing, o.material);
+    hit.material = material(h.object, h.crossing);
     hit.alpha = static_cast<double>(h.crossing.coverage);
     hit.sub_rays = h.crossing.sub_rays;
     const SurfacePoint s = shape.surface(o.xf.is_identity() ? r : o.xf.inverse_ray(r), h.crossing);

@@ -72,10 +72,17 @@ public:
 private:
     const Scene& scene_;
     std::vector<std::shared_ptr<const Shape>> shapes_;  // per object, as traced
+    // Per object, the materials of the surfaces its crossings number (a CSG tree's leaves:
+    // csg_surface_materials), or empty: the object's material. Empty when no object has any.
+    std::vector<std::span<const std::uint32_t>> surface_materials_;
     std::vector<AccelObject> accel_objects_;
     std::unique_ptr<EmbreeAccel> accel_;
 
     void surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const;
+    // The materials of object i's surfaces, traced as `traced` (see surface_materials_).
+    std::span<const std::uint32_t> surface_materials(std::size_t i, const Shape& traced) const;
+    // The material of crossing c of object i.
+    std::uint32_t material(std::uint32_t object, const Crossing& c) const;
 };
 
 

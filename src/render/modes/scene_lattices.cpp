@@ -7,6 +7,7 @@
 #include <map>
 
 #include "csg/csg_shape.h"
+#include "geometry/lattice_source.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/coverage.h"
 #include "lattice/encoding.h"
@@ -50,7 +51,7 @@ struct LevelCosts {
     const Scene& scene;
     const Primitive& p;
     const TableSpec& spec;
-    double cost = p.shape ? std::max(1.0, p.shape->intersect_cost()) : 1.0;  // per sub-ray
+    double cost = p.shape ? std::max(1.0, ShapeSource(*p.shape).intersect_cost()) : 1.0;  // per sub-ray
 
     long long sigma_inv(int j) const { return static_cast<long long>(spec.sigma_inv) << j; }
     std::string name(int j) const { return "sigma^-1 = " + std::to_string(sigma_inv(j)); }
@@ -250,8 +251,8 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const 
     std::vector<bool> used(scene.primitives.size(), false), csg_leaf(used), instanced(used);
     for (const SceneObject& o : scene.objects) {
         if (o.primitive >= 0) used[static_cast<std::size_t>(o.primitive)] = instanced[static_cast<std::size_t>(o.primitive)] = true;
-        if (const auto* csg = dynamic_cast<const CsgShape*>(o.shape.get()))
-            for (const int p : csg->leaf_primitives())
+        if (o.shape)
+            for (const int p : csg_leaf_primitives(*o.shape))
                 used[static_cast<std::size_t>(p)] = csg_leaf[static_cast<std::size_t>(p)] = true;
     }
     const bool sub_rays = filtering.policy == LatticePolicy::kFootprint;

@@ -11,7 +11,7 @@ const Encoding kCandidatesEncoding{
     .max_points = 0xFFFFFFFFull,
     .bytes_per_hit = 2.0,
     .needs_hits = false,
-    // 2: CAND3, whose lists name a CSG primitive's leaves (Shape::piece_count).
+    // 2: CAND3, whose lists name a CSG primitive's leaves (Pieces::piece_count).
     .layout = 2,
     .build = [](const RawHits&, const TableContext& ctx, const EncodeOptions& opt) {
         return CandidatesTable::build(ctx, false, opt.memory_budget);

@@ -21,7 +21,7 @@
 namespace lat {
 namespace {
 
-// Payload tag "CAND3": part sets as sorted index lists of pieces (Shape::piece_count). The
+// Payload tag "CAND3": part sets as sorted index lists of pieces (Pieces::piece_count). The
 // tags before it (CAND1, CAND2) were written under another layout (Encoding::layout), so their
 // files have other names in the cache and are never opened: the table is built anew.
 constexpr std::uint64_t kMagic = 0x33444E4143'5441ull;
@@ -83,7 +83,7 @@ double segment_segment_distance(Vec3 p0, Vec3 p1, Vec3 q0, Vec3 q1) {
     return length(p0 + d1 * s - (q0 + d2 * t));
 }
 
-// One piece of the primitive (Shape::piece_count), in lattice units: what "within reach of a
+// One piece of the primitive (Pieces::piece_count), in lattice units: what "within reach of a
 // segment" means for it. A chain's spheres and capsules are tested exactly; other pieces by
 // their spheres, one at a time (the culling sphere that found the segment: a mesh leaf has one
 // per triangle, and scanning them all for every segment would be quadratic).
@@ -98,9 +98,10 @@ struct Part {
     }
 };
 
-std::vector<Part> parts_of(const Shape& shape, double cell) {
+std::vector<Part> parts_of(const Shape& primitive, double cell) {
     std::vector<Part> parts;
-    const auto* chain = dynamic_cast<const ChainShape*>(&shape);
+    const ChainShape* chain = as_chain(primitive);
+    const ShapeSource shape(primitive);
     for (std::size_t i = 0; i < shape.piece_count(); ++i) {
         Part p{Part::kSpheres, {}, {}, 0};
         if (chain && i < chain->spheres().size()) {
@@ -235,7 +236,7 @@ std::vector<Block> find_candidates(const TableContext& ctx, const BoundaryGrid& 
 
 ByteBuffer CandidatesTable::build(const TableContext& ctx, bool progress, std::size_t memory_budget) {
     if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
-    if (ctx.primitive->piece_count() > 0xFFFFFFFFull)
+    if (ShapeSource(*ctx.primitive).piece_count() > 0xFFFFFFFFull)
         throw std::runtime_error("candidates: the primitive has more than 2^32 pieces");
     const BoundaryGrid grid(ctx.cells);
     const std::vector<Block> blocks = find_candidates(ctx, grid, progress, memory_budget);
@@ -309,7 +310,7 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
 
 // Every list lies within the index array, ascending, and names parts the primitive has.
 void CandidatesTable::check_lists(std::uint64_t total) const {
-    const std::uint64_t nparts = ctx_.primitive->piece_count();
+    const std::uint64_t nparts = ShapeSource(*ctx_.primitive).piece_count();
     if (offsets_[0] != 0 || offsets_[sets_] != total)
         throw std::runtime_error("candidates: part list offsets do not match their count");
     for (std::uint32_t i = 0; i < sets_; ++i) {
@@ -346,18 +347,19 @@ bool CandidatesTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) co
     const Vec3 pa = to_vec(grid_.point(a)), pb = to_vec(grid_.point(b));
     const Ray seg{pa * ctx_.cell, (pb - pa) * ctx_.cell};
     const Shape& shape = *ctx_.primitive;
+    const ShapeSource source(shape);  // not a hot path: a table's lookups are for tools
     if (shape.inside(seg.o)) {  // a point of the closed solid on the box: the hit is the point
         hit = {0.0, normalize(shape.normal(seg, nearest_crossing(shape, seg)))};
         return true;
     }
     Crossing best{kInfinity, 0, 0};
-    if (!shape.pieces_are_union()) {
+    if (!source.pieces_are_union()) {
         shape.intersect(seg, 0.0, 1.0 + 1e-12, best);  // not a hot path: the whole primitive
     } else {
         for (int k = 0; k < list.count; ++k) {
             Crossing c;
             const double tmax = std::min(best.t, 1.0 + 1e-12);
-            if (shape.intersect_primitive(list.parts[k], seg, 0.0, tmax, c)) best = c;
+            if (source.parts().intersect_part(list.parts[k], seg, 0.0, tmax, c)) best = c;
         }
     }
     if (best.t > 1.0) return false;

@@ -11,6 +11,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "geometry/lattice_source.h"
 #include "geometry/shape.h"
 #include "lattice/octahedral.h"
 
@@ -98,7 +99,7 @@ private:
     std::vector<Vec3> point_;
     std::map<std::pair<std::uint16_t, std::uint16_t>, std::uint32_t> code_of_;
     std::vector<std::uint32_t> codes_;  // (part, leaf) per code
-    bool cheap_normals_ = true;         // every code's normal (Shape::cheap_normal)
+    bool cheap_normals_ = true;         // every code's normal (LatticeSource::cheap_normal)
     bool use_part_ = false;
     std::vector<std::uint64_t> occ_;
     std::vector<std::uint32_t> counts_;
@@ -124,9 +125,10 @@ private:
 
     // Part codes: the normal re-evaluated at the decoded point; t may need more bits for it.
     // Returns false when the part normals cannot meet the target, when `auto` chooses and some
-    // part's normal is not cheap (Shape::cheap_normal), or when there is no primitive.
+    // part's normal is not cheap (LatticeSource::cheap_normal), or when there is no primitive.
     bool choose_part_codes(std::uint32_t& part_t_bits, std::uint32_t& part_bits) {
         if (ctx_.primitive == nullptr || opt_.normals == DenseNormals::kOct) return false;
+        const ShapeSource primitive(*ctx_.primitive);
         for (const auto& chunk : raw_.chunks)
             for (const RawHit& h : chunk)
                 if (code_of_.emplace(std::make_pair(h.part, h.leaf), std::uint32_t(code_of_.size()))
@@ -134,7 +136,7 @@ private:
                     const Crossing c = h.crossing(0);
                     codes_.push_back(c.part);
                     codes_.push_back(c.leaf);
-                    cheap_normals_ = cheap_normals_ && ctx_.primitive->cheap_normal(c);
+                    cheap_normals_ = cheap_normals_ && primitive.cheap_normal(c);
                 }
         if (opt_.normals == DenseNormals::kAuto && !cheap_normals_) return false;
         part_bits = 0;
@@ -292,9 +294,13 @@ DenseTable::DenseTable(const std::uint8_t* payload, std::size_t size, std::uint6
     records_ = reinterpret_cast<const std::uint64_t*>(payload + sec.records);
     part_codes_ = reinterpret_cast<const std::uint32_t*>(payload + sec.codes);
     // Every part code must name a surface of the primitive: lookups evaluate its normal there.
-    for (std::uint32_t i = 0; i < l_.parts; ++i)
-        if (!ctx.primitive->names_surface({0.0, part_codes_[2 * i], part_codes_[2 * i + 1]}))
-            throw std::runtime_error("dense: a part code names no surface of the primitive");
+    if (l_.parts > 0 && !ctx.primitive) throw std::runtime_error("dense: part codes need the primitive");
+    if (l_.parts > 0) {
+        const ShapeSource primitive(*ctx.primitive);
+        for (std::uint32_t i = 0; i < l_.parts; ++i)
+            if (!primitive.names_surface({0.0, part_codes_[2 * i], part_codes_[2 * i + 1]}))
+                throw std::runtime_error("dense: a part code names no surface of the primitive");
+    }
     t_scale_ = 1.0 / double((1ull << l_.t_bits) - 1);
 }
 
