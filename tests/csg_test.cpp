@@ -202,9 +202,9 @@ TEST(CsgTree, NestedTreesNumberTheirSurfacesMaterials) {
     ASSERT_TRUE(outer->intersect({{0.9, 0, -5}, {0, 0, 1}}, 0, kInfinity, c));
     EXPECT_EQ(outer->surface_materials()[c.leaf_index()], 2u);
 
-    // Swapped for a shape that numbers the primitive's surfaces as the tree does, the instance
-    // leaf keeps their materials; for a shape of one surface, it takes the leaf's tag.
-    // (As a `candidates` lattice of the tree does: the tree's crossings, not a tree itself.)
+    // An instance leaf swapped for another shape (its lattice, in lattice mode) takes the
+    // leaf's tag for every surface that shape numbers: a scene primitive's tree carries no
+    // materials of its own.
     class NumbersTwo final : public Shape, public LatticeSource {
     public:
         Bounds3 bounds() const override { return {{-1, -1, -1}, {1, 1, 1}}; }
@@ -216,11 +216,12 @@ TEST(CsgTree, NestedTreesNumberTheirSurfacesMaterials) {
         std::uint32_t surface_count() const override { return 2; }
         double intersect_cost() const override { return 1; }
     };
-    const auto same =
+    const auto two =
         csg_with_primitive_shapes(*outer, [&](int) { return std::make_shared<NumbersTwo>(); });
-    ASSERT_TRUE(same);
-    const auto kept = csg_surface_materials(*same);
-    EXPECT_EQ(std::vector<std::uint32_t>(kept.begin(), kept.end()), want);
+    ASSERT_TRUE(two);
+    const auto swapped = csg_surface_materials(*two);
+    EXPECT_EQ(std::vector<std::uint32_t>(swapped.begin(), swapped.end()),
+              (std::vector<std::uint32_t>{1, 2, 2}));
     const auto one = csg_with_primitive_shapes(
         *outer, [&](int) { return std::make_shared<SphereShape>(Vec3{0, 0, 0}, 1.0); });
     const auto tagged = csg_surface_materials(*one);

@@ -148,6 +148,7 @@ struct EmbreeAccel::Impl {
         const DirectPrim& d = direct[prim];
         if (!d.shared) return true;
         // Only shapes of several cull parts share them.
+        assert(objects[d.object].cull);
         const CullParts& cull = *objects[d.object].cull;
         if (d.cull == kEveryPart) {
             if (!meets_any_cull_part(cull, local)) return false;
@@ -422,7 +423,7 @@ struct EmbreeAccel::Impl {
         } else if (enter_whole && enters_whole(o)) {
             place_whole(i, wb);
         } else {
-            const ShapeCull cull(*o.shape);
+            const ShapeCull cull = culled(o);
             const std::size_t parts = cull.cull_count();
             for (std::uint32_t c = 0; c < parts; ++c) {
                 Bounds3 b = cull.cull_bounds(c, *o.xf, o.widest_footprint);
@@ -449,8 +450,11 @@ struct EmbreeAccel::Impl {
         direct_bounds.push_back(b);
     }
 
-    static std::size_t part_count(const Placed& o) { return o.parts ? o.parts->part_count() : 1; }
-    static std::size_t cull_count(const Placed& o) { return o.cull ? o.cull->cull_count() : 1; }
+    // The object's parts and cull parts, through the interfaces asked once (Placed).
+    static ShapeParts parted(const Placed& o) { return ShapeParts(*o.shape, o.parts); }
+    static ShapeCull culled(const Placed& o) { return ShapeCull(*o.shape, o.cull); }
+    static std::size_t part_count(const Placed& o) { return parted(o).part_count(); }
+    static std::size_t cull_count(const Placed& o) { return culled(o).cull_count(); }
     // Asked of consecutive objects, which mostly share their shape (instances), once a shape.
     const Shape* cost_asked = nullptr;
     bool cost_cheap = false;
@@ -467,6 +471,7 @@ struct EmbreeAccel::Impl {
     }
     // The bounds of an object entered whole, whose world box is wb: its cull parts' together.
     static Bounds3 whole_bounds(const Placed& o, const Bounds3& wb) {
+        assert(o.cull);  // entered whole: several cull parts
         Bounds3 b;
         for (std::size_t c = 0; c < o.cull->cull_count(); ++c)
             b = merge(b, o.cull->cull_bounds(c, *o.xf, o.widest_footprint));
@@ -515,6 +520,7 @@ EmbreeAccel::Impl::DirectPrim EmbreeAccel::Impl::direct_prim(std::uint32_t objec
                                                              std::uint32_t cull, bool shared,
                                                              const Placed& o) {
     DirectPrim d{object, cull, shared, {}};
+    assert(!shared || o.cull);  // shared: one of several cull parts
     if (Capsule c; shared && o.cull->cull_capsule(cull, *o.xf, o.widest_footprint, c))
         d.capsule = FloatCapsule::holding(c);
     return d;

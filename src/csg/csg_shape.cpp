@@ -66,10 +66,6 @@ void combine_spans(const SpanList& a, const SpanList& b, CsgOp op, SpanList& out
 
 int CsgShape::add_leaf(CsgLeaf leaf) {
     const std::span<const std::uint32_t> inner = csg_surface_materials(*leaf.shape);
-    return add_leaf(std::move(leaf), inner);
-}
-
-int CsgShape::add_leaf(CsgLeaf leaf, std::span<const std::uint32_t> inner) {
     const Bounds3 b = leaf.shape->placed_bounds(leaf.xf);
     const ShapeSource source(*leaf.shape);
     const std::uint32_t first = surfaces_, count = source.surface_count();
@@ -141,14 +137,7 @@ std::shared_ptr<CsgShape> CsgShape::with_primitive_shapes(const PrimitiveShapeFn
     for (const Leaf& l : leaves_) {
         CsgLeaf leaf = l.leaf;
         if (leaf.primitive >= 0) leaf.shape = shape(leaf.primitive);
-        // A shape that numbers the primitive's surfaces (a `candidates` lattice of a tree)
-        // keeps their materials.
-        const std::uint32_t count = ShapeSource(*leaf.shape).surface_count();
-        const std::span<const std::uint32_t> kept(materials_.data() + l.first_surface,
-                                                  l.source.surface_count());
-        const std::span<const std::uint32_t> inner =
-            count == kept.size() ? kept : csg_surface_materials(*leaf.shape);
-        out->add_leaf(std::move(leaf), inner);
+        out->add_leaf(std::move(leaf));
     }
     out->nodes_ = nodes_;
     out->set_root(root_);

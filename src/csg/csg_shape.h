@@ -49,7 +49,8 @@ public:
 
     // The material of each surface the leaf field of its crossings numbers (kNoMaterial: the
     // object's): a leaf's tag, or, for a leaf that is itself a tree, its own surfaces'
-    // materials where they have one.
+    // materials where they have one. (A scene primitive's tree has none: its instances take
+    // their object's material, and an instance leaf its leaf's tag, however it is traced.)
     std::span<const std::uint32_t> surface_materials() const { return materials_; }
 
     Bounds3 bounds() const override;
@@ -90,8 +91,6 @@ private:
     };
     std::uint32_t surfaces_ = 0;
     std::vector<std::uint32_t> materials_;  // per surface number (surface_materials)
-    // add_leaf, with the materials of the leaf's own surfaces (empty: the leaf's tag for all).
-    int add_leaf(CsgLeaf leaf, std::span<const std::uint32_t> inner);
     // The leaf of crossing c, and c as that leaf reported it (its flip bit cleared: this
     // tree's flips count them all).
     struct Located {

@@ -68,6 +68,8 @@ inline const CullParts* cull_parts_of(const Shape& s) { return dynamic_cast<cons
 class ShapeParts {
 public:
     explicit ShapeParts(const Shape& s) : shape_(&s), parts_(parts_of(s)) {}
+    // With the shape's Parts already asked (parts_of; null: it has none).
+    ShapeParts(const Shape& s, const Parts* parts) : shape_(&s), parts_(parts) {}
 
     const Shape& shape() const { return *shape_; }
     // Null for a shape of one part.
@@ -93,7 +95,8 @@ public:
         if (parts_) parts_->part_spans(i, r, out);
         else shape_->spans(r, out);
     }
-    // A shape of one part: the spheres of its LatticeSource, else the sphere around its box.
+    // A shape of one part: the spheres of its LatticeSource, else the sphere around its box
+    // (asked per call: culling spheres are made once, while a table is set up).
     void part_spheres(std::size_t i, std::vector<BoundingSphere>& out) const;
     bool part_capsule(std::size_t i, Capsule& out) const {
         return parts_ && parts_->part_capsule(i, out);
@@ -108,6 +111,8 @@ private:
 class ShapeCull {
 public:
     explicit ShapeCull(const Shape& s) : shape_(&s), cull_(cull_parts_of(s)) {}
+    // With the shape's CullParts already asked (cull_parts_of; null: it has none).
+    ShapeCull(const Shape& s, const CullParts* cull) : shape_(&s), cull_(cull) {}
 
     std::size_t cull_count() const { return cull_ ? cull_->cull_count() : 1; }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf, double widest) const {

@@ -25,6 +25,10 @@ struct BoundingSphere {
     Vec3 center;
     double radius;
 };
+// The sphere around a box.
+inline BoundingSphere sphere_around(const Bounds3& b) {
+    return {b.center(), 0.5 * length(b.extent())};
+}
 
 // The points within distance r of the segment [a, b] (a sphere when a = b).
 struct Capsule {

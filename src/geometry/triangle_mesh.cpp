@@ -164,18 +164,17 @@ bool TriangleMeshShape::occluded(const Ray& r, double tmin, double tmax) const {
     return found;
 }
 
-// Ray parity with orientation: each crossing enters (the ray runs against the outward normal)
-// or leaves. A ray through a shared edge or vertex may cross two triangles at one point; such
-// twins going the same way count once, while an enter and a leave there (a graze) both count.
 void TriangleMeshShape::part_spans(std::size_t, const Ray& r, SpanList& out) const {
     spans(r, out);
 }
 
 void TriangleMeshShape::part_spheres(std::size_t i, std::vector<BoundingSphere>& out) const {
-    const Bounds3 b = part_bounds(i);
-    out.push_back({b.center(), 0.5 * length(b.extent())});
+    out.push_back(sphere_around(part_bounds(i)));
 }
 
+// Ray parity with orientation: each crossing enters (the ray runs against the outward normal)
+// or leaves. A ray through a shared edge or vertex may cross two triangles at one point; such
+// twins going the same way count once, while an enter and a leave there (a graze) both count.
 void TriangleMeshShape::spans(const Ray& r, SpanList& out) const {
     if (!closed_) return;  // an open mesh bounds no solid (the scene reader keeps it out of CSG)
     struct Hit {

@@ -2,9 +2,10 @@
 // A triangle mesh as a shape: traced exactly in double precision (Moller-Trumbore), shaded with
 // the file's vertex normals where a triangle has them at all three corners and with its face
 // normal elsewhere, so that creases stay sharp unless the file (or `smooth`: area-weighted
-// averages of the faces around each vertex) says otherwise. Each triangle is one primitive, so the accelerator holds them one by one. A closed
-// mesh (every edge shared by exactly two triangles, consistently oriented) is also a solid for
-// CSG, inside by ray parity; an open one is only a surface.
+// averages of the faces around each vertex) says otherwise. Each triangle is one part
+// (geometry/parts.h), so the accelerator holds them one by one. A closed mesh (every edge shared
+// by exactly two triangles, consistently oriented) is also a solid for CSG, inside by ray
+// parity; an open one is only a surface.
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -76,7 +77,7 @@ private:
 };
 
 // The mesh s is, if it is one: the typed view for what needs its triangles or whether it is
-// closed (the texture baseline's atlas; CSG, which takes only closed meshes).
+// closed (the texture baseline's atlas).
 const TriangleMeshShape* as_mesh(const Shape& s);
 
 }  // namespace lat

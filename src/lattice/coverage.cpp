@@ -40,8 +40,8 @@ CoverageSample summarise(const BoundaryGrid& grid, std::uint32_t a, std::uint32_
 }
 
 // The closest hit of the sub-ray (lattice units) with the given parts, added to the tally.
-template <class S, class Parts>
-void trace_sub_ray(const S& shape, double h, const SubRay& s, const Parts& parts, Tally& n) {
+template <class S, class List>
+void trace_sub_ray(const S& shape, double h, const SubRay& s, const List& parts, Tally& n) {
     const Ray r{s.p * h, (s.q - s.p) * h};
     Crossing bc;
     if (!first_crossing_of_parts(shape, parts, r, 0.0, 1.0 + 1e-12, bc)) return;
@@ -58,8 +58,8 @@ struct PieceSolid {
     const ShapeSource& source;
 };
 
-template <class Parts>
-void trace_sub_ray(const PieceSolid& solid, double h, const SubRay& s, const Parts& on, Tally& n) {
+template <class List>
+void trace_sub_ray(const PieceSolid& solid, double h, const SubRay& s, const List& on, Tally& n) {
     const Ray r{s.p * h, (s.q - s.p) * h};
     ScratchSpans spans;
     solid.source.pieces_spans(on, r, *spans);
@@ -80,9 +80,9 @@ bool snaps_to(const LatticeFrame& frame, double h, const SubRay& s, std::uint32_
 // The definition: every sub-ray snapped, and intersected with the given parts (the closest hit
 // of each). Sub-rays that the renderer would snap to another pair (their exit rounds
 // elsewhere, or they clip to other faces) are not the pair's rays, and are left out of its share.
-template <class Parts>
+template <class List>
 CoverageSample sample_pair(const ShapeParts& shape, const LatticeFrame& frame, const BoundaryGrid& grid,
-                           double h, std::uint32_t a, std::uint32_t b, const Parts& parts) {
+                           double h, std::uint32_t a, std::uint32_t b, const List& parts) {
     const PairRays pr(grid, grid.point(a), grid.point(b));
     Tally n;
     for (const auto& off : coverage_offsets()) {

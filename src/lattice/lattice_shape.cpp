@@ -42,10 +42,10 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach, const B
     }
     const Vec3 ext = box_.extent();
     const std::size_t axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-    std::vector<Piece> pieces;
+    std::vector<CulledPart> pieces;
     bool capsules = true;
     for (std::size_t i = 0; i < n; ++i) {
-        Piece p;
+        CulledPart p;
         p.part = static_cast<std::uint32_t>(i);
         p.box = lat::intersect(expand(parts.part_bounds(i), reach), region);
         capsules = capsules && parts.part_capsule(i, p.capsule);
@@ -56,11 +56,11 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach, const B
         cull_.push_back({Bounds3{}, 0, 0});
         return;
     }
-    std::vector<Piece> few;  // the capsules, if a few hold them all
+    std::vector<CulledPart> few;  // the capsules, if a few hold them all
     if (capsules && pieces.size() <= 4 * kMaxCullParts) {
         few = pieces;
         // A kept capsule stands for those it covers, so its box is its own (not its part's).
-        for (Piece& p : few) p.box = lat::intersect(p.capsule.placed_bounds(Transform{}), region);
+        for (CulledPart& p : few) p.box = lat::intersect(p.capsule.placed_bounds(Transform{}), region);
         drop_covered(few);
     }
     capsules = capsules && !few.empty() && few.size() <= kMaxCullParts;
@@ -69,9 +69,9 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach, const B
         primitive_ = parts;
         reach_ = reach;
     }
-    for (Piece& p : pieces) p.key = p.box.center()[axis];
+    for (CulledPart& p : pieces) p.key = p.box.center()[axis];
     std::stable_sort(pieces.begin(), pieces.end(),
-                     [](const Piece& a, const Piece& b) { return a.key < b.key; });
+                     [](const CulledPart& a, const CulledPart& b) { return a.key < b.key; });
     group(pieces, capsules, region);
 }
 
@@ -79,8 +79,8 @@ void LatticeFrame::make_cull_parts(const Shape* primitive, double reach, const B
 // callback per ray that meets its box, so pieces inside another are dropped (of equal ones, the
 // first is kept). Quadratic: only for primitives of a few parts. Rounding in the test is far
 // inside kSnapReach's slack.
-void LatticeFrame::drop_covered(std::vector<Piece>& pieces) {
-    std::vector<Piece> kept;
+void LatticeFrame::drop_covered(std::vector<CulledPart>& pieces) {
+    std::vector<CulledPart> kept;
     for (std::size_t i = 0; i < pieces.size(); ++i) {
         bool covered = false;
         for (std::size_t j = 0; j < pieces.size() && !covered; ++j)
@@ -91,7 +91,7 @@ void LatticeFrame::drop_covered(std::vector<Piece>& pieces) {
     pieces = std::move(kept);
 }
 
-void LatticeFrame::group(const std::vector<Piece>& pieces, bool capsules,
+void LatticeFrame::group(const std::vector<CulledPart>& pieces, bool capsules,
                          const Bounds3& region) {
     // Boxes alone: two neighbouring parts a box (for a chain, a sphere and its cylinder) was
     // fastest on the plates among 1, 3, 6, 10 and 19 boxes for the 19-part hair. Capsules pay

@@ -96,7 +96,7 @@ private:
     // primitives of at most this many parts.
     static constexpr std::size_t kMaxPlacedParts = 256;
 
-    struct Piece {  // one part of the primitive, as culling sees it
+    struct CulledPart {  // one part of the primitive, as culling sees it
         Bounds3 box;
         Capsule capsule;
         double key = 0;
@@ -104,8 +104,8 @@ private:
     };
     Bounds3 placed_parts(const CullPart& p, const Transform& xf, double narrower) const;
     void make_cull_parts(const Shape* primitive, double reach, const Bounds3& region);
-    static void drop_covered(std::vector<Piece>& pieces);
-    void group(const std::vector<Piece>& pieces, bool capsules, const Bounds3& region);
+    static void drop_covered(std::vector<CulledPart>& pieces);
+    void group(const std::vector<CulledPart>& pieces, bool capsules, const Bounds3& region);
     void split_in_halves();
 };
 

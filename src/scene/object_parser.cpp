@@ -141,7 +141,9 @@ ObjectParser::Leaf ObjectParser::parse_leaf(const JsonValue& v, const std::strin
     }
     if (type == "mesh") {
         keys({"file", "smooth"});
-        return {mesh(v), Transform{}, -1};
+        std::shared_ptr<const TriangleMeshShape> m = mesh(v);
+        const bool closed = m->closed();
+        return {std::move(m), Transform{}, -1, closed};
     }
     if (type == "instance") {
         keys({"primitive"});
@@ -192,7 +194,7 @@ int ObjectParser::add_csg(CsgShape& csg, const JsonValue& v, const Transform& to
     if (type == "instance" && override_material == kNoMaterial)
         v.at("type").fail("a primitive cannot contain instances");
     Leaf leaf = parse_leaf(v, type);
-    if (const TriangleMeshShape* m = as_mesh(*leaf.shape); m && !m->closed())
+    if (!leaf.solid)
         v.at("file").fail(
             "an open mesh cannot be a csg leaf: it bounds no solid (a closed mesh has every edge "
             "shared by exactly two triangles, wound the same way)");

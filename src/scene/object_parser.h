@@ -44,6 +44,7 @@ private:
         std::shared_ptr<const Shape> shape;
         Transform placement;
         int primitive = -1;
+        bool solid = true;  // false: an open mesh, which bounds no solid (no CSG leaf)
     };
     Leaf parse_leaf(const JsonValue& v, const std::string& type) const;
     // Adds v's subtree to csg; `to_root` maps v's parent frame to the CSG root frame; `depth`

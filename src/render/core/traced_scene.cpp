@@ -3,7 +3,6 @@
 #include <cassert>
 
 #include "csg/csg_shape.h"
-#include "geometry/lattice_source.h"
 
 namespace lat {
 
@@ -21,16 +20,13 @@ TracedScene::TracedScene(const Scene& scene, const InstanceShapeFn& instance_sha
         }
         shapes_.push_back(std::move(s));
     }
-    // Asked once for each run of objects with the same shape and primitive (instances).
+    // A CSG tree's own, as traced (exactly, or with its instance leaves swapped for their
+    // lattices); asked once for each run of objects of one shape (instances).
     const Shape* asked = nullptr;
-    int asked_primitive = -1;
     std::span<const std::uint32_t> m;
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         if (!shapes_[i]) continue;
-        if (shapes_[i].get() != asked || scene.objects[i].primitive != asked_primitive) {
-            asked = shapes_[i].get(), asked_primitive = scene.objects[i].primitive;
-            m = surface_materials(i, *asked);
-        }
+        if (shapes_[i].get() != asked) asked = shapes_[i].get(), m = csg_surface_materials(*asked);
         if (m.empty()) continue;
         surface_materials_.resize(scene.objects.size());
         surface_materials_[i] = m;
@@ -59,22 +55,6 @@ bool TracedScene::intersect_layers(const Ray& r, double tmin, double tmax, std::
     partial.resize(layers.size());
     for (std::size_t i = 0; i < layers.size(); ++i) surface_hit(r, layers[i], partial[i]);
     return found;
-}
-
-// A CSG tree's own materials, as traced (exactly, or with its instance leaves swapped for their
-// lattices); for an instance of a CSG primitive, the primitive's, when the traced shape numbers
-// its surfaces as the tree does (a `candidates` lattice; a lattice of one surface names that
-// one), else none: a lattice that does not tell the surfaces apart takes the object's material.
-std::span<const std::uint32_t> TracedScene::surface_materials(std::size_t i,
-                                                              const Shape& traced) const {
-    const SceneObject& o = scene_.objects[i];
-    const std::span<const std::uint32_t> own = csg_surface_materials(traced);
-    if (!own.empty() || o.primitive < 0) return own;
-    const Shape* primitive = scene_.primitives[static_cast<std::size_t>(o.primitive)].shape.get();
-    const std::span<const std::uint32_t> of_primitive =
-        primitive ? csg_surface_materials(*primitive) : std::span<const std::uint32_t>{};
-    return ShapeSource(traced).surface_count() == of_primitive.size() ? of_primitive
-                                                                      : std::span<const std::uint32_t>{};
 }
 
 std::uint32_t TracedScene::material(std::uint32_t object, const Crossing& c) const {

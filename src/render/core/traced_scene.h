@@ -79,8 +79,6 @@ private:
     std::unique_ptr<EmbreeAccel> accel_;
 
     void surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const;
-    // The materials of object i's surfaces, traced as `traced` (see surface_materials_).
-    std::span<const std::uint32_t> surface_materials(std::size_t i, const Shape& traced) const;
     // The material of crossing c of object i.
     std::uint32_t material(std::uint32_t object, const Crossing& c) const;
 };

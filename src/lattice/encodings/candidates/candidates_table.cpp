@@ -12,7 +12,7 @@
 #include <string_view>
 #include <unordered_map>
 
-#include "geometry/chain.h"
+#include "geometry/lattice_source.h"
 #include "lattice/face_cones.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -84,10 +84,11 @@ double segment_segment_distance(Vec3 p0, Vec3 p1, Vec3 q0, Vec3 q1) {
 }
 
 // One piece of the primitive (Pieces::piece_count), in lattice units: what "within reach of a
-// segment" means for it. A chain's spheres and capsules are tested exactly; other pieces by
-// their spheres, one at a time (the culling sphere that found the segment: a mesh leaf has one
-// per triangle, and scanning them all for every segment would be quadratic).
-struct Part {
+// segment" means for it. Parts that know a capsule holding them (a chain's spheres and
+// cylinders: Parts::part_capsule) are tested exactly by it; other pieces by their spheres, one at
+// a time (the culling sphere that found the segment: a mesh leaf has one per triangle, and
+// scanning them all for every segment would be quadratic).
+struct Piece {
     enum Kind { kSphere, kCapsule, kSpheres } kind;
     Vec3 a, b;  // centre, or capsule axis
     double r;   // radius
@@ -98,23 +99,18 @@ struct Part {
     }
 };
 
-std::vector<Part> parts_of(const Shape& primitive, double cell) {
-    std::vector<Part> parts;
-    const ChainShape* chain = as_chain(primitive);
+std::vector<Piece> pieces_of(const Shape& primitive, double cell) {
+    std::vector<Piece> pieces;
     const ShapeSource shape(primitive);
     for (std::size_t i = 0; i < shape.piece_count(); ++i) {
-        Part p{Part::kSpheres, {}, {}, 0};
-        if (chain && i < chain->spheres().size()) {
-            const ChainSphere& s = chain->spheres()[i];
-            p = {Part::kSphere, s.center / cell, {}, s.radius / cell};
-        } else if (chain) {
-            const ChainCylinder& c = chain->cylinders()[i - chain->spheres().size()];
-            p = {Part::kCapsule, chain->spheres()[static_cast<std::size_t>(c.from)].center / cell,
-                 chain->spheres()[static_cast<std::size_t>(c.to)].center / cell, c.radius / cell};
-        }
-        parts.push_back(p);
+        Piece p{Piece::kSpheres, {}, {}, 0};
+        // The pieces are the parts where the shape is their union.
+        if (Capsule c; shape.pieces_are_union() && shape.parts().part_capsule(i, c))
+            p = c.a == c.b ? Piece{Piece::kSphere, c.a / cell, {}, c.r / cell}
+                           : Piece{Piece::kCapsule, c.a / cell, c.b / cell, c.r / cell};
+        pieces.push_back(p);
     }
-    return parts;
+    return pieces;
 }
 
 struct Scratch {
@@ -158,7 +154,7 @@ struct Block {
 class CandidateFinder {
 public:
     CandidateFinder(const TableContext& ctx, const BoundaryGrid& grid)
-        : grid_(grid), parts_(parts_of(*ctx.primitive, ctx.cell)) {
+        : grid_(grid), pieces_(pieces_of(*ctx.primitive, ctx.cell)) {
         const Vec3 cells{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])};
         cull_ = piece_spheres(*ctx.primitive, ctx.cell, cells, kSnapReach, 1e-9);
         for (int f = 0; f < 6; ++f) faces_[static_cast<std::size_t>(f)] = layout_face(grid, f);
@@ -172,7 +168,7 @@ public:
         std::vector<std::uint32_t>& self = s.self;
         self.clear();
         for (const PartSphere& ps : cull_)
-            if ((self.empty() || self.back() != ps.part) && parts_[ps.part].near(ps, p, p))
+            if ((self.empty() || self.back() != ps.part) && pieces_[ps.part].near(ps, p, p))
                 self.push_back(ps.part);
         if (!self.empty()) out.emit(CandidatesTable::pair_index(a, a), self);
         for (const FaceLayout& fl : faces_) {
@@ -182,7 +178,7 @@ public:
                     std::vector<std::uint32_t>& l = s.parts[k];
                     if (fl.ids[k] <= a || (!l.empty() && l.back() == ps.part)) return;
                     if (!BoundaryGrid::valid_pair(fa, fl.mask[k])) return;
-                    if (!parts_[ps.part].near(ps, p, q)) return;
+                    if (!pieces_[ps.part].near(ps, p, q)) return;
                     if (l.empty()) s.touched.push_back(k);
                     l.push_back(ps.part);
                 });
@@ -197,7 +193,7 @@ public:
 
 private:
     const BoundaryGrid& grid_;
-    std::vector<Part> parts_;
+    std::vector<Piece> pieces_;
     // Grouped by part in ascending order: each face point's list is then built sorted, and a
     // part already in it is its last entry.
     std::vector<PartSphere> cull_;
