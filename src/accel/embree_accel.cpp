@@ -50,29 +50,34 @@ struct EmbreeAccel::Impl {
     std::uint32_t our_number(std::uint32_t given_self) const {
         return given_self < numbered.size() ? numbered[given_self] : EmbreeAccel::kNoObject;
     }
+    // The objects given, while the accelerator is built (AccelObjects).
+    const AccelObjects* given = nullptr;
+    Transform transform_of(std::uint32_t obj) const { return given->transform(objects[obj].original); }
     // Fills objects with the objects given, in the order of a Morton curve through the centres
     // of their world boxes (empty and unbounded ones last), and bounds with those boxes.
-    void number_objects(std::span<const AccelObject> given_objects, std::vector<Bounds3>& bounds) {
-        std::vector<Bounds3> given_bounds(given_objects.size());
-        std::vector<Vec3> centres(given_objects.size());
-        tbb::parallel_for(std::size_t{0}, given_objects.size(), [&](std::size_t i) {
-            const AccelObject& o = given_objects[i];
-            const Bounds3& b = given_bounds[i] = o.shape->placed_bounds(*o.xf);
+    void number_objects(std::vector<Bounds3>& bounds) {
+        const std::size_t n = given->size();
+        std::vector<Bounds3> given_bounds(n);
+        std::vector<Vec3> centres(n);
+        tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+            const Bounds3& b = given_bounds[i] = given->shape(i)->placed_bounds(given->transform(i));
             const bool held = embree_can_hold(b) && !b.empty();
             centres[i] = held ? b.center() : Vec3{kInfinity, 0, 0};
         });
         const std::vector<std::uint32_t> order = space_order(centres);
-        numbered.resize(given_objects.size());
-        objects.reserve(given_objects.size());
-        bounds.reserve(given_objects.size());
-        for (const std::uint32_t i : order) {
-            const AccelObject& o = given_objects[i];
-            numbered[i] = static_cast<std::uint32_t>(objects.size());
-            objects.push_back({o.shape, sheet_source(*o.shape), o.xf, o.xf->inverse_map(),
-                               o.widest_footprint, i, o.xf->is_identity(),
-                               keeps_directions_across(*o.xf)});
-            bounds.push_back(given_bounds[i]);
-        }
+        centres = {};
+        numbered.resize(n);
+        objects.resize(n);
+        bounds.resize(n);
+        tbb::parallel_for(std::size_t{0}, n, [&](std::size_t k) {
+            const std::uint32_t i = order[k];
+            const Shape* shape = given->shape(i);
+            const Transform xf = given->transform(i);
+            numbered[i] = static_cast<std::uint32_t>(k);
+            objects[k] = {shape, sheet_source(*shape), xf.inverse_map(), given->widest_footprint(i),
+                          i, xf.is_identity(), keeps_directions_across(xf)};
+            bounds[k] = given_bounds[i];
+        });
     }
     // The top-level user geometry of single-part objects: one primitive per cull part
     // (Shape::cull_count).
@@ -87,9 +92,9 @@ struct EmbreeAccel::Impl {
     };
     static_assert(sizeof(DirectPrim) == 36);
     static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
-                                  const Placed& o);
+                                  const Placed& o, const Transform& xf);
     std::vector<DirectPrim> direct;
-    std::vector<Bounds3> direct_bounds;      // world space, per direct primitive; build only
+    std::vector<RTCBounds> direct_bounds;    // world space, per direct primitive; build only
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
     std::vector<std::uint32_t> inst_object;  // top-level geomID -> object, for instances
     struct FlatPrim {
@@ -379,13 +384,21 @@ struct EmbreeAccel::Impl {
     static void bounds_flat(const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
         const FlatPrim fp = self->flat[args->primID];
-        const Placed& o = self->objects[fp.object];
-        *args->bounds_o = to_rtc_bounds(o.shape->primitive_bounds(fp.part, *o.xf));
+        // An object's parts come one after another: its transform is made once for them all.
+        thread_local const Impl* last_accel = nullptr;
+        thread_local std::uint32_t last_object = EmbreeAccel::kNoObject;
+        thread_local Transform xf;
+        if (last_accel != self || last_object != fp.object) {
+            xf = self->transform_of(fp.object);
+            last_accel = self;
+            last_object = fp.object;
+        }
+        *args->bounds_o = to_rtc_bounds(self->objects[fp.object].shape->primitive_bounds(fp.part, xf));
     }
 
     static void bounds_direct(const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
-        *args->bounds_o = to_rtc_bounds(self->direct_bounds[args->primID]);
+        *args->bounds_o = self->direct_bounds[args->primID];
     }
 
     static void bounds_proto(const RTCBoundsFunctionArguments* args) {
@@ -423,14 +436,15 @@ struct EmbreeAccel::Impl {
             place_whole(i, wb);
         } else {
             const std::size_t parts = o.shape->cull_count();
+            const Transform xf = transform_of(i);
             for (std::uint32_t c = 0; c < parts; ++c) {
-                Bounds3 b = o.shape->cull_bounds(c, *o.xf, o.widest_footprint);
+                Bounds3 b = o.shape->cull_bounds(c, xf, o.widest_footprint);
                 if (parts == 1) b = lat::intersect(wb, b);  // a lone part: within the object's box
                 if (b.empty()) continue;
-                direct.push_back(direct_prim(i, c, parts > 1, o));
+                direct.push_back(direct_prim(i, c, parts > 1, o, xf));
                 o.direct = true;
                 o.cheap_blocker = o.shape->intersect_cost() <= EmbreeAccel::kCheapBlockerCost;
-                direct_bounds.push_back(b);
+                direct_bounds.push_back(to_rtc_bounds(b));
             }
         }
     }
@@ -445,17 +459,19 @@ struct EmbreeAccel::Impl {
         direct.push_back({i, kEveryPart, 1, {}});  // no capsule: every line meets it
         o.direct = true;
         o.cheap_blocker = o.shape->intersect_cost() <= EmbreeAccel::kCheapBlockerCost;
-        direct_bounds.push_back(b);
+        direct_bounds.push_back(to_rtc_bounds(b));
     }
 
     static bool enters_whole(const Placed& o) {
         return o.shape->primitive_count() <= 1 && o.shape->cull_count() > 1;
     }
     // The bounds of an object entered whole, whose world box is wb: its cull parts' together.
-    static Bounds3 whole_bounds(const Placed& o, const Bounds3& wb) {
+    Bounds3 whole_bounds(std::uint32_t i, const Bounds3& wb) const {
+        const Placed& o = objects[i];
+        const Transform xf = transform_of(i);
         Bounds3 b;
         for (std::size_t c = 0; c < o.shape->cull_count(); ++c)
-            b = merge(b, o.shape->cull_bounds(c, *o.xf, o.widest_footprint));
+            b = merge(b, o.shape->cull_bounds(c, xf, o.widest_footprint));
         return lat::intersect(wb, b);
     }
 
@@ -464,7 +480,7 @@ struct EmbreeAccel::Impl {
         const Placed& o = objects[i];
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(g, prototype_scene(o.shape));
-        const Affine& a = o.xf->forward();
+        const Affine a = transform_of(i).forward();
         float xfm[12];
         for (int r = 0; r < 3; ++r) {
             for (int c = 0; c < 3; ++c)
@@ -499,18 +515,41 @@ static void on_embree_error(void* user, RTCError, const char* str) {
 
 EmbreeAccel::Impl::DirectPrim EmbreeAccel::Impl::direct_prim(std::uint32_t object,
                                                              std::uint32_t cull, bool shared,
-                                                             const Placed& o) {
+                                                             const Placed& o, const Transform& xf) {
     DirectPrim d{object, cull, shared, {}};
-    if (Capsule c; shared && o.shape->cull_capsule(cull, *o.xf, o.widest_footprint, c))
+    if (Capsule c; shared && o.shape->cull_capsule(cull, xf, o.widest_footprint, c))
         d.capsule = FloatCapsule::holding(c);
     return d;
 }
 
+namespace {
+
+// AccelObjects over objects whose transforms are held by the caller.
+class GivenObjects final : public AccelObjects {
+public:
+    explicit GivenObjects(std::span<const AccelObject> objects) : objects_(objects) {}
+    std::size_t size() const override { return objects_.size(); }
+    const Shape* shape(std::size_t i) const override { return objects_[i].shape; }
+    Transform transform(std::size_t i) const override { return *objects_[i].xf; }
+    double widest_footprint(std::size_t i) const override {
+        return objects_[i].widest_footprint;
+    }
+
+private:
+    std::span<const AccelObject> objects_;
+};
+
+}  // namespace
+
 EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOptions& opt)
+    : EmbreeAccel(GivenObjects(objects), opt) {}
+
+EmbreeAccel::EmbreeAccel(const AccelObjects& objects, const AccelOptions& opt)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
+    m.given = &objects;
     std::vector<Bounds3> placed_bounds;
-    m.number_objects(objects, placed_bounds);
+    m.number_objects(placed_bounds);
     m.device = rtcNewDevice(nullptr);
     if (!m.device) throw std::runtime_error("Embree: cannot create a device");
     rtcSetDeviceErrorFunction(m.device, on_embree_error, &m);
@@ -533,7 +572,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
             const Placed& o = m.objects[i];
             const Bounds3& wb = placed_bounds[i];
             if (Impl::enters_whole(o) && !wb.empty() && embree_can_hold(wb))
-                placed_bounds[i] = Impl::whole_bounds(o, wb);
+                placed_bounds[i] = m.whole_bounds(static_cast<std::uint32_t>(i), wb);
         });
 
     // Placing takes a tenth of the bar, Embree's build the rest.
@@ -542,6 +581,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
         m.place(i, placed_bounds[i]);
         if (i % 4096 == 0) bar.set(100 * std::uint64_t{i} / m.objects.size());
     }
+    placed_bounds = {};  // not held through Embree's build, the peak of memory
     // Tested one after another: in the order given, as before they were numbered in space.
     std::sort(m.unbounded.begin(), m.unbounded.end(), [&](std::uint32_t a, std::uint32_t b) {
         return m.objects[a].original < m.objects[b].original;
@@ -564,6 +604,7 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
     rtcCommitScene(m.scene);
     rtcSetSceneProgressMonitorFunction(m.scene, nullptr, nullptr);
     m.direct_bounds = {};  // read only by the build
+    m.given = nullptr;
     bar.finish();
     if (!m.error.empty()) throw std::runtime_error("Embree: " + m.error);
 }

@@ -38,8 +38,9 @@ std::uint64_t instance_geometry_bytes(const Scene& scene) {
     std::uint64_t bytes = 0;
     std::vector<bool> counted(scene.primitives.size(), false);
     for (const std::size_t i : instance_objects(scene)) {
-        bytes += sizeof(Transform);
-        const auto p = static_cast<std::size_t>(scene.objects[i].primitive);
+        std::size_t in_group = i;
+        bytes += scene.group_of(in_group) ? sizeof(Affine) : sizeof(Transform);
+        const auto p = static_cast<std::size_t>(scene.primitive_of(i));
         if (counted[p]) continue;
         counted[p] = true;
         if (const auto* c = dynamic_cast<const ChainShape*>(scene.primitives[p].shape.get()))

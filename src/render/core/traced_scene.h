@@ -67,12 +67,12 @@ public:
 
     const Scene& scene() const { return scene_; }
     // The shape traced for an object (its lattice, in lattice mode).
-    const Shape& shape(std::uint32_t object) const { return *shapes_[object]; }
+    const Shape& shape(std::uint32_t object) const;
 
 private:
     const Scene& scene_;
-    std::vector<std::shared_ptr<const Shape>> shapes_;  // per object, as traced
-    std::vector<AccelObject> accel_objects_;
+    // As traced: per object of scene.objects, and per scatter group (its instances share it).
+    std::vector<std::shared_ptr<const Shape>> object_shapes_, group_shapes_;
     std::unique_ptr<EmbreeAccel> accel_;
 
     void surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const;
