@@ -54,30 +54,52 @@ struct EmbreeAccel::Impl {
     const AccelObjects* given = nullptr;
     Transform transform_of(std::uint32_t obj) const { return given->transform(objects[obj].original); }
     // Fills objects with the objects given, in the order of a Morton curve through the centres
-    // of their world boxes (empty and unbounded ones last), and bounds with those boxes.
+    // of their world boxes (empty and unbounded ones last), and bounds with their bounds in the
+    // hierarchy: their world boxes, or for objects entered whole (enter_whole, set before)
+    // whole_bounds. Each object's transform is made once, in the order given (a scene's
+    // placements are read in turn), and the records are then put in space order in place.
     void number_objects(std::vector<Bounds3>& bounds) {
         const std::size_t n = given->size();
-        std::vector<Bounds3> given_bounds(n);
+        objects.resize(n);
+        bounds.resize(n);
         std::vector<Vec3> centres(n);
         tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-            const Bounds3& b = given_bounds[i] = given->shape(i)->placed_bounds(given->transform(i));
+            const Shape* shape = given->shape(i);
+            const Transform xf = given->transform(i);
+            const double widest = given->widest_footprint(i);
+            Bounds3 b = shape->placed_bounds(xf);
             const bool held = embree_can_hold(b) && !b.empty();
             centres[i] = held ? b.center() : Vec3{kInfinity, 0, 0};
+            if (held && enter_whole && enters_whole(*shape)) b = whole_bounds(*shape, xf, widest, b);
+            bounds[i] = b;
+            objects[i] = {shape, sheet_source(*shape), xf.inverse_map(), widest,
+                          static_cast<std::uint32_t>(i), xf.is_identity(),
+                          keeps_directions_across(xf)};
         });
         const std::vector<std::uint32_t> order = space_order(centres);
         centres = {};
         numbered.resize(n);
-        objects.resize(n);
-        bounds.resize(n);
-        tbb::parallel_for(std::size_t{0}, n, [&](std::size_t k) {
-            const std::uint32_t i = order[k];
-            const Shape* shape = given->shape(i);
-            const Transform xf = given->transform(i);
-            numbered[i] = static_cast<std::uint32_t>(k);
-            objects[k] = {shape, sheet_source(*shape), xf.inverse_map(), given->widest_footprint(i),
-                          i, xf.is_identity(), keeps_directions_across(xf)};
-            bounds[k] = given_bounds[i];
-        });
+        for (std::size_t k = 0; k < n; ++k) numbered[order[k]] = static_cast<std::uint32_t>(k);
+        // objects[k] = objects as given[order[k]], cycle by cycle.
+        std::vector<bool> done(n, false);
+        for (std::size_t k = 0; k < n; ++k) {
+            if (done[k]) continue;
+            const Placed first = objects[k];
+            const Bounds3 first_bounds = bounds[k];
+            std::size_t j = k;
+            for (;;) {
+                done[j] = true;
+                const std::size_t from = order[j];
+                if (from == k) {
+                    objects[j] = first;
+                    bounds[j] = first_bounds;
+                    break;
+                }
+                objects[j] = objects[from];
+                bounds[j] = bounds[from];
+                j = from;
+            }
+        }
     }
     // The top-level user geometry of single-part objects: one primitive per cull part
     // (Shape::cull_count).
@@ -432,7 +454,7 @@ struct EmbreeAccel::Impl {
             for (std::uint32_t p = 0; p < o.shape->primitive_count(); ++p) flat.push_back({i, p});
         } else if (o.shape->primitive_count() > 1) {
             place_instance(i);
-        } else if (enter_whole && enters_whole(o)) {
+        } else if (enter_whole && enters_whole(*o.shape)) {
             place_whole(i, wb);
         } else {
             const std::size_t parts = o.shape->cull_count();
@@ -462,16 +484,15 @@ struct EmbreeAccel::Impl {
         direct_bounds.push_back(to_rtc_bounds(b));
     }
 
-    static bool enters_whole(const Placed& o) {
-        return o.shape->primitive_count() <= 1 && o.shape->cull_count() > 1;
+    static bool enters_whole(const Shape& shape) {
+        return shape.primitive_count() <= 1 && shape.cull_count() > 1;
     }
     // The bounds of an object entered whole, whose world box is wb: its cull parts' together.
-    Bounds3 whole_bounds(std::uint32_t i, const Bounds3& wb) const {
-        const Placed& o = objects[i];
-        const Transform xf = transform_of(i);
+    static Bounds3 whole_bounds(const Shape& shape, const Transform& xf, double widest,
+                                const Bounds3& wb) {
         Bounds3 b;
-        for (std::size_t c = 0; c < o.shape->cull_count(); ++c)
-            b = merge(b, o.shape->cull_bounds(c, xf, o.widest_footprint));
+        for (std::size_t c = 0; c < shape.cull_count(); ++c)
+            b = merge(b, shape.cull_bounds(c, xf, widest));
         return lat::intersect(wb, b);
     }
 
@@ -548,8 +569,15 @@ EmbreeAccel::EmbreeAccel(const AccelObjects& objects, const AccelOptions& opt)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.given = &objects;
+    // Numbering takes a tenth of the bar, placing another, Embree's build the rest.
+    ProgressBar bar("build", 1000, opt.progress, 1000);
+    std::size_t cull_parts = 0;
+    for (std::size_t i = 0; i < objects.size(); ++i)
+        if (const Shape& s = *objects.shape(i); Impl::enters_whole(s)) cull_parts += s.cull_count();
+    m.enter_whole = cull_parts > opt.cull_part_budget;
     std::vector<Bounds3> placed_bounds;
     m.number_objects(placed_bounds);
+    bar.set(100);
     m.device = rtcNewDevice(nullptr);
     if (!m.device) throw std::runtime_error("Embree: cannot create a device");
     rtcSetDeviceErrorFunction(m.device, on_embree_error, &m);
@@ -561,25 +589,9 @@ EmbreeAccel::EmbreeAccel(const AccelObjects& objects, const AccelOptions& opt)
         if (o.shape->primitive_count() > 1) parts += o.shape->primitive_count();
     m.flatten = opt.instancing == Instancing::kNever ||
                 (opt.instancing == Instancing::kAuto && parts <= opt.flatten_budget);
-    std::size_t cull_parts = 0;
-    for (const Placed& o : m.objects)
-        if (Impl::enters_whole(o)) cull_parts += o.shape->cull_count();
-    m.enter_whole = cull_parts > opt.cull_part_budget;
-    // Objects entered whole are bounded by their cull parts together, a bound made in
-    // parallel (place is sequential).
-    if (m.enter_whole)
-        tbb::parallel_for(std::size_t{0}, m.objects.size(), [&](std::size_t i) {
-            const Placed& o = m.objects[i];
-            const Bounds3& wb = placed_bounds[i];
-            if (Impl::enters_whole(o) && !wb.empty() && embree_can_hold(wb))
-                placed_bounds[i] = m.whole_bounds(static_cast<std::uint32_t>(i), wb);
-        });
-
-    // Placing takes a tenth of the bar, Embree's build the rest.
-    ProgressBar bar("build", 1000, opt.progress, 1000);
     for (std::uint32_t i = 0; i < m.objects.size(); ++i) {
         m.place(i, placed_bounds[i]);
-        if (i % 4096 == 0) bar.set(100 * std::uint64_t{i} / m.objects.size());
+        if (i % 4096 == 0) bar.set(100 + 100 * std::uint64_t{i} / m.objects.size());
     }
     placed_bounds = {};  // not held through Embree's build, the peak of memory
     // Tested one after another: in the order given, as before they were numbered in space.
@@ -597,7 +609,7 @@ EmbreeAccel::EmbreeAccel(const AccelObjects& objects, const AccelOptions& opt)
     rtcSetSceneProgressMonitorFunction(
         m.scene,
         [](void* b, double done) {
-            static_cast<ProgressBar*>(b)->set(100 + static_cast<std::uint64_t>(900 * done));
+            static_cast<ProgressBar*>(b)->set(200 + static_cast<std::uint64_t>(800 * done));
             return true;
         },
         &bar);

@@ -12,6 +12,7 @@
 #include "render/core/camera.h"
 #include "render/modes/integrators.h"
 #include "render/baselines/scene_parts.h"
+#include "util/memory.h"
 
 namespace lat {
 namespace {
@@ -122,10 +123,12 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             r.prepare_ms = ms_since(t0);
             dist::mark(dist::Step::kTables);
             t0 = clock::now();
+            const double cpu0 = cpu_seconds();
             AccelOptions accel = settings.accel;
             accel.progress = settings.progress;
             const TracedScene rs(scene, instance_shape, accel, r.lattices.widest_footprints);
             r.build_ms = ms_since(t0);
+            r.build_cpu_ms = (cpu_seconds() - cpu0) * 1e3;
             dist::mark(dist::Step::kAccel);
             if (settings.before_render) settings.before_render();
             // Partial hits are traced in layers, chosen here once: a filter makes them
