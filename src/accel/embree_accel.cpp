@@ -57,7 +57,7 @@ struct EmbreeAccel::Impl {
     // of their world boxes (empty and unbounded ones last), and bounds with their bounds in the
     // hierarchy: their world boxes, or for objects entered whole (enter_whole, set before)
     // whole_bounds. Each object's transform is made once, in the order given (a scene's
-    // placements are read in turn), and the records are then put in space order in place.
+    // placements are read in turn), and the records are then put in space order.
     void number_objects(std::vector<Bounds3>& bounds) {
         const std::size_t n = given->size();
         objects.resize(n);
@@ -79,27 +79,19 @@ struct EmbreeAccel::Impl {
         const std::vector<std::uint32_t> order = space_order(centres);
         centres = {};
         numbered.resize(n);
-        for (std::size_t k = 0; k < n; ++k) numbered[order[k]] = static_cast<std::uint32_t>(k);
-        // objects[k] = objects as given[order[k]], cycle by cycle.
-        std::vector<bool> done(n, false);
-        for (std::size_t k = 0; k < n; ++k) {
-            if (done[k]) continue;
-            const Placed first = objects[k];
-            const Bounds3 first_bounds = bounds[k];
-            std::size_t j = k;
-            for (;;) {
-                done[j] = true;
-                const std::size_t from = order[j];
-                if (from == k) {
-                    objects[j] = first;
-                    bounds[j] = first_bounds;
-                    break;
-                }
-                objects[j] = objects[from];
-                bounds[j] = bounds[from];
-                j = from;
-            }
-        }
+        tbb::parallel_for(std::size_t{0}, n, [&](std::size_t k) {
+            numbered[order[k]] = static_cast<std::uint32_t>(k);
+        });
+        objects = in_order(objects, order);
+        bounds = in_order(bounds, order);
+    }
+    // v[order[0]], v[order[1]], ...: gathered in parallel (the reads fall at random in v),
+    // one vector at a time, so that the copy is never more than one vector's size.
+    template <class T>
+    static std::vector<T> in_order(const std::vector<T>& v, const std::vector<std::uint32_t>& order) {
+        std::vector<T> out(v.size());
+        tbb::parallel_for(std::size_t{0}, v.size(), [&](std::size_t k) { out[k] = v[order[k]]; });
+        return out;
     }
     // The top-level user geometry of single-part objects: one primitive per cull part
     // (Shape::cull_count).
