@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <map>
@@ -50,8 +51,9 @@ struct EmbreeAccel::Impl {
     std::uint32_t our_number(std::uint32_t given_self) const {
         return given_self < numbered.size() ? numbered[given_self] : EmbreeAccel::kNoObject;
     }
-    // The objects given, while the accelerator is built (AccelObjects).
+    // The objects given, while the accelerator is built (AccelObjects), and the build's number.
     const AccelObjects* given = nullptr;
+    std::uint64_t build = 0;
     Transform transform_of(std::uint32_t obj) const { return given->transform(objects[obj].original); }
     // Fills objects with the objects given, in the order of a Morton curve through the centres
     // of their world boxes (empty and unbounded ones last), and bounds with their bounds in the
@@ -398,13 +400,14 @@ struct EmbreeAccel::Impl {
     static void bounds_flat(const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
         const FlatPrim fp = self->flat[args->primID];
-        // An object's parts come one after another: its transform is made once for them all.
-        thread_local const Impl* last_accel = nullptr;
+        // An object's parts come one after another: its transform is made once for them all
+        // (kept by the build, whose number no later accelerator shares, unlike its address).
+        thread_local std::uint64_t last_build = 0;
         thread_local std::uint32_t last_object = EmbreeAccel::kNoObject;
         thread_local Transform xf;
-        if (last_accel != self || last_object != fp.object) {
+        if (last_build != self->build || last_object != fp.object) {
             xf = self->transform_of(fp.object);
-            last_accel = self;
+            last_build = self->build;
             last_object = fp.object;
         }
         *args->bounds_o = to_rtc_bounds(self->objects[fp.object].shape->primitive_bounds(fp.part, xf));
@@ -560,7 +563,9 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
 EmbreeAccel::EmbreeAccel(const AccelObjects& objects, const AccelOptions& opt)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
+    static std::atomic<std::uint64_t> builds{0};
     m.given = &objects;
+    m.build = ++builds;
     // Numbering takes a tenth of the bar, placing another, Embree's build the rest.
     ProgressBar bar("build", 1000, opt.progress, 1000);
     std::size_t cull_parts = 0;
