@@ -14,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::string text(reinterpret_cast<const char*>(data), size);
     try {
         lat::Scene scene = lat::load_scene_text(text, "fuzz.json");
-        if (scene.objects.size() > 32) return 0;
+        if (scene.object_count() > 32) return 0;
         scene.camera.width = 4;  // the geometry is what is fuzzed, not the image size
         scene.camera.height = 3;
         const lat::TracedScene rs(scene);

@@ -53,14 +53,12 @@ pyb::list scatters(const PyScene& s) {
         const auto n = static_cast<pyb::ssize_t>(g.count);
         pyb::array_t<double> roots({n, pyb::ssize_t{3}}), frames({n, pyb::ssize_t{3}, pyb::ssize_t{3}}), scales(n);
         double *r = roots.mutable_data(), *f = frames.mutable_data(), *sc = scales.mutable_data();
-        std::string primitive;
+        const Primitive& prim = s.scene.primitives[static_cast<std::size_t>(g.primitive)];
         for (std::size_t i = 0; i < g.count; ++i) {
-            const SceneObject& o = s.scene.objects[g.first + i];
-            const Primitive& prim = s.scene.primitives[static_cast<std::size_t>(o.primitive)];
-            primitive = prim.name;
-            const Mat3& m = o.xf.forward().m;
+            const Affine& a = g.placements[i];
+            const Mat3& m = a.m;
             const double scale = std::cbrt(std::abs(determinant(m)));
-            const Vec3 root = o.xf.point(primitive_root(prim));
+            const Vec3 root = a.point(primitive_root(prim));
             for (int c = 0; c < 3; ++c) {
                 r[3 * i + c] = root[c];
                 for (int k = 0; k < 3; ++k) f[9 * i + 3 * c + k] = m.r[c][k] / scale;
@@ -70,7 +68,7 @@ pyb::list scatters(const PyScene& s) {
         pyb::dict d;
         d["name"] = g.name;
         d["object"] = g.json_index;
-        d["primitive"] = primitive;
+        d["primitive"] = prim.name;
         d["roots"] = roots;
         d["frames"] = frames;
         d["scales"] = scales;
@@ -96,7 +94,7 @@ e.g. "scene: objects[3].transform: ...".)")
         .def_property_readonly("load_ms", [](const PyScene& s) { return s.load_ms; })
         .def_property_readonly("width", [](const PyScene& s) { return s.scene.camera.width; })
         .def_property_readonly("height", [](const PyScene& s) { return s.scene.camera.height; })
-        .def_property_readonly("object_count", [](const PyScene& s) { return s.scene.objects.size(); })
+        .def_property_readonly("object_count", [](const PyScene& s) { return s.scene.object_count(); })
         .def_property_readonly("primitives", [](const PyScene& s) {
             std::vector<std::string> names;
             for (const Primitive& p : s.scene.primitives) names.push_back(p.name);
@@ -112,7 +110,7 @@ e.g. "scene: objects[3].transform: ...".)")
              "A copy to edit; shapes and meshes are shared, not reloaded")
         .def("__repr__", [](const PyScene& s) {
             return "<lattice.Scene " + s.scene.file + ": " + std::to_string(s.scene.camera.width) + "x" +
-                   std::to_string(s.scene.camera.height) + ", " + std::to_string(s.scene.objects.size()) +
+                   std::to_string(s.scene.camera.height) + ", " + std::to_string(s.scene.object_count()) +
                    " objects>";
         });
 

@@ -42,7 +42,7 @@ Scene load(const std::string& objects) {
 std::vector<Vec3> roots(const Scene& s) {
     std::vector<Vec3> out;
     const ScatterGroup& g = s.scatters.at(0);
-    for (std::size_t i = g.first; i < g.first + g.count; ++i) out.push_back(s.objects[i].xf.point({1, 1, 0}));
+    for (std::size_t i = g.first; i < g.first + g.count; ++i) out.push_back(s.transform(i).point({1, 1, 0}));
     return out;
 }
 
@@ -136,22 +136,22 @@ TEST(Scatter, UniformByAreaOnATorusAndAMesh) {
 TEST(Scatter, RootsOnTheSurfaceAlongTheNormal) {
     const Scene s = load(R"({"type": "scatter", "primitive": "hair", "count": 200, "material": "fur",
         "twist": 30, "scale": [0.5, 2], "on": {"type": "sphere", "radius": 3, "material": "skin"}})");
-    for (std::size_t i = s.scatters[0].first; i < s.objects.size(); ++i) {
-        const Transform& xf = s.objects[i].xf;
+    for (std::size_t i = s.scatters[0].first; i < s.object_count(); ++i) {
+        const Transform xf = s.transform(i);
         const Vec3 root = xf.point({1, 1, 0});
         const Vec3 up = xf.vector({0, 0, 1});
         EXPECT_NEAR(length(root), 3, 1e-12);
         EXPECT_NEAR(dot(normalize(up), root / 3), 1, 1e-12);  // no tilt: along the normal
         EXPECT_GE(length(up), 0.5 - 1e-12);
         EXPECT_LE(length(up), 2 + 1e-12);
-        EXPECT_EQ(s.objects[i].primitive, 0);
+        EXPECT_EQ(s.primitive_of(i), 0);
     }
     // With a tilt, the axis stays within it of the normal.
     const Scene t = load(R"({"type": "scatter", "primitive": "hair", "count": 500, "material": "fur",
         "tilt_deg": 20, "on": {"type": "sphere", "radius": 3, "material": "skin"}})");
     double widest = 0;
-    for (std::size_t i = t.scatters[0].first; i < t.objects.size(); ++i) {
-        const Transform& xf = t.objects[i].xf;
+    for (std::size_t i = t.scatters[0].first; i < t.object_count(); ++i) {
+        const Transform xf = t.transform(i);
         const double c = dot(normalize(xf.vector({0, 0, 1})), normalize(xf.point({1, 1, 0})));
         widest = std::max(widest, std::acos(std::min(1.0, c)) * 180 / M_PI);
     }
@@ -175,8 +175,8 @@ TEST(Scatter, PoissonDiskKeepsItsDistance) {
 // The placements as bytes: what "deterministic" is about.
 std::uint64_t placement_hash(const Scene& s) {
     std::vector<double> v;
-    for (const SceneObject& o : s.objects) {
-        const Affine& a = o.xf.forward();
+    for (std::size_t i = 0; i < s.object_count(); ++i) {
+        const Affine a = s.transform(i).forward();
         for (std::size_t r = 0; r < 3; ++r) {
             for (std::size_t c = 0; c < 3; ++c) v.push_back(a.m.r[r][c]);
             v.push_back(a.t[r]);
@@ -209,7 +209,7 @@ TEST(Scatter, DeterministicForASeedAndAnyThreadCount) {
     EXPECT_NE(placement_hash(load(other)), h1);
     // And the roots are the same numbers on every machine: the first one, to 1e-9.
     const Scene s = load(objs);
-    const Vec3 p = s.objects[1].xf.point({1, 1, 0});
+    const Vec3 p = s.transform(1).point({1, 1, 0});
     EXPECT_EQ(std::to_string(std::llround(p.x * 1e9)) + " " + std::to_string(std::llround(p.y * 1e9)) +
                   " " + std::to_string(std::llround(p.z * 1e9)),
               kFirstRoot);
@@ -264,7 +264,7 @@ TEST(Scatter, CommandWritesExplicitInstancesThatRenderTheSameImage) {
     const std::string cmd = test::lattice_binary() + " scatter " + scene + " -o " + placed + " > /dev/null";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
     const Scene a = load_scene(scene), b = load_scene(placed);
-    ASSERT_EQ(a.objects.size(), b.objects.size());
+    ASSERT_EQ(a.object_count(), b.object_count());
     EXPECT_TRUE(b.scatters.empty());
     EXPECT_EQ(placement_hash(a), placement_hash(b));  // the mesh path was moved to stay found
     EXPECT_EQ(render_exact(TracedScene(a), {}).display.rgb, render_exact(TracedScene(b), {}).display.rgb);

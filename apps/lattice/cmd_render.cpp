@@ -92,6 +92,7 @@ int run_render(const RenderRequest& a) {
     const ThreadLimit limit(a.threads);
     const bool progress = !a.quiet && dist::is_root() && ProgressBar::stderr_is_terminal();
     t.loaded = since_start();
+    t.loaded_cpu = cpu_seconds() * 1e3;
     ModeSettings settings = mode_settings(a);
     settings.progress = progress;
     settings.across_ranks = across;

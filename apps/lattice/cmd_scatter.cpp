@@ -90,7 +90,7 @@ int run_scatter(const ScatterArgs& a) {
     }
     for (std::size_t i = g.first; i < g.first + g.count; ++i)
         objects.push_back({{"type", "instance"}, {"primitive", primitive}, {"material", material},
-                           {"transform", matrix(s.objects[i].xf)}});
+                           {"transform", matrix(s.transform(i))}});
     move_mesh_paths(doc, folder_of(a.scene), folder_of(a.output));
     write_json_file(a.output, doc);
     std::printf("%s: %zu instances of '%s'\n", a.output.c_str(), g.count, primitive.c_str());

@@ -147,7 +147,7 @@ int run_table2(const Table2Args& a) {
         TableSpec spec;
         spec.encoding = e;
         for (const std::size_t i : instance_objects(scene))
-            plan_table(scene.primitives[static_cast<std::size_t>(scene.objects[i].primitive)], spec, scene.file);
+            plan_table(scene.primitives[static_cast<std::size_t>(scene.primitive_of(i))], spec, scene.file);
     }
     std::error_code ec;
     fs::create_directories(a.out_dir, ec);

@@ -1,10 +1,12 @@
 #include "accel/embree_accel.h"
 
 #include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <map>
@@ -51,30 +53,65 @@ struct EmbreeAccel::Impl {
     std::uint32_t our_number(std::uint32_t given_self) const {
         return given_self < numbered.size() ? numbered[given_self] : EmbreeAccel::kNoObject;
     }
+    // A shape's interfaces, asked once for a run of objects of that shape (instances come
+    // together): asking costs a cross-cast each.
+    struct ShapeRoles {
+        const Shape* shape = nullptr;
+        const SheetSource* sheets = nullptr;
+        const Parts* parts = nullptr;
+        const CullParts* cull = nullptr;
+        void ask(const Shape& s) {
+            if (&s == shape) return;
+            shape = &s, sheets = sheet_source(s), parts = parts_of(s), cull = cull_parts_of(s);
+        }
+    };
+    // The objects given, while the accelerator is built (AccelObjects), and the build's number.
+    const AccelObjects* given = nullptr;
+    std::uint64_t build = 0;
+    Transform transform_of(std::uint32_t obj) const { return given->transform(objects[obj].original); }
     // Fills objects with the objects given, in the order of a Morton curve through the centres
-    // of their world boxes (empty and unbounded ones last), and bounds with those boxes.
-    void number_objects(std::span<const AccelObject> given_objects, std::vector<Bounds3>& bounds) {
-        std::vector<Bounds3> given_bounds(given_objects.size());
-        std::vector<Vec3> centres(given_objects.size());
-        tbb::parallel_for(std::size_t{0}, given_objects.size(), [&](std::size_t i) {
-            const AccelObject& o = given_objects[i];
-            const Bounds3& b = given_bounds[i] = o.shape->placed_bounds(*o.xf);
-            const bool held = embree_can_hold(b) && !b.empty();
-            centres[i] = held ? b.center() : Vec3{kInfinity, 0, 0};
+    // of their world boxes (empty and unbounded ones last), and bounds with their bounds in the
+    // hierarchy: their world boxes, or for objects entered whole (enter_whole, set before)
+    // whole_bounds. Each object's transform is made once, in the order given (a scene's
+    // placements are read in turn), and the records are then put in space order.
+    void number_objects(std::vector<Bounds3>& bounds) {
+        const std::size_t n = given->size();
+        objects.resize(n);
+        bounds.resize(n);
+        std::vector<Vec3> centres(n);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const auto& range) {
+            ShapeRoles roles;
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                const Shape* shape = given->shape(i);
+                roles.ask(*shape);
+                const Transform xf = given->transform(i);
+                Placed& o = objects[i];
+                o = {shape, roles.sheets, roles.parts, roles.cull, xf.inverse_map(),
+                     given->widest_footprint(i), static_cast<std::uint32_t>(i),
+                     xf.is_identity(), keeps_directions_across(xf)};
+                Bounds3 b = shape->placed_bounds(xf);
+                const bool held = embree_can_hold(b) && !b.empty();
+                centres[i] = held ? b.center() : Vec3{kInfinity, 0, 0};
+                if (held && enter_whole && enters_whole(o)) b = whole_bounds(o, xf, b);
+                bounds[i] = b;
+            }
         });
         const std::vector<std::uint32_t> order = space_order(centres);
-        numbered.resize(given_objects.size());
-        objects.reserve(given_objects.size());
-        bounds.reserve(given_objects.size());
-        for (const std::uint32_t i : order) {
-            const AccelObject& o = given_objects[i];
-            numbered[i] = static_cast<std::uint32_t>(objects.size());
-            objects.push_back({o.shape, sheet_source(*o.shape), parts_of(*o.shape),
-                               cull_parts_of(*o.shape), o.xf, o.xf->inverse_map(),
-                               o.widest_footprint, i, o.xf->is_identity(),
-                               keeps_directions_across(*o.xf)});
-            bounds.push_back(given_bounds[i]);
-        }
+        centres = {};
+        numbered.resize(n);
+        tbb::parallel_for(std::size_t{0}, n, [&](std::size_t k) {
+            numbered[order[k]] = static_cast<std::uint32_t>(k);
+        });
+        objects = in_order(objects, order);
+        bounds = in_order(bounds, order);
+    }
+    // v[order[0]], v[order[1]], ...: gathered in parallel (the reads fall at random in v),
+    // one vector at a time, so that the copy is never more than one vector's size.
+    template <class T>
+    static std::vector<T> in_order(const std::vector<T>& v, const std::vector<std::uint32_t>& order) {
+        std::vector<T> out(v.size());
+        tbb::parallel_for(std::size_t{0}, v.size(), [&](std::size_t k) { out[k] = v[order[k]]; });
+        return out;
     }
     // The top-level user geometry of single-part objects: one primitive per cull part
     // (CullParts::cull_count).
@@ -89,9 +126,9 @@ struct EmbreeAccel::Impl {
     };
     static_assert(sizeof(DirectPrim) == 36);
     static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
-                                  const Placed& o);
+                                  const Placed& o, const Transform& xf);
     std::vector<DirectPrim> direct;
-    std::vector<Bounds3> direct_bounds;      // world space, per direct primitive; build only
+    std::vector<RTCBounds> direct_bounds;    // world space, per direct primitive; build only
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
     std::vector<std::uint32_t> inst_object;  // top-level geomID -> object, for instances
     struct FlatPrim {
@@ -380,13 +417,22 @@ struct EmbreeAccel::Impl {
     static void bounds_flat(const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
         const FlatPrim fp = self->flat[args->primID];
-        const Placed& o = self->objects[fp.object];
-        *args->bounds_o = to_rtc_bounds(o.parts->part_bounds(fp.part, *o.xf));
+        // An object's parts come one after another: its transform is made once for them all
+        // (kept by the build, whose number no later accelerator shares, unlike its address).
+        thread_local std::uint64_t last_build = 0;
+        thread_local std::uint32_t last_object = EmbreeAccel::kNoObject;
+        thread_local Transform xf;
+        if (last_build != self->build || last_object != fp.object) {
+            xf = self->transform_of(fp.object);
+            last_build = self->build;
+            last_object = fp.object;
+        }
+        *args->bounds_o = to_rtc_bounds(self->objects[fp.object].parts->part_bounds(fp.part, xf));
     }
 
     static void bounds_direct(const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
-        *args->bounds_o = to_rtc_bounds(self->direct_bounds[args->primID]);
+        *args->bounds_o = self->direct_bounds[args->primID];
     }
 
     static void bounds_proto(const RTCBoundsFunctionArguments* args) {
@@ -420,19 +466,20 @@ struct EmbreeAccel::Impl {
             for (std::uint32_t p = 0; p < o.parts->part_count(); ++p) flat.push_back({i, p});
         } else if (part_count(o) > 1) {
             place_instance(i);
-        } else if (enter_whole && enters_whole(o)) {
+        } else if (enter_whole && enters_whole(*o.shape)) {
             place_whole(i, wb);
         } else {
             const ShapeCull cull = culled(o);
             const std::size_t parts = cull.cull_count();
+            const Transform xf = transform_of(i);
             for (std::uint32_t c = 0; c < parts; ++c) {
-                Bounds3 b = cull.cull_bounds(c, *o.xf, o.widest_footprint);
+                Bounds3 b = cull.cull_bounds(c, xf, o.widest_footprint);
                 if (parts == 1) b = lat::intersect(wb, b);  // a lone part: within the object's box
                 if (b.empty()) continue;
-                direct.push_back(direct_prim(i, c, parts > 1, o));
+                direct.push_back(direct_prim(i, c, parts > 1, o, xf));
                 o.direct = true;
                 o.cheap_blocker = cheap_to_test(o);
-                direct_bounds.push_back(b);
+                direct_bounds.push_back(to_rtc_bounds(b));
             }
         }
     }
@@ -447,7 +494,7 @@ struct EmbreeAccel::Impl {
         direct.push_back({i, kEveryPart, 1, {}});  // no capsule: every line meets it
         o.direct = true;
         o.cheap_blocker = cheap_to_test(o);
-        direct_bounds.push_back(b);
+        direct_bounds.push_back(to_rtc_bounds(b));
     }
 
     // The object's parts and cull parts, through the interfaces asked once (Placed).
@@ -466,15 +513,14 @@ struct EmbreeAccel::Impl {
         return cost_cheap;
     }
 
-    static bool enters_whole(const Placed& o) {
-        return part_count(o) <= 1 && cull_count(o) > 1;
-    }
-    // The bounds of an object entered whole, whose world box is wb: its cull parts' together.
-    static Bounds3 whole_bounds(const Placed& o, const Bounds3& wb) {
+    static bool enters_whole(const Placed& o) { return part_count(o) <= 1 && cull_count(o) > 1; }
+    // The bounds of an object entered whole, placed by xf, whose world box is wb: its cull
+    // parts' together.
+    static Bounds3 whole_bounds(const Placed& o, const Transform& xf, const Bounds3& wb) {
         assert(o.cull);  // entered whole: several cull parts
         Bounds3 b;
         for (std::size_t c = 0; c < o.cull->cull_count(); ++c)
-            b = merge(b, o.cull->cull_bounds(c, *o.xf, o.widest_footprint));
+            b = merge(b, o.cull->cull_bounds(c, xf, o.widest_footprint));
         return lat::intersect(wb, b);
     }
 
@@ -483,7 +529,7 @@ struct EmbreeAccel::Impl {
         const Placed& o = objects[i];
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(g, prototype_scene(o.parts));
-        const Affine& a = o.xf->forward();
+        const Affine a = transform_of(i).forward();
         float xfm[12];
         for (int r = 0; r < 3; ++r) {
             for (int c = 0; c < 3; ++c)
@@ -518,19 +564,57 @@ static void on_embree_error(void* user, RTCError, const char* str) {
 
 EmbreeAccel::Impl::DirectPrim EmbreeAccel::Impl::direct_prim(std::uint32_t object,
                                                              std::uint32_t cull, bool shared,
-                                                             const Placed& o) {
+                                                             const Placed& o, const Transform& xf) {
     DirectPrim d{object, cull, shared, {}};
     assert(!shared || o.cull);  // shared: one of several cull parts
-    if (Capsule c; shared && o.cull->cull_capsule(cull, *o.xf, o.widest_footprint, c))
+    if (Capsule c; shared && o.cull->cull_capsule(cull, xf, o.widest_footprint, c))
         d.capsule = FloatCapsule::holding(c);
     return d;
 }
 
+namespace {
+
+// AccelObjects over objects whose transforms are held by the caller.
+class GivenObjects final : public AccelObjects {
+public:
+    explicit GivenObjects(std::span<const AccelObject> objects) : objects_(objects) {}
+    std::size_t size() const override { return objects_.size(); }
+    const Shape* shape(std::size_t i) const override { return objects_[i].shape; }
+    Transform transform(std::size_t i) const override { return *objects_[i].xf; }
+    double widest_footprint(std::size_t i) const override {
+        return objects_[i].widest_footprint;
+    }
+
+private:
+    std::span<const AccelObject> objects_;
+};
+
+}  // namespace
+
 EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOptions& opt)
+    : EmbreeAccel(GivenObjects(objects), opt) {}
+
+EmbreeAccel::EmbreeAccel(const AccelObjects& objects, const AccelOptions& opt)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
+    static std::atomic<std::uint64_t> builds{0};
+    m.given = &objects;
+    m.build = ++builds;
+    // Numbering takes a tenth of the bar, placing another, Embree's build the rest.
+    ProgressBar bar("build", 1000, opt.progress, 1000);
+    std::size_t cull_parts = 0;
+    Impl::ShapeRoles roles;
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        const Shape& s = *objects.shape(i);
+        roles.ask(s);
+        const std::size_t parts = ShapeParts(s, roles.parts).part_count();
+        const std::size_t culls = ShapeCull(s, roles.cull).cull_count();
+        if (parts <= 1 && culls > 1) cull_parts += culls;  // Impl::enters_whole
+    }
+    m.enter_whole = cull_parts > opt.cull_part_budget;
     std::vector<Bounds3> placed_bounds;
-    m.number_objects(objects, placed_bounds);
+    m.number_objects(placed_bounds);
+    bar.set(100);
     m.device = rtcNewDevice(nullptr);
     if (!m.device) throw std::runtime_error("Embree: cannot create a device");
     rtcSetDeviceErrorFunction(m.device, on_embree_error, &m);
@@ -542,26 +626,11 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
         if (Impl::part_count(o) > 1) parts += Impl::part_count(o);
     m.flatten = opt.instancing == Instancing::kNever ||
                 (opt.instancing == Instancing::kAuto && parts <= opt.flatten_budget);
-    std::size_t cull_parts = 0;
-    for (const Placed& o : m.objects)
-        if (Impl::enters_whole(o)) cull_parts += Impl::cull_count(o);
-    m.enter_whole = cull_parts > opt.cull_part_budget;
-    // Objects entered whole are bounded by their cull parts together, a bound made in
-    // parallel (place is sequential).
-    if (m.enter_whole)
-        tbb::parallel_for(std::size_t{0}, m.objects.size(), [&](std::size_t i) {
-            const Placed& o = m.objects[i];
-            const Bounds3& wb = placed_bounds[i];
-            if (Impl::enters_whole(o) && !wb.empty() && embree_can_hold(wb))
-                placed_bounds[i] = Impl::whole_bounds(o, wb);
-        });
-
-    // Placing takes a tenth of the bar, Embree's build the rest.
-    ProgressBar bar("build", 1000, opt.progress, 1000);
     for (std::uint32_t i = 0; i < m.objects.size(); ++i) {
         m.place(i, placed_bounds[i]);
-        if (i % 4096 == 0) bar.set(100 * std::uint64_t{i} / m.objects.size());
+        if (i % 4096 == 0) bar.set(100 + 100 * std::uint64_t{i} / m.objects.size());
     }
+    placed_bounds = {};  // not held through Embree's build, the peak of memory
     // Tested one after another: in the order given, as before they were numbered in space.
     std::sort(m.unbounded.begin(), m.unbounded.end(), [&](std::uint32_t a, std::uint32_t b) {
         return m.objects[a].original < m.objects[b].original;
@@ -577,13 +646,14 @@ EmbreeAccel::EmbreeAccel(std::span<const AccelObject> objects, const AccelOption
     rtcSetSceneProgressMonitorFunction(
         m.scene,
         [](void* b, double done) {
-            static_cast<ProgressBar*>(b)->set(100 + static_cast<std::uint64_t>(900 * done));
+            static_cast<ProgressBar*>(b)->set(200 + static_cast<std::uint64_t>(800 * done));
             return true;
         },
         &bar);
     rtcCommitScene(m.scene);
     rtcSetSceneProgressMonitorFunction(m.scene, nullptr, nullptr);
     m.direct_bounds = {};  // read only by the build
+    m.given = nullptr;
     bar.finish();
     if (!m.error.empty()) throw std::runtime_error("Embree: " + m.error);
 }

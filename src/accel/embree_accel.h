@@ -15,12 +15,24 @@
 namespace lat {
 
 struct AccelObject {
-    const Shape* shape = nullptr;
-    const Transform* xf = nullptr;  // object -> world; must outlive the accelerator
+    const Shape* shape = nullptr;  // must outlive the accelerator
+    const Transform* xf = nullptr;  // object -> world; read only while the accelerator is built
     // The widest footprint (object units) of the rays the object is traced with, for shapes
     // whose culling narrows with it (CullParts::cull_bounds; lattices answered by sub-rays): each
     // instance gets its own, from how near the camera it stands. Infinity: any.
     double widest_footprint = kInfinity;
+};
+
+// The objects to place, as AccelObject says, read one by one while the accelerator is built
+// and never after: a caller may make each transform when asked (a scene's scattered instances
+// keep only their forward maps). The accelerator keeps each object's inverse map itself.
+class AccelObjects {
+public:
+    virtual ~AccelObjects() = default;
+    virtual std::size_t size() const = 0;
+    virtual const Shape* shape(std::size_t i) const = 0;  // must outlive the accelerator
+    virtual Transform transform(std::size_t i) const = 0;
+    virtual double widest_footprint(std::size_t) const { return kInfinity; }
 };
 
 // Multi-part objects (chains) can be placed as Embree instances of one prototype scene each, or
@@ -47,6 +59,7 @@ using AccelHit = ObjectHit;
 
 class EmbreeAccel {
 public:
+    explicit EmbreeAccel(const AccelObjects& objects, const AccelOptions& opt = {});
     explicit EmbreeAccel(std::span<const AccelObject> objects, const AccelOptions& opt = {});
 
     ~EmbreeAccel();

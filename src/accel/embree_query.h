@@ -28,12 +28,11 @@ struct Placed {
     const SheetSource* sheets;  // the shape's, if it has more than its closest crossing to give
     const Parts* parts;         // the shape's, if it has several parts (geometry/parts.h)
     const CullParts* cull;      // the shape's, if it is culled by parts of its own
-    const Transform* xf;        // object -> world
-    Affine inverse;       // xf's inverse map
+    Affine inverse;             // its transform's inverse map (world -> object)
     double widest_footprint;
     std::uint32_t original;  // its index among the objects given to the constructor
-    bool identity;           // xf is the identity
-    bool similar;            // keeps_directions_across(xf)
+    bool identity;           // its transform is the identity
+    bool similar;            // keeps_directions_across(its transform)
     // Placed as direct primitives (one Embree primitive per cull part, whose callbacks test
     // the whole shape), so that a shadow ray leaving it can test it after the traversal
     // instead (test_self_last). Culling is conservative, so the test unculled answers as the

@@ -1,5 +1,7 @@
 #include "accel/space_order.h"
 
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <utility>
 
@@ -37,7 +39,7 @@ std::vector<std::uint32_t> space_order(std::span<const Vec3> points) {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> keys(points.size());
     for (std::uint32_t i = 0; i < points.size(); ++i)
         keys[i] = {is_finite(points[i]) ? morton_code(points[i], all) : ~0u, i};
-    std::sort(keys.begin(), keys.end());
+    tbb::parallel_sort(keys.begin(), keys.end());  // the keys are distinct: one order
     std::vector<std::uint32_t> order;
     order.reserve(keys.size());
     for (const auto& key : keys) order.push_back(key.second);

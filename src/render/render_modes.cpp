@@ -12,6 +12,7 @@
 #include "render/core/camera.h"
 #include "render/modes/integrators.h"
 #include "render/baselines/scene_parts.h"
+#include "util/memory.h"
 
 namespace lat {
 namespace {
@@ -38,8 +39,9 @@ std::uint64_t instance_geometry_bytes(const Scene& scene) {
     std::uint64_t bytes = 0;
     std::vector<bool> counted(scene.primitives.size(), false);
     for (const std::size_t i : instance_objects(scene)) {
-        bytes += sizeof(Transform);
-        const auto p = static_cast<std::size_t>(scene.objects[i].primitive);
+        std::size_t in_group = i;
+        bytes += scene.group_of(in_group) ? sizeof(Affine) : sizeof(Transform);
+        const auto p = static_cast<std::size_t>(scene.primitive_of(i));
         if (counted[p]) continue;
         counted[p] = true;
         if (const auto& s = scene.primitives[p].shape; const ChainShape* c = s ? as_chain(*s) : nullptr)
@@ -121,10 +123,12 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             r.prepare_ms = ms_since(t0);
             dist::mark(dist::Step::kTables);
             t0 = clock::now();
+            const double cpu0 = cpu_seconds();
             AccelOptions accel = settings.accel;
             accel.progress = settings.progress;
             const TracedScene rs(scene, instance_shape, accel, r.lattices.widest_footprints);
             r.build_ms = ms_since(t0);
+            r.build_cpu_ms = (cpu_seconds() - cpu0) * 1e3;
             dist::mark(dist::Step::kAccel);
             if (settings.before_render) settings.before_render();
             // Partial hits are traced in layers, chosen here once: a filter makes them

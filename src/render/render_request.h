@@ -114,6 +114,7 @@ double mrays_per_s(const RenderStats& st);
 // Wall-clock milestones of a render, in milliseconds from its start.
 struct RenderTimings {
     double loaded = 0, written = 0;
+    double loaded_cpu = 0;  // the process's CPU time (all threads) when the scene was loaded, ms
 };
 
 // A rank's timeline for the stats: {"loaded": ms, ...}, the steps it reached.

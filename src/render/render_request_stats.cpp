@@ -67,7 +67,9 @@ nlohmann::json render_stats_json(const RenderRequest& a, const Scene& scene, con
     j["sampler"] = r.out.stats.sampler;
     j["threads"] = st.threads;
     j["load_ms"] = t.loaded;
+    j["load_cpu_ms"] = t.loaded_cpu;
     j["build_ms"] = r.build_ms;
+    j["build_cpu_ms"] = r.build_cpu_ms;
     j["prepare_ms"] = r.prepare_ms;
     j["bytes_added"] = r.bytes_added;
     if (a.answers_instances()) {

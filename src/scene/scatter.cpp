@@ -169,7 +169,7 @@ Vec3 across(Vec3 n, Vec3 comb) {
 
 // The instance's transform: its root on the surface point, its z axis along the (tilted)
 // normal, turned about it by the twist, scaled. Draws come from the instance's own stream.
-Transform placement(const SurfaceSample& s, const ScatterParams& p, Vec3 root, CounterRng& rng) {
+Affine placement(const SurfaceSample& s, const ScatterParams& p, Vec3 root, CounterRng& rng) {
     const Vec3 n = p.align_normal ? s.n : Vec3{0, 0, 1};
     const Vec3 t = across(n, p.comb), b = cross(n, t);
     const double cos_t = 1 - rng.uniform() * (1 - p.cos_tilt);  // uniform over the cone's cap
@@ -186,7 +186,7 @@ Transform placement(const SurfaceSample& s, const ScatterParams& p, Vec3 root, C
     // must write matrices that read back bit for bit.
     for (std::size_t r = 0; r < 3; ++r) a.m.r[r] = Vec3{x[r], y[r], z[r]} * k + Vec3{0, 0, 0};
     a.t = s.p - a.m * root + Vec3{0, 0, 0};
-    return *Transform::from_affine(a);  // a rotation times k > 0: never singular
+    return a;  // a rotation times k > 0: never singular
 }
 
 // Poisson-disk (dart throwing): candidates in stream order, each kept when no kept point lies
@@ -248,7 +248,7 @@ Vec3 primitive_root(const Primitive& prim) {
 }
 
 void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser& parser,
-                    const std::vector<Primitive>& primitives, std::vector<SceneObject>& out,
+                    const std::vector<Primitive>& primitives, std::size_t before, ScatterGroup& out,
                     bool progress) {
     v.allow_keys({"type", "name", "primitive", "on", "count", "density", "seed", "align", "twist",
                   "scale", "tilt_deg", "material", "box", "min_distance", "poisson", "comb"},
@@ -257,26 +257,23 @@ void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser&
     const ScatterParams p = parse_params(v, parser, primitives, sampler->area());
     const Primitive& prim = primitives[static_cast<std::size_t>(p.primitive)];
     const Vec3 root = primitive_root(prim);
-    require_memory_for(p.count, out.size(), v);
+    require_memory_for(p.count, before, v);
     // Each instance draws from its own streams (2i: its point, 2i + 1: its placement), so the
     // instances are placed in parallel, alike for any number of threads.
     std::vector<SurfaceSample> points;
     if (p.min_distance > 0) points = poisson_samples(*sampler, p, v);
     const std::size_t n = p.min_distance > 0 ? points.size() : p.count;
-    const std::size_t first = out.size();
-    out.resize(first + n);
-    const std::string where = v.path();
+    out.shape = prim.shape;
+    out.material = p.material;
+    out.primitive = p.primitive;
+    out.where = v.path();
+    out.placements.resize(n);
     ProgressBar bar("place", n, progress, 1000);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& range) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
             CounterRng point_rng(p.seed, 2 * i), rng(p.seed, 2 * i + 1);
             const SurfaceSample s = points.empty() ? sampler->sample(point_rng) : points[i];
-            SceneObject& o = out[first + i];
-            o.shape = prim.shape;
-            o.xf = placement(s, p, root, rng);
-            o.material = p.material;
-            o.primitive = p.primitive;
-            o.where = where;
+            out.placements[i] = placement(s, p, root, rng);
         }
         bar.add(range.size());
     });

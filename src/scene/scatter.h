@@ -2,8 +2,8 @@
 // "scatter" objects: many instances of a primitive placed over the surface of another object
 // (sphere, ellipsoid, any named quadric within a box, torus, half-space patch, triangle mesh),
 // area-uniformly or as Poisson-disk (blue) noise, deterministically for a seed. The loader
-// expands each scatter into ordinary instance objects, so both render modes trace them as any
-// other instance. docs/scene-format.md describes the fields.
+// expands each scatter into a group of instances (ScatterGroup: their placements in an array),
+// which both render modes trace as any other instance. docs/scene-format.md describes the fields.
 #include <cstddef>
 #include <vector>
 
@@ -25,10 +25,11 @@ constexpr std::size_t kScatterBytesPerInstance = 1000;
 Vec3 primitive_root(const Primitive& prim);
 
 // Expands the scatter `v` over the surface object `on` (its JSON, already parsed once as an
-// object of the scene), appending its instances to `out`. progress: a bar on stderr when
-// placing them takes longer than a second.
+// object of the scene), into the group `out` (its name, place in the file and numbering are
+// the caller's). before: how many objects the scene holds already. progress: a bar on stderr
+// when placing them takes longer than a second.
 void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser& parser,
-                    const std::vector<Primitive>& primitives, std::vector<SceneObject>& out,
-                    bool progress = false);
+                    const std::vector<Primitive>& primitives, std::size_t before,
+                    ScatterGroup& out, bool progress = false);
 
 }  // namespace lat

@@ -172,7 +172,7 @@ JsonValue scatter_target(const JsonValue& sc, const JsonValue& objects,
 }
 
 // Objects first, then scatters (which may name objects anywhere in the list) expanded into
-// instances after them.
+// groups of instances numbered after them (an inline surface of a scatter is an object).
 void load_objects(const JsonValue& objects, const ObjectParser& parser, Scene& s, bool progress) {
     std::map<std::string, std::size_t> names;
     std::vector<std::size_t> scatters;
@@ -191,11 +191,12 @@ void load_objects(const JsonValue& objects, const ObjectParser& parser, Scene& s
     for (const std::size_t i : scatters) {
         const JsonValue sc = objects[i];
         const JsonValue on = scatter_target(sc, objects, names, parser, s);
-        ScatterGroup g{name_of(sc).value_or(""), i, s.objects.size(), 0};
-        expand_scatter(sc, on, parser, s.primitives, s.objects, progress);
-        g.count = s.objects.size() - g.first;
-        s.scatters.push_back(g);
+        ScatterGroup& g = s.scatters.emplace_back();
+        g.name = name_of(sc).value_or("");
+        g.json_index = i;
+        expand_scatter(sc, on, parser, s.primitives, s.object_count(), g, progress);
     }
+    s.number_scatters();
 }
 
 }  // namespace

@@ -201,7 +201,7 @@ Vec3 shade_base(const TracedScene& base, const std::vector<ShadowMap>& maps, con
 ParticleSet make_particles(const Scene& scene) {
     ParticleSet set;
     for (const std::size_t oi : instance_objects(scene)) {
-        const SceneObject& o = scene.objects[oi];
+        const SceneObject o = scene.object(oi);
         const Primitive& prim = scene.primitives[static_cast<std::size_t>(o.primitive)];
         const ChainShape* chain = prim.shape ? as_chain(*prim.shape) : nullptr;
         if (!chain)

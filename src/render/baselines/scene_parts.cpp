@@ -16,7 +16,9 @@ Scene filtered(const Scene& scene, bool instances) {
     out.primitives = scene.primitives;
     for (const SceneObject& o : scene.objects)
         if ((o.primitive >= 0) == instances) out.objects.push_back(o);
-    return out;  // scatter groups index the full list, so they are not carried over
+    if (instances) out.scatters = scene.scatters;
+    out.number_scatters();
+    return out;
 }
 
 }  // namespace
@@ -26,8 +28,8 @@ Scene instance_scene(const Scene& scene) { return filtered(scene, true); }
 
 std::vector<std::size_t> instance_objects(const Scene& scene) {
     std::vector<std::size_t> out;
-    for (std::size_t i = 0; i < scene.objects.size(); ++i)
-        if (scene.objects[i].primitive >= 0) out.push_back(i);
+    for (std::size_t i = 0; i < scene.object_count(); ++i)
+        if (scene.primitive_of(i) >= 0) out.push_back(i);
     return out;
 }
 

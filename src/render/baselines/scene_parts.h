@@ -13,7 +13,7 @@ namespace lat {
 Scene base_scene(const Scene& scene);
 // The scene with only its top-level instances.
 Scene instance_scene(const Scene& scene);
-// Indices into scene.objects of the top-level instances.
+// Numbers (Scene::object) of the top-level instances.
 std::vector<std::size_t> instance_objects(const Scene& scene);
 
 }  // namespace lat

@@ -80,7 +80,7 @@ std::size_t texture_base(const Scene& scene) {
         if (candidate.primitive >= 0) continue;
         d.clear();
         for (std::size_t k = 0; k < inst.size(); k += step)
-            d.push_back(root_distance(scene, candidate, scene.objects[inst[k]]));
+            d.push_back(root_distance(scene, candidate, scene.object(inst[k])));
         std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
         if (d[d.size() / 2] < best) {
             best = d[d.size() / 2];
@@ -88,7 +88,7 @@ std::size_t texture_base(const Scene& scene) {
         }
     }
     if (base == scene.objects.size())
-        throw InputError(located_message(scene.file, scene.objects[inst.front()].where,
+        throw InputError(located_message(scene.file, scene.where_of(inst.front()),
                                          "texture mode maps instances onto the surface they grow from, and no "
                                          "object of the scene lies under their roots"));
     if (!has_texture_atlas(scene.objects[base]))
@@ -97,7 +97,7 @@ std::size_t texture_base(const Scene& scene) {
                                          "spheres, ellipsoids and triangle meshes only"));
     // All of them: fur standing elsewhere would be baked as seen from this surface, wrongly.
     for (const std::size_t k : inst) {
-        const SceneObject& o = scene.objects[k];
+        const SceneObject o = scene.object(k);
         if (root_distance(scene, scene.objects[base], o) > instance_size(scene, o))
             throw InputError(located_message(
                 scene.file, o.where,
@@ -119,7 +119,7 @@ TextureMaps bake_texture(const Scene& scene, const TextureOptions& opt) {
     double reach = 0;
     std::map<std::uint32_t, int> material_count;
     for (const std::size_t k : inst) {
-        const SceneObject& o = scene.objects[k];
+        const SceneObject o = scene.object(k);
         ++material_count[o.material];
         const double d = root_distance(scene, base, o);
         reach = std::max(reach, instance_size(scene, o) + (std::isfinite(d) ? d : 0.0));
@@ -187,7 +187,7 @@ public:
         if (!maps.atlas) return;
         // The base's index among the traced objects: instances before it were removed.
         for (std::size_t i = 0; i < maps.base_object; ++i)
-            if (scene.objects[i].primitive < 0) ++base_index_;
+            if (scene.primitive_of(i) < 0) ++base_index_;
     }
 
     Vec3 radiance(const TraceRay& traced, ShadeState& state) const override {

@@ -6,11 +6,35 @@
 
 namespace lat {
 
+namespace {
+
+// The scene's objects as the accelerator reads them, with the shapes traced.
+class SceneObjects final : public AccelObjects {
+public:
+    SceneObjects(const Scene& scene, const TracedScene& traced, std::span<const double> widest)
+        : scene_(scene), traced_(traced), widest_(widest) {}
+    std::size_t size() const override { return scene_.object_count(); }
+    const Shape* shape(std::size_t i) const override {
+        return &traced_.shape(static_cast<std::uint32_t>(i));
+    }
+    Transform transform(std::size_t i) const override { return scene_.transform(i); }
+    double widest_footprint(std::size_t i) const override {
+        return widest_.empty() ? kInfinity : widest_[i];
+    }
+
+private:
+    const Scene& scene_;
+    const TracedScene& traced_;
+    std::span<const double> widest_;
+};
+
+}  // namespace
+
 TracedScene::TracedScene(const Scene& scene, const InstanceShapeFn& instance_shape,
                          const AccelOptions& accel, std::span<const double> widest_footprints)
     : scene_(scene) {
-    assert(widest_footprints.empty() || widest_footprints.size() == scene.objects.size());
-    shapes_.reserve(scene.objects.size());
+    assert(widest_footprints.empty() || widest_footprints.size() == scene.object_count());
+    object_shapes_.reserve(scene.objects.size());
     for (const SceneObject& o : scene.objects) {
         std::shared_ptr<const Shape> s = o.shape;
         if (o.primitive >= 0 && instance_shape) {
@@ -18,24 +42,30 @@ TracedScene::TracedScene(const Scene& scene, const InstanceShapeFn& instance_sha
         } else if (o.shape && instance_shape) {
             if (auto swapped = csg_with_primitive_shapes(*o.shape, instance_shape)) s = swapped;
         }
-        shapes_.push_back(std::move(s));
+        object_shapes_.push_back(std::move(s));
     }
     // A CSG tree's own, as traced (exactly, or with its instance leaves swapped for their
-    // lattices); asked once for each run of objects of one shape (instances).
+    // lattices); asked once for each run of objects of one shape.
     const Shape* asked = nullptr;
     std::span<const std::uint32_t> m;
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-        if (!shapes_[i]) continue;
-        if (shapes_[i].get() != asked) asked = shapes_[i].get(), m = csg_surface_materials(*asked);
+        if (!object_shapes_[i]) continue;
+        if (object_shapes_[i].get() != asked)
+            asked = object_shapes_[i].get(), m = csg_surface_materials(*asked);
         if (m.empty()) continue;
         surface_materials_.resize(scene.objects.size());
         surface_materials_[i] = m;
     }
-    accel_objects_.reserve(scene.objects.size());
-    for (std::size_t i = 0; i < scene.objects.size(); ++i)
-        accel_objects_.push_back({shapes_[i].get(), &scene.objects[i].xf,
-                                  widest_footprints.empty() ? kInfinity : widest_footprints[i]});
-    accel_ = std::make_unique<EmbreeAccel>(accel_objects_, accel);
+    for (const ScatterGroup& g : scene.scatters)
+        group_shapes_.push_back(instance_shape ? instance_shape(g.primitive) : g.shape);
+    accel_ = std::make_unique<EmbreeAccel>(SceneObjects(scene, *this, widest_footprints), accel);
+}
+
+const Shape& TracedScene::shape(std::uint32_t object) const {
+    std::size_t i = object;
+    if (const ScatterGroup* g = scene_.group_of(i))
+        return *group_shapes_[static_cast<std::size_t>(g - scene_.scatters.data())];
+    return *object_shapes_[object];
 }
 
 bool TracedScene::intersect(const Ray& r, double tmin, double tmax, SurfaceHit& hit) const {
@@ -58,35 +88,36 @@ bool TracedScene::intersect_layers(const Ray& r, double tmin, double tmax, std::
 }
 
 std::uint32_t TracedScene::material(std::uint32_t object, const Crossing& c) const {
-    const std::uint32_t fallback = scene_.objects[object].material;
-    if (surface_materials_.empty()) return fallback;
+    const std::uint32_t fallback = scene_.material_of(object);
+    // Objects of scene.objects come first (Scene::object_count): a scatter's are past them.
+    if (object >= surface_materials_.size()) return fallback;
     const std::span<const std::uint32_t> m = surface_materials_[object];
     const std::uint32_t s = c.leaf_index();
     return s < m.size() && m[s] != kNoMaterial ? m[s] : fallback;
 }
 
 void TracedScene::surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const {
-    const SceneObject& o = scene_.objects[h.object];
-    const Shape& shape = *shapes_[h.object];
+    const Transform xf = scene_.transform(h.object);
+    const Shape& shape = this->shape(h.object);
     hit.t = h.t;
     hit.object = h.object;
     hit.part = h.crossing.part;
     hit.material = material(h.object, h.crossing);
     hit.alpha = static_cast<double>(h.crossing.coverage);
     hit.sub_rays = h.crossing.sub_rays;
-    const SurfacePoint s = shape.surface(o.xf.is_identity() ? r : o.xf.inverse_ray(r), h.crossing);
+    const SurfacePoint s = shape.surface(xf.is_identity() ? r : xf.inverse_ray(r), h.crossing);
     // Only a mean of normals (prefiltered lattices) is meant to be shorter than 1.
     const double len = length(s.n);
     hit.normal_length = len < 1 - 1e-6 ? len : 1.0;
     hit.normals = h.normals;
-    if (o.xf.is_identity()) {
+    if (xf.is_identity()) {
         hit.p = s.p;
         hit.n = hit.normal_length < 1 && len > 0 ? s.n / len : s.n;
     } else {
-        hit.p = o.xf.point(s.p);
-        hit.n = normalize(o.xf.normal(s.n));
+        hit.p = xf.point(s.p);
+        hit.n = normalize(xf.normal(s.n));
         for (std::uint8_t k = 0; k < hit.normals.count; ++k)
-            hit.normals.n[k] = normalize(o.xf.normal(hit.normals.n[k]));
+            hit.normals.n[k] = normalize(xf.normal(hit.normals.n[k]));
     }
 }
 

@@ -67,15 +67,16 @@ public:
 
     const Scene& scene() const { return scene_; }
     // The shape traced for an object (its lattice, in lattice mode).
-    const Shape& shape(std::uint32_t object) const { return *shapes_[object]; }
+    const Shape& shape(std::uint32_t object) const;
 
 private:
     const Scene& scene_;
-    std::vector<std::shared_ptr<const Shape>> shapes_;  // per object, as traced
-    // Per object, the materials of the surfaces its crossings number (a CSG tree's leaves:
-    // csg_surface_materials), or empty: the object's material. Empty when no object has any.
+    // As traced: per object of scene.objects, and per scatter group (its instances share it).
+    std::vector<std::shared_ptr<const Shape>> object_shapes_, group_shapes_;
+    // Per object of scene.objects, the materials of the surfaces its crossings number (a CSG
+    // tree's leaves: csg_surface_materials), or empty: the object's material. Empty when no
+    // object has any (a scatter's instances have none: they are primitives').
     std::vector<std::span<const std::uint32_t>> surface_materials_;
-    std::vector<AccelObject> accel_objects_;
     std::unique_ptr<EmbreeAccel> accel_;
 
     void surface_hit(const Ray& r, const AccelHit& h, SurfaceHit& hit) const;

@@ -144,10 +144,11 @@ std::string levels_note(const LevelCosts& c, std::pair<int, int> wanted, const L
 double sub_ray_bounds(const Scene& scene, int prim, const TableContext& base, double spread,
                       SceneLattices& out) {
     double widest = 0;
-    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-        if (scene.objects[i].primitive != prim) continue;
+    if (out.widest_footprints.empty()) out.widest_footprints.assign(scene.object_count(), kInfinity);
+    for (std::size_t i = 0; i < out.widest_footprints.size(); ++i) {
+        if (scene.primitive_of(i) != prim) continue;
         out.widest_footprints[i] =
-            kSubRayWidening * instance_footprints(scene, scene.objects[i], base, spread).second;
+            kSubRayWidening * instance_footprints(scene, scene.transform(i), base, spread).second;
         widest = std::max(widest, out.widest_footprints[i]);
     }
     return widest;
@@ -216,26 +217,26 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache* cache, con
 
 }  // namespace
 
-std::pair<double, double> instance_footprints(const Scene& scene, const SceneObject& o,
+std::pair<double, double> instance_footprints(const Scene& scene, const Transform& xf,
                                               const TableContext& base, double spread) {
     const Bounds3 box{{0, 0, 0}, Vec3{double(base.cells[0]), double(base.cells[1]),
                                       double(base.cells[2])} * base.cell};
-    const Bounds3 wb = o.xf.bounds(box);
+    const Bounds3 wb = xf.bounds(box);
     const double r = 0.5 * length(wb.extent());
     const double d = length(wb.center() - scene.camera.eye);
     // Object units per world unit along a ray (rigid or uniformly scaled instances).
-    const double scale = 1 / std::cbrt(length(o.xf.vector({1, 0, 0})) *
-                                       length(o.xf.vector({0, 1, 0})) *
-                                       length(o.xf.vector({0, 0, 1})));
+    const double scale = 1 / std::cbrt(length(xf.vector({1, 0, 0})) *
+                                       length(xf.vector({0, 1, 0})) *
+                                       length(xf.vector({0, 0, 1})));
     return {std::max(d - r, 1e-9) * spread * scale, (d + r) * spread * scale};
 }
 
 std::pair<double, double> footprint_range(const Scene& scene, int prim, const TableContext& base,
                                           double spread) {
     double lo = kInfinity, hi = -kInfinity;
-    for (const SceneObject& o : scene.objects) {
-        if (o.primitive != prim) continue;
-        const auto [near, far] = instance_footprints(scene, o, base, spread);
+    for (std::size_t i = 0; i < scene.object_count(); ++i) {
+        if (scene.primitive_of(i) != prim) continue;
+        const auto [near, far] = instance_footprints(scene, scene.transform(i), base, spread);
         lo = std::min(lo, near);
         hi = std::max(hi, far);
     }
@@ -246,9 +247,11 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const 
                              bool progress, const LatticeFiltering& filtering) {
     SceneLattices out;
     out.shapes.resize(scene.primitives.size());
-    out.widest_footprints.assign(scene.objects.size(), kInfinity);
     // Instances, at the top level or as CSG leaves.
     std::vector<bool> used(scene.primitives.size(), false), csg_leaf(used), instanced(used);
+    for (const ScatterGroup& g : scene.scatters)
+        if (!g.placements.empty())
+            used[static_cast<std::size_t>(g.primitive)] = instanced[static_cast<std::size_t>(g.primitive)] = true;
     for (const SceneObject& o : scene.objects) {
         if (o.primitive >= 0) used[static_cast<std::size_t>(o.primitive)] = instanced[static_cast<std::size_t>(o.primitive)] = true;
         if (o.shape)

@@ -25,7 +25,8 @@ struct PrimitiveAnswer {
 struct SceneLattices {
     std::vector<std::shared_ptr<const Shape>> shapes;  // per primitive; null: its own shape
     // Per object: the widest footprint (object units) its rays are traced with, for instances
-    // of primitives answered by sub-rays (AccelObject::widest_footprint); else infinity.
+    // of primitives answered by sub-rays (AccelObject::widest_footprint); else infinity. Empty
+    // when no primitive is answered by sub-rays (every one infinity).
     std::vector<double> widest_footprints;
     std::uint64_t table_bytes = 0;
     std::uint64_t table_entries = 0;
@@ -84,7 +85,7 @@ inline constexpr int kMaxLodLevels = 3;
 std::pair<double, double> footprint_range(const Scene& scene, int prim, const TableContext& base,
                                           double spread);
 // The same for one instance.
-std::pair<double, double> instance_footprints(const Scene& scene, const SceneObject& o,
+std::pair<double, double> instance_footprints(const Scene& scene, const Transform& xf,
                                               const TableContext& base, double spread);
 
 // With filtering, spec's encoding must store coverage (Encoding::coverage; else InputError).
