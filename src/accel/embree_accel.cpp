@@ -466,7 +466,7 @@ struct EmbreeAccel::Impl {
             for (std::uint32_t p = 0; p < o.parts->part_count(); ++p) flat.push_back({i, p});
         } else if (part_count(o) > 1) {
             place_instance(i);
-        } else if (enter_whole && enters_whole(*o.shape)) {
+        } else if (enter_whole && enters_whole(o)) {
             place_whole(i, wb);
         } else {
             const ShapeCull cull = culled(o);
