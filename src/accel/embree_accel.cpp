@@ -501,7 +501,6 @@ struct EmbreeAccel::Impl {
     static ShapeParts parted(const Placed& o) { return ShapeParts(*o.shape, o.parts); }
     static ShapeCull culled(const Placed& o) { return ShapeCull(*o.shape, o.cull); }
     static std::size_t part_count(const Placed& o) { return parted(o).part_count(); }
-    static std::size_t cull_count(const Placed& o) { return culled(o).cull_count(); }
     // Asked of consecutive objects, which mostly share their shape (instances), once a shape.
     const Shape* cost_asked = nullptr;
     bool cost_cheap = false;
@@ -513,7 +512,11 @@ struct EmbreeAccel::Impl {
         return cost_cheap;
     }
 
-    static bool enters_whole(const Placed& o) { return part_count(o) <= 1 && cull_count(o) > 1; }
+    // Whether an object of these parts would enter whole past the cull-part budget.
+    static bool enters_whole(const ShapeParts& parts, const ShapeCull& cull) {
+        return parts.part_count() <= 1 && cull.cull_count() > 1;
+    }
+    static bool enters_whole(const Placed& o) { return enters_whole(parted(o), culled(o)); }
     // The bounds of an object entered whole, placed by xf, whose world box is wb: its cull
     // parts' together.
     static Bounds3 whole_bounds(const Placed& o, const Transform& xf, const Bounds3& wb) {
@@ -607,9 +610,8 @@ EmbreeAccel::EmbreeAccel(const AccelObjects& objects, const AccelOptions& opt)
     for (std::size_t i = 0; i < objects.size(); ++i) {
         const Shape& s = *objects.shape(i);
         roles.ask(s);
-        const std::size_t parts = ShapeParts(s, roles.parts).part_count();
-        const std::size_t culls = ShapeCull(s, roles.cull).cull_count();
-        if (parts <= 1 && culls > 1) cull_parts += culls;  // Impl::enters_whole
+        const ShapeCull cull(s, roles.cull);
+        if (Impl::enters_whole(ShapeParts(s, roles.parts), cull)) cull_parts += cull.cull_count();
     }
     m.enter_whole = cull_parts > opt.cull_part_budget;
     std::vector<Bounds3> placed_bounds;

@@ -282,6 +282,7 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
     : entries_(entries), size_(size), ctx_(ctx), grid_(ctx.cells) {
     if (size < sizeof(Header)) throw std::runtime_error("candidates: payload too small");
     if (!ctx.primitive) throw std::runtime_error("candidates: the table needs the primitive");
+    primitive_.emplace(*ctx.primitive);
     Header h;
     std::memcpy(&h, payload, sizeof h);
     if (h.magic != kMagic) throw std::runtime_error("candidates: bad payload tag");
@@ -306,7 +307,7 @@ CandidatesTable::CandidatesTable(const std::uint8_t* payload, std::size_t size, 
 
 // Every list lies within the index array, ascending, and names parts the primitive has.
 void CandidatesTable::check_lists(std::uint64_t total) const {
-    const std::uint64_t nparts = ShapeSource(*ctx_.primitive).piece_count();
+    const std::uint64_t nparts = primitive_->piece_count();
     if (offsets_[0] != 0 || offsets_[sets_] != total)
         throw std::runtime_error("candidates: part list offsets do not match their count");
     for (std::uint32_t i = 0; i < sets_; ++i) {
@@ -343,7 +344,7 @@ bool CandidatesTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) co
     const Vec3 pa = to_vec(grid_.point(a)), pb = to_vec(grid_.point(b));
     const Ray seg{pa * ctx_.cell, (pb - pa) * ctx_.cell};
     const Shape& shape = *ctx_.primitive;
-    const ShapeSource source(shape);  // not a hot path: a table's lookups are for tools
+    const ShapeSource& source = *primitive_;
     if (shape.inside(seg.o)) {  // a point of the closed solid on the box: the hit is the point
         hit = {0.0, normalize(shape.normal(seg, nearest_crossing(shape, seg)))};
         return true;

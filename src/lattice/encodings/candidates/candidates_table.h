@@ -11,8 +11,10 @@
 // each stored once as a sorted list of 32-bit part indices (an offset array into one index
 // array), so a primitive may have any number of parts.
 #include <cstdint>
+#include <optional>
 #include <vector>
 
+#include "geometry/lattice_source.h"
 #include "lattice/bits/bit_array.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/table.h"
@@ -54,6 +56,7 @@ private:
     std::uint64_t entries_;
     std::size_t size_;
     TableContext ctx_;
+    std::optional<ShapeSource> primitive_;  // ctx_.primitive's, asked once
     BoundaryGrid grid_;
 
     void check_lists(std::uint64_t total) const;
