@@ -408,6 +408,21 @@ TEST(Coverage, ARayStartingBetweenTwoCrossingsIsStillBlocked) {
     EXPECT_GT(double(blocked) / between, 0.8) << blocked << " of " << between;
 }
 
+// A ray that starts among a pair's crossings (a shadow ray leaving a point among fur) meets
+// the share of them ahead of its start: none a half spread behind their mean, half at it, all
+// a half spread ahead, linearly between (so a shadow no longer jumps where the mean passes the
+// start).
+TEST(Coverage, ARayMeetsTheShareOfAPairsCrossingsAheadOfItsStart) {
+    const double spread = 2.0;
+    EXPECT_EQ(crossing_share_ahead(-1.0, spread), 0.0);
+    EXPECT_EQ(crossing_share_ahead(-5.0, spread), 0.0);
+    EXPECT_DOUBLE_EQ(crossing_share_ahead(-0.5, spread), 0.25);
+    EXPECT_DOUBLE_EQ(crossing_share_ahead(0.0, spread), 0.5);
+    EXPECT_DOUBLE_EQ(crossing_share_ahead(0.5, spread), 0.75);
+    EXPECT_EQ(crossing_share_ahead(1.0, spread), 1.0);
+    EXPECT_EQ(crossing_share_ahead(7.0, spread), 1.0);
+}
+
 // A hair of radius 0.15 in cells of 1, across the view, 2.3 pixels a cell.
 const char* kThinHair = R"({
   "camera": {"eye": [3, -60, 4], "look_at": [3, 0, 4], "up": [0, 0, 1], "fov_y_deg": 10, "width": 96, "height": 96},

@@ -34,6 +34,10 @@ double lod_level(double cell0, double width) {
     return std::log2(cell0 / (width * kCellPerFootprint));
 }
 
+double crossing_share_ahead(double dt, double spread) {
+    return std::clamp(dt / spread + 0.5, 0.0, 1.0);
+}
+
 double lod_blend(double f, double band) {
     if (band <= 0) return f < 0.5 ? 0.0 : 1.0;
     return std::clamp((f - 0.5) / band + 0.5, 0.0, 1.0);
@@ -128,13 +132,17 @@ void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, bool normal
     // leaving a surface among the fur) can have that crossing behind it, and the pair then
     // answers with its last crossing, the first one of the reversed pair (as point-sampled
     // lattices do, HitTableShape::line_hits): a hair whose line through the box is crossed
-    // behind and ahead of the ray's start still blocks it.
+    // behind and ahead of the ray's start still blocks it. A crossing near the start counts
+    // for its share ahead of it (crossing_share_ahead).
     const double dd = dot(r.d, r.d);
-    // Adds pair i of `bl` (looked up as h) if r meets its crossing after tmin.
+    const double spread = kCrossingSpreadCells * l.frame.cell() / std::sqrt(dd);  // in t
+    // Adds pair i of `bl` (looked up as h) for the share of its crossings r meets after tmin;
+    // false when that share is 0.
     auto add_if_ahead = [&](const Blend& bl, int i, const CoverageHit& hi) {
         const Vec3 p = lerp(to_vec(bl.ca[i]), to_vec(bl.cb[i]), hi.t) * l.frame.cell();
-        if (dot(p - r.o, r.d) / dd <= tmin) return false;
-        s.add(bl.w[i], hi, p);
+        const double ahead = crossing_share_ahead(dot(p - r.o, r.d) / dd - tmin, spread);
+        if (ahead <= 0) return false;
+        s.add(bl.w[i] * ahead, hi, p);
         return true;
     };
     Blend back;
