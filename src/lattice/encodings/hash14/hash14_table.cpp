@@ -7,6 +7,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "lattice/encoding.h"
 #include "lattice/octahedral.h"
 #include "util/hash.h"
 
@@ -34,6 +35,12 @@ std::uint16_t quantise_t(float t) {
 }  // namespace
 
 ByteBuffer Hash14Table::build(const RawHits& hits) {
+    BufferSink sink;
+    write(RawHits(hits), sink);  // shares the hits' storage: frees nothing of the caller's
+    return sink.take();
+}
+
+void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     const std::uint64_t n = hits.size();
     const std::uint64_t buckets = std::max<std::uint64_t>(1, n / 2);
     if (buckets + n >= kEnd) throw std::length_error("hash14: too many entries for 32-bit links");
@@ -97,29 +104,48 @@ ByteBuffer Hash14Table::build(const RawHits& hits) {
     std::vector<std::uint64_t> over_start(parts + 1, buckets);
     for (std::uint64_t p = 0; p < parts; ++p) over_start[p + 1] = over_start[p] + over_count[p];
 
-    ByteBuffer payload(kHeader + over_start[parts] * sizeof(Hash14Entry));
-    std::memcpy(payload.data(), &buckets, 8);
-    auto* out = reinterpret_cast<Hash14Entry*>(payload.data() + kHeader);
-    tbb::parallel_for(std::uint64_t{0}, parts, [&](std::uint64_t p) {
-        Hash14Entry* part_out = out + b0(p);
-        for (std::uint64_t k = b0(p); k < b0(p + 1); ++k) out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, kEnd};
-        std::uint64_t next_over = over_start[p];
-        for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
-            const Sorted& h = sorted[i];
-            const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, kEnd};
-            Hash14Entry& head = part_out[h.bucket];
-            if (head.a == 0xFFFF) {
-                head = e;
-                continue;
+    hits = {};  // read for the last time above
+
+    // The payload, a group of partitions at a time: each group's buckets and overflow entries
+    // are two contiguous ranges of it, built in a buffer that is reused, then handed to the sink.
+    sink.reserve(kHeader + over_start[parts] * sizeof(Hash14Entry));
+    sink.write_at(0, &buckets, kHeader);
+    constexpr std::uint64_t kGroup = 64;  // partitions: about 8 MB of entries
+    std::uint64_t most = 0;
+    for (std::uint64_t g = 0; g < parts; g += kGroup) {
+        const std::uint64_t g1 = std::min(parts, g + kGroup);
+        most = std::max(most, (b0(g1) - b0(g)) + (over_start[g1] - over_start[g]));
+    }
+    ByteBuffer stage_buf(most * sizeof(Hash14Entry));
+    auto* stage = reinterpret_cast<Hash14Entry*>(stage_buf.data());
+    for (std::uint64_t g = 0; g < parts; g += kGroup) {
+        const std::uint64_t g1 = std::min(parts, g + kGroup);
+        const std::uint64_t nb = b0(g1) - b0(g);
+        // The stage holds the group's buckets, then its overflow entries.
+        Hash14Entry* const over_stage = stage + nb;
+        tbb::parallel_for(g, g1, [&](std::uint64_t p) {
+            Hash14Entry* part_out = stage + (b0(p) - b0(g));
+            for (std::uint64_t k = 0; k < b0(p + 1) - b0(p); ++k) part_out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, kEnd};
+            std::uint64_t next_over = over_start[p];
+            for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
+                const Sorted& h = sorted[i];
+                const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, kEnd};
+                Hash14Entry& head = part_out[h.bucket];
+                if (head.a == 0xFFFF) {
+                    head = e;
+                    continue;
+                }
+                // Collisions go right after the bucket's head in its chain.
+                Hash14Entry& slot = over_stage[next_over - over_start[g]];
+                slot = e;
+                slot.next = head.next;
+                head.next = static_cast<std::uint32_t>(next_over++);
             }
-            // Collisions go right after the bucket's head in its chain.
-            Hash14Entry& slot = out[next_over];
-            slot = e;
-            slot.next = head.next;
-            head.next = static_cast<std::uint32_t>(next_over++);
-        }
-    });
-    return payload;
+        });
+        sink.write_at(kHeader + b0(g) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
+        sink.write_at(kHeader + over_start[g] * sizeof(Hash14Entry), stage + nb,
+                      (over_start[g1] - over_start[g]) * sizeof(Hash14Entry));
+    }
 }
 
 Hash14Table::Hash14Table(const std::uint8_t* payload, std::size_t size, std::uint64_t entries)
