@@ -121,6 +121,17 @@ TEST(PayloadStream, SameBytesAsTheWholeBuildEveryByteOnce) {
         }
 }
 
+// Hits that nothing else holds are made into entries in place, in their own buffers.
+TEST(PayloadStream, HitsHeldByTheEncoderAloneGiveTheSameBytes) {
+    const Encoding& e = find_encoding("hash14");
+    const Rasterized& r = hair(2);
+    RasterizeResult own = rasterize(r.ctx);
+    for (const auto& buffer : own.raw.storage) EXPECT_EQ(buffer.use_count(), 1);
+    CountingSink sink;
+    encode_payload(e, std::move(own.raw), r.ctx, {}, sink);
+    EXPECT_TRUE(sink.bytes == whole_build(e, r));
+}
+
 TEST(PayloadStream, NoHitsMakeTheSamePayload) {
     const Encoding& e = find_encoding("hash14");
     const Rasterized& r = hair(1);

@@ -285,7 +285,7 @@ void gather_blocks(const dist::DealReport& mine, bool keep_hits, std::vector<Cou
     std::vector<bool> dealt(counts.size());
     dist::mark_dealt(mine.chunks, dealt, dist::MessageReader({}, "block list", 0));
     for (std::size_t r = 1; r < all.size(); ++r) {
-        auto buffer = std::make_shared<const ByteBuffer>(std::move(all[r]));
+        auto buffer = std::make_shared<ByteBuffer>(std::move(all[r]));
         dist::MessageReader in({buffer->data(), buffer->size()}, "rasterized blocks", static_cast<int>(r));
         const std::uint64_t m = in.read<std::uint64_t>();
         const auto list = [&](auto& v) {  // m values, checked to fit before they are allocated
