@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <numeric>
 #include <filesystem>
 #include <map>
+#include <numeric>
 #include <vector>
 
 #include "lattice/encoding.h"
@@ -35,8 +35,8 @@ const Rasterized& hair(int k) {
     if (fresh) {
         const Primitive& p = scene.primitives.at(0);
         const LatticeSpec& l = *p.lattice;
-        it->second.ctx = {{l.cells[0] * k, l.cells[1] * k, l.cells[2] * k}, l.sigma / k, l.sigma,
-                          p.shape.get()};
+        it->second.ctx = {
+            {l.cells[0] * k, l.cells[1] * k, l.cells[2] * k}, l.sigma / k, l.sigma, p.shape.get()};
         it->second.raster = rasterize(it->second.ctx);
     }
     return it->second;
@@ -77,9 +77,14 @@ std::vector<std::uint8_t> hash14_reference(const RawHits& hits) {
     std::vector<Hash14Entry> e(buckets, Hash14Entry{0xFFFF, 0xFFFF, 0, 0, 0, Hash14Table::kEnd});
     for (const std::size_t i : order) {
         const RawHit& h = all[i];
-        const auto t = static_cast<std::uint16_t>(std::lround(std::clamp(double(h.t), 0.0, 1.0) * 65535));
-        const Hash14Entry entry{static_cast<std::uint16_t>(h.a), static_cast<std::uint16_t>(h.b), t,
-                                h.nu, h.nv, Hash14Table::kEnd};
+        const auto t =
+            static_cast<std::uint16_t>(std::lround(std::clamp(double(h.t), 0.0, 1.0) * 65535));
+        const Hash14Entry entry{static_cast<std::uint16_t>(h.a),
+                                static_cast<std::uint16_t>(h.b),
+                                t,
+                                h.nu,
+                                h.nv,
+                                Hash14Table::kEnd};
         Hash14Entry& head = e[bucket_of(h)];
         if (head.a == 0xFFFF) {
             head = entry;

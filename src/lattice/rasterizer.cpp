@@ -119,6 +119,7 @@ public:
         const bool start_inside = shape.inside(p * h_);
         for (int f = 0; f < 6; ++f) {
             const FaceLayout& fl = faces_[static_cast<std::size_t>(f)];
+            const std::vector<Vec3>& at = points_[static_cast<std::size_t>(f)];
             if (s.best_t.size() < fl.mask.size()) {
                 s.best_t.assign(fl.mask.size(), kInfinity);
                 s.best_c.resize(fl.mask.size());
@@ -139,8 +140,7 @@ public:
                 if (fl.ids[k] == a || !BoundaryGrid::valid_pair(fa, fl.mask[k])) continue;
                 ++cnt.hits;
                 cnt.counted += static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fl.mask[k]));
-                if (keep) s.arena.push(make_hit(shape, a, p, fl.ids[k], points_[static_cast<std::size_t>(f)][k],
-                                                start_inside, s, k));
+                if (keep) s.arena.push(make_hit(shape, a, p, fl.ids[k], at[k], start_inside, s, k));
             }
             if (!start_inside)
                 for (const std::size_t k : s.touched) s.best_t[k] = kInfinity;

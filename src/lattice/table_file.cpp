@@ -7,8 +7,8 @@
 
 #include <bit>
 #include <cassert>
-#include <cmath>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>

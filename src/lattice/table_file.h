@@ -8,8 +8,8 @@
 // Loading checks all of it and rejects a truncated, corrupt or mismatched file with a message
 // naming the file and what is wrong. The payload is memory-mapped, not copied.
 #include <array>
-#include <functional>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>

@@ -106,13 +106,16 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
         b.header.entries = b.raster.hits;
         // The payload goes straight into the file, and the encoding may free the hits as it
         // reads them: the build's peak is then about the hits alone.
-        const std::uint64_t payload_bytes = write_table_file(path, b.header, [&](PayloadSink& sink) {
-            naming_the_primitive(plan, [&] {
-                encode_payload(*plan.encoding, std::move(b.raster.raw), plan.context, options, sink);
+        const std::uint64_t payload_bytes =
+            write_table_file(path, b.header, [&](PayloadSink& sink) {
+                naming_the_primitive(plan, [&] {
+                    encode_payload(*plan.encoding, std::move(b.raster.raw), plan.context, options,
+                                   sink);
+                });
             });
-        });
         b.raster.raw = {};
-        b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        b.encode_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         b.bytes = payload_bytes + kTableHeaderBytes + b.header.metadata.size();
         dist::mark(dist::Step::kEncoded);
     };

@@ -41,8 +41,8 @@ static_assert(sizeof(Sorted) == 12);
 
 // Every chunk of hits made into entries by to_entry(hit, chunk), in place in its buffer where
 // the hits are held by nothing else: the 8 bytes a hit saves then go back to the system before
-// the sorted copy is made, which reuses them (first touches of memory new to the process are
-// what this VM makes slow). Else into a new buffer, which `hits` keeps.
+// the sorted copy is made, which reuses them (a first touch of memory the system has not just
+// freed is dear, on virtual machines above all). Else into a new buffer, which `hits` keeps.
 template <class ToEntry>
 std::vector<std::span<const Sorted>> compact_hits(RawHits& hits, ToEntry&& to_entry) {
     // The chunks of each buffer, in address order: compacted in that order, an entry never
@@ -50,7 +50,8 @@ std::vector<std::span<const Sorted>> compact_hits(RawHits& hits, ToEntry&& to_en
     const std::size_t nbuf = hits.storage.size();
     std::vector<std::vector<std::size_t>> in_buffer(nbuf);
     const auto holds = [&](std::size_t j, const std::uint8_t* p) {
-        return p >= hits.storage[j]->data() && p < hits.storage[j]->data() + hits.storage[j]->size();
+        return p >= hits.storage[j]->data() &&
+               p < hits.storage[j]->data() + hits.storage[j]->size();
     };
     for (std::size_t c = 0; c < hits.chunks.size(); ++c) {
         if (hits.chunks[c].empty()) continue;
@@ -118,14 +119,20 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     auto part_of = [](std::uint64_t bucket) { return bucket >> kPartBits; };
     const std::size_t nchunks = hits.chunks.size();
     std::vector<std::uint64_t> count(nchunks * parts, 0);
-    const std::vector<std::span<const Sorted>> compact = compact_hits(hits, [&](const RawHit& h, std::size_t c) {
-        if (h.a >= kMaxPoints || h.b >= kMaxPoints) throw std::length_error("hash14: point id over 16 bits");
-        const std::uint64_t bucket = bucket_of(h.a, h.b, buckets);
-        ++count[c * parts + part_of(bucket)];
-        const auto local = static_cast<std::uint16_t>(bucket & ((1u << kPartBits) - 1));
-        return Sorted{static_cast<std::uint16_t>(h.a), static_cast<std::uint16_t>(h.b), quantise_t(h.t),
-                      h.nu, h.nv, local};
-    });
+    const std::vector<std::span<const Sorted>> compact =
+        compact_hits(hits, [&](const RawHit& h, std::size_t c) {
+            if (h.a >= kMaxPoints || h.b >= kMaxPoints)
+                throw std::length_error("hash14: point id over 16 bits");
+            const std::uint64_t bucket = bucket_of(h.a, h.b, buckets);
+            ++count[c * parts + part_of(bucket)];
+            const auto local = static_cast<std::uint16_t>(bucket & ((1u << kPartBits) - 1));
+            return Sorted{static_cast<std::uint16_t>(h.a),
+                          static_cast<std::uint16_t>(h.b),
+                          quantise_t(h.t),
+                          h.nu,
+                          h.nv,
+                          local};
+        });
     // Stable positions: partition by partition, chunk by chunk.
     std::vector<std::uint64_t> offset(nchunks * parts), part_start(parts + 1, 0);
     std::uint64_t pos = 0;
@@ -181,7 +188,8 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
         Hash14Entry* const over_stage = stage + nb;
         tbb::parallel_for(g, g1, [&](std::uint64_t p) {
             Hash14Entry* part_out = stage + (b0(p) - b0(g));
-            for (std::uint64_t k = 0; k < b0(p + 1) - b0(p); ++k) part_out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, kEnd};
+            for (std::uint64_t k = 0; k < b0(p + 1) - b0(p); ++k)
+                part_out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, kEnd};
             std::uint64_t next_over = over_start[p];
             for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
                 const Sorted& h = sorted[i];
