@@ -37,6 +37,27 @@ struct EncodeOptions {
     bool progress = false;
 };
 
+// Where an encoding's payload goes: its size first, then pieces at byte offsets, in any order,
+// each byte written once, from one thread at a time. A table file (lattice/table_file.h) takes
+// it straight into the file, so that a large payload never needs memory of its own.
+class PayloadSink {
+public:
+    virtual ~PayloadSink() = default;
+    virtual void reserve(std::size_t size) = 0;  // once, before any piece
+    virtual void write_at(std::size_t offset, const void* data, std::size_t n) = 0;
+};
+
+// A sink into memory.
+class BufferSink final : public PayloadSink {
+public:
+    void reserve(std::size_t size) override { buffer_ = ByteBuffer(size); }
+    void write_at(std::size_t offset, const void* data, std::size_t n) override;
+    ByteBuffer take() { return std::move(buffer_); }
+
+private:
+    ByteBuffer buffer_;
+};
+
 struct Encoding {
     std::string_view name;
     std::string_view summary;
@@ -55,6 +76,11 @@ struct Encoding {
     // The payload. `hits` are the rasterized hits when needs_hits (else empty); ctx.primitive
     // is set. Must not depend on the thread count.
     ByteBuffer (*build)(const RawHits& hits, const TableContext& ctx, const EncodeOptions& opt);
+    // Optional: the same payload written into a sink, consuming the hits (an encoding frees
+    // them as soon as it has read them), for encodings whose build would otherwise hold the
+    // hits, a copy of them and the payload at once. encode_payload chooses between the two.
+    void (*stream)(RawHits&& hits, const TableContext& ctx, const EncodeOptions& opt,
+                   PayloadSink& sink) = nullptr;
     // The table over a payload (which must outlive it); throws std::runtime_error when the
     // payload is inconsistent.
     std::unique_ptr<LatticeTable> (*open)(const std::uint8_t* payload, std::size_t size,
@@ -64,6 +90,11 @@ struct Encoding {
     // culls rays far from the primitive by it without changing any answer.
     double (*error_bound)(const TableContext& ctx, const EncodeOptions& opt);
 };
+
+// The payload of `enc` for the hits, into the sink: through its stream when it has one, else
+// its build (then copied in). Byte for byte the payload build gives.
+void encode_payload(const Encoding& enc, RawHits&& hits, const TableContext& ctx,
+                    const EncodeOptions& opt, PayloadSink& sink);
 
 // Every registered encoding, in the order they are listed to users.
 std::span<const Encoding* const> encodings();

@@ -95,7 +95,11 @@ const Shape& whole_shape(const ShapeParts& parts) { return parts.shape(); }
 class Tracer {
 public:
     Tracer(const Shape& shape, const TableContext& lg) : grid_(lg.cells), h_(lg.cell) {
-        for (int f = 0; f < 6; ++f) faces_[static_cast<std::size_t>(f)] = layout_face(grid_, f);
+        for (int f = 0; f < 6; ++f) {
+            const FaceLayout& fl = faces_[static_cast<std::size_t>(f)] = layout_face(grid_, f);
+            std::vector<Vec3>& at = points_[static_cast<std::size_t>(f)];
+            for (const std::uint32_t id : fl.ids) at.push_back(to_vec(grid_.point(id)));
+        }
         count_sums();
         // Padded beyond the parts' touch tolerance so culling never drops a touching hit.
         spheres_ = part_spheres(shape, h_, 0.0, 1e-6);
@@ -115,6 +119,7 @@ public:
         const bool start_inside = shape.inside(p * h_);
         for (int f = 0; f < 6; ++f) {
             const FaceLayout& fl = faces_[static_cast<std::size_t>(f)];
+            const std::vector<Vec3>& at = points_[static_cast<std::size_t>(f)];
             if (s.best_t.size() < fl.mask.size()) {
                 s.best_t.assign(fl.mask.size(), kInfinity);
                 s.best_c.resize(fl.mask.size());
@@ -135,7 +140,7 @@ public:
                 if (fl.ids[k] == a || !BoundaryGrid::valid_pair(fa, fl.mask[k])) continue;
                 ++cnt.hits;
                 cnt.counted += static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fl.mask[k]));
-                if (keep) s.arena.push(make_hit(shape, a, p, fl.ids[k], start_inside, s, k));
+                if (keep) s.arena.push(make_hit(shape, a, p, fl.ids[k], at[k], start_inside, s, k));
             }
             if (!start_inside)
                 for (const std::size_t k : s.touched) s.best_t[k] = kInfinity;
@@ -147,6 +152,7 @@ private:
     BoundaryGrid grid_;
     double h_;
     std::array<FaceLayout, 6> faces_;
+    std::array<std::vector<Vec3>, 6> points_;  // each face point's coordinates (lattice units)
     struct Sum {
         std::uint64_t valid = 0, multiplicity = 0;
     };
@@ -237,9 +243,8 @@ private:
     }
 
     template <class S>
-    RawHit make_hit(const S& shape, std::uint32_t a, const Vec3& p, std::uint32_t b, bool start_inside,
-                    const Scratch& s, std::size_t k) const {
-        const Vec3 qv = to_vec(grid_.point(b));
+    RawHit make_hit(const S& shape, std::uint32_t a, const Vec3& p, std::uint32_t b, const Vec3& qv,
+                    bool start_inside, const Scratch& s, std::size_t k) const {
         const Ray r{p * h_, (qv - p) * h_};
         Crossing c = s.best_c[k];
         float t = static_cast<float>(std::min(1.0, s.best_t[k]));
@@ -285,7 +290,7 @@ void gather_blocks(const dist::DealReport& mine, bool keep_hits, std::vector<Cou
     std::vector<bool> dealt(counts.size());
     dist::mark_dealt(mine.chunks, dealt, dist::MessageReader({}, "block list", 0));
     for (std::size_t r = 1; r < all.size(); ++r) {
-        auto buffer = std::make_shared<const ByteBuffer>(std::move(all[r]));
+        auto buffer = std::make_shared<ByteBuffer>(std::move(all[r]));
         dist::MessageReader in({buffer->data(), buffer->size()}, "rasterized blocks", static_cast<int>(r));
         const std::uint64_t m = in.read<std::uint64_t>();
         const auto list = [&](auto& v) {  // m values, checked to fit before they are allocated

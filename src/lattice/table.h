@@ -42,7 +42,8 @@ static_assert(sizeof(RawHit) == 20);
 inline constexpr int kRawNormalBits = 16;
 
 // Rasterized hits in chunks (one per block of entry points, in a fixed order) that point into
-// large buffers, so that a big rasterization is never copied or grown piecewise.
+// large buffers, so that a big rasterization is never copied or grown piecewise. The buffers
+// are made non-const: an encoding that holds the only reference to one may reuse its memory.
 struct RawHits {
     std::vector<std::shared_ptr<const ByteBuffer>> storage;
     std::vector<std::span<const RawHit>> chunks;

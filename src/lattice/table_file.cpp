@@ -6,8 +6,9 @@
 #include <unistd.h>
 
 #include <bit>
-#include <cmath>
+#include <cassert>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -165,6 +166,36 @@ bool read_whole(int fd, Mapping& m) {
     return true;
 }
 
+// Puts a payload's pieces into a table file, after its header.
+class FileSink final : public PayloadSink {
+public:
+    explicit FileSink(AtomicFile& out) : out_(out) {}
+    void reserve(std::size_t size) override { size_ = size; }
+    void write_at(std::size_t offset, const void* data, std::size_t n) override {
+        assert(offset <= size_ && n <= size_ - offset);
+        out_.write_at(kTableHeaderBytes + offset, data, n);
+    }
+    std::size_t size() const { return size_; }
+
+private:
+    AtomicFile& out_;
+    std::size_t size_ = 0;
+};
+
+// hash_bytes of n bytes of what `out` holds at `offset`.
+std::uint64_t hash_written(const AtomicFile& out, std::size_t offset, std::size_t n) {
+    if (n == 0) return hash_bytes(nullptr, 0);
+    const int fd = ::fileno(out.file());
+    // Bytes never written read as zeros (and mapping past the end would fault).
+    if (::ftruncate(fd, static_cast<off_t>(offset + n)) != 0)
+        throw_write_errno(out.target(), errno, "lattice table");
+    void* p = ::mmap(nullptr, offset + n, PROT_READ, MAP_SHARED, fd, 0);
+    if (p == MAP_FAILED) throw_write_errno(out.target(), errno, "lattice table");
+    const std::uint64_t h = hash_bytes(static_cast<const std::uint8_t*>(p) + offset, n);
+    ::munmap(p, offset + n);
+    return h;
+}
+
 }  // namespace
 
 std::string TableHeader::describe() const {
@@ -174,18 +205,28 @@ std::string TableHeader::describe() const {
     return buf;
 }
 
-void write_table_file(const std::string& path, const TableHeader& h0,
-                      const ByteBuffer& payload) {
-    TableHeader h = h0;
-    h.payload_bytes = payload.size();
-    const std::uint64_t checksum =
-        hash_bytes(h.metadata.data(), h.metadata.size(), hash_bytes(payload.data(), payload.size()));
-    const auto header = encode_header(h, checksum);
+void write_table_file(const std::string& path, const TableHeader& h, const ByteBuffer& payload) {
+    write_table_file(path, h, [&](PayloadSink& sink) {
+        sink.reserve(payload.size());
+        sink.write_at(0, payload.data(), payload.size());
+    });
+}
+
+std::uint64_t write_table_file(const std::string& path, const TableHeader& h0,
+                               const std::function<void(PayloadSink&)>& fill) {
     AtomicFile out(path, "lattice table");
-    out.write(header.data(), header.size());
-    out.write(payload.data(), payload.size());
-    out.write(h.metadata.data(), h.metadata.size());
+    FileSink sink(out);
+    fill(sink);
+    TableHeader h = h0;
+    h.payload_bytes = sink.size();
+    // The checksum is read back from the file (its pages are still cached).
+    const std::uint64_t checksum = hash_bytes(h.metadata.data(), h.metadata.size(),
+                                              hash_written(out, kTableHeaderBytes, sink.size()));
+    const auto header = encode_header(h, checksum);
+    out.write_at(kTableHeaderBytes + sink.size(), h.metadata.data(), h.metadata.size());
+    out.write_at(0, header.data(), header.size());
     out.commit();
+    return sink.size();
 }
 
 TableHeader read_table_header(const std::string& path) {

@@ -9,10 +9,12 @@
 // naming the file and what is wrong. The payload is memory-mapped, not copied.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "lattice/encoding.h"
 #include "lattice/table.h"
 #include "util/big_buffer.h"
 
@@ -46,6 +48,10 @@ inline constexpr std::uint64_t kMaxTableFileBytes = std::uint64_t{64} << 30;
 // Writes atomically (temporary file + rename); throws InputError naming the path.
 void write_table_file(const std::string& path, const TableHeader& h,
                       const ByteBuffer& payload);
+// The same file, its payload written by `fill` into a sink that puts each piece straight into
+// the file (so that the payload never needs memory of its own); returns the payload's size.
+std::uint64_t write_table_file(const std::string& path, const TableHeader& h,
+                               const std::function<void(PayloadSink&)>& fill);
 
 // A table loaded from disk, with the mapping that holds its payload.
 struct LoadedTable {

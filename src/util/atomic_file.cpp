@@ -103,6 +103,18 @@ void AtomicFile::write(const void* data, std::size_t n) {
     if (n != 0 && std::fwrite(data, 1, n, file_) != n) throw_write_errno(target_, errno, what_);
 }
 
+void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t n) {
+    throw_if_interrupted();
+    if (std::fflush(file_) != 0) throw_write_errno(target_, errno, what_);
+    const auto* p = static_cast<const char*>(data);
+    while (n != 0) {
+        const ssize_t k = ::pwrite(::fileno(file_), p, n, static_cast<off_t>(offset));
+        if (k < 0 && errno == EINTR) continue;
+        if (k <= 0) throw_write_errno(target_, k < 0 ? errno : EIO, what_);
+        p += k, n -= static_cast<std::size_t>(k), offset += static_cast<std::uint64_t>(k);
+    }
+}
+
 void AtomicFile::commit() {
     throw_if_interrupted();
     if (std::fflush(file_) != 0) throw_write_errno(target_, errno, what_);

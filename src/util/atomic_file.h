@@ -4,6 +4,7 @@
 // real name. Temporaries have unique names (TARGET.tmp-XXXXXX, by mkstemp), so concurrent
 // writers of one target never collide; the last rename wins. Live temporaries are registered,
 // so that an interrupted process can remove them on its way out (see util/interrupt.h).
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -31,6 +32,9 @@ public:
 
     // Writes n bytes; throws InputError naming the target on failure, Interrupted on a signal.
     void write(const void* data, std::size_t n);
+    // Writes n bytes at a byte offset of the file (after what write() buffered), for files
+    // written in pieces out of order; the same errors as write().
+    void write_at(std::uint64_t offset, const void* data, std::size_t n);
     // Flushes, closes and renames into place (no fsync: this guards against partial files, not
     // power loss). Throws InputError on failure and Interrupted (leaving the target untouched)
     // if a signal arrived.

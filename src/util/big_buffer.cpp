@@ -26,6 +26,18 @@ ByteBuffer::ByteBuffer(std::size_t size) : size_(size) {
     ::madvise(data_, mapped_, MADV_HUGEPAGE);  // a hint; fine if refused
 }
 
+void ByteBuffer::shrink(std::size_t size) {
+    if (size >= size_) return;
+    constexpr std::size_t kHuge = std::size_t{2} << 20;
+    const std::size_t keep = (size + kHuge - 1) / kHuge * kHuge;
+    if (keep < mapped_) {
+        ::munmap(data_ + keep, mapped_ - keep);
+        mapped_ = keep;
+    }
+    size_ = size;
+    if (mapped_ == 0) data_ = nullptr;
+}
+
 ByteBuffer::~ByteBuffer() {
     if (data_) ::munmap(data_, mapped_);
 }

@@ -23,6 +23,9 @@ public:
     std::uint8_t* data() { return data_; }
     const std::uint8_t* data() const { return data_; }
     std::size_t size() const { return size_; }
+    // Keeps the first `size` bytes (at most size()) and gives the whole huge pages beyond back
+    // to the system, so that the memory a later buffer touches first can be these pages.
+    void shrink(std::size_t size);
 
 private:
     std::uint8_t* data_ = nullptr;

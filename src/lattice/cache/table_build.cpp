@@ -102,14 +102,21 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
         EncodeOptions options = plan.options;
         options.memory_budget = static_cast<std::size_t>(0.8 * double(available_memory_bytes()));
         options.progress = progress;
-        const ByteBuffer payload = naming_the_primitive(
-            plan, [&] { return plan.encoding->build(b.raster.raw, plan.context, options); });
-        b.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        b.raster.raw = {};
         b.header.pairs = b.raster.pairs_eq2;
         b.header.entries = b.raster.hits;
-        write_table_file(path, b.header, payload);
-        b.bytes = payload.size() + kTableHeaderBytes + b.header.metadata.size();
+        // The payload goes straight into the file, and the encoding may free the hits as it
+        // reads them: the build's peak is then about the hits alone.
+        const std::uint64_t payload_bytes =
+            write_table_file(path, b.header, [&](PayloadSink& sink) {
+                naming_the_primitive(plan, [&] {
+                    encode_payload(*plan.encoding, std::move(b.raster.raw), plan.context, options,
+                                   sink);
+                });
+            });
+        b.raster.raw = {};
+        b.encode_seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        b.bytes = payload_bytes + kTableHeaderBytes + b.header.metadata.size();
         dist::mark(dist::Step::kEncoded);
     };
     // Rank 0 encodes every hit while the other ranks wait: with their cores too, on its node.

@@ -3,6 +3,7 @@
 #include "lattice/encoding.h"
 
 #include <cassert>
+#include <cstring>
 
 #include "util/error.h"
 
@@ -17,6 +18,23 @@ std::span<const Encoding* const> encodings() {
         &kPerfect6Encoding, &kPerfect7Encoding, &kLearnedEncoding, &kCoverageEncoding,
     };
     return all;
+}
+
+void BufferSink::write_at(std::size_t offset, const void* data, std::size_t n) {
+    assert(offset <= buffer_.size() && n <= buffer_.size() - offset);
+    if (n) std::memcpy(buffer_.data() + offset, data, n);
+}
+
+void encode_payload(const Encoding& enc, RawHits&& hits, const TableContext& ctx,
+                    const EncodeOptions& opt, PayloadSink& sink) {
+    if (enc.stream) {
+        enc.stream(std::move(hits), ctx, opt, sink);
+        return;
+    }
+    const ByteBuffer payload = enc.build(hits, ctx, opt);
+    hits = {};
+    sink.reserve(payload.size());
+    sink.write_at(0, payload.data(), payload.size());
 }
 
 const Encoding& find_encoding(std::string_view name) {

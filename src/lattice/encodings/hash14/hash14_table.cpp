@@ -3,10 +3,12 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 
+#include "lattice/encoding.h"
 #include "lattice/octahedral.h"
 #include "util/hash.h"
 
@@ -31,9 +33,80 @@ std::uint16_t quantise_t(float t) {
     return static_cast<std::uint16_t>(x - whole >= 0.5 ? whole + 1 : whole);
 }
 
+// A hit as its finished entry, with its bucket within its partition.
+struct Sorted {
+    std::uint16_t a, b, t, nu, nv, bucket;
+};
+static_assert(sizeof(Sorted) == 12);
+
+// Every chunk of hits made into entries by to_entry(hit, chunk), in place in its buffer where
+// the hits are held by nothing else: the 8 bytes a hit saves then go back to the system before
+// the sorted copy is made, which reuses them (a first touch of memory the system has not just
+// freed is dear, on virtual machines above all). Else into a new buffer, which `hits` keeps.
+template <class ToEntry>
+std::vector<std::span<const Sorted>> compact_hits(RawHits& hits, ToEntry&& to_entry) {
+    // The chunks of each buffer, in address order: compacted in that order, an entry never
+    // overwrites a hit not yet read.
+    const std::size_t nbuf = hits.storage.size();
+    std::vector<std::vector<std::size_t>> in_buffer(nbuf);
+    const auto holds = [&](std::size_t j, const std::uint8_t* p) {
+        return p >= hits.storage[j]->data() &&
+               p < hits.storage[j]->data() + hits.storage[j]->size();
+    };
+    for (std::size_t c = 0; c < hits.chunks.size(); ++c) {
+        if (hits.chunks[c].empty()) continue;
+        const auto* p = reinterpret_cast<const std::uint8_t*>(hits.chunks[c].data());
+        std::size_t j = 0;
+        while (j < nbuf && !holds(j, p)) ++j;
+        assert(j < nbuf && "every chunk lies in one of the hits' buffers");
+        in_buffer[j].push_back(c);
+    }
+    std::vector<std::span<const Sorted>> out(hits.chunks.size());
+    std::vector<std::shared_ptr<const ByteBuffer>> fresh(nbuf);
+    tbb::parallel_for(std::size_t{0}, nbuf, [&](std::size_t j) {
+        std::vector<std::size_t>& cs = in_buffer[j];
+        std::sort(cs.begin(), cs.end(), [&](std::size_t x, std::size_t y) {
+            return hits.chunks[x].data() < hits.chunks[y].data();
+        });
+        std::size_t total = 0;
+        for (const std::size_t c : cs) total += hits.chunks[c].size();
+        // RawHits' buffers are never const objects (table.h).
+        const bool ours = hits.storage[j].use_count() == 1;
+        ByteBuffer* target = const_cast<ByteBuffer*>(hits.storage[j].get());
+        if (!ours) {
+            auto buf = std::make_shared<ByteBuffer>(total * sizeof(Sorted));
+            target = buf.get();
+            fresh[j] = std::move(buf);
+        }
+        std::uint8_t* w = target->data();
+        for (const std::size_t c : cs) {
+            auto* first = reinterpret_cast<const Sorted*>(w);
+            for (const RawHit& in : hits.chunks[c]) {
+                RawHit h;
+                std::memcpy(&h, &in, sizeof h);  // read whole before its bytes are overwritten
+                const Sorted e = to_entry(h, c);
+                std::memcpy(w, &e, sizeof e);
+                w += sizeof e;
+            }
+            out[c] = {first, hits.chunks[c].size()};
+        }
+        if (ours) target->shrink(total * sizeof(Sorted));
+    });
+    for (std::size_t j = 0; j < nbuf; ++j)
+        if (fresh[j]) hits.storage[j] = std::move(fresh[j]);
+    hits.chunks.clear();
+    return out;
+}
+
 }  // namespace
 
 ByteBuffer Hash14Table::build(const RawHits& hits) {
+    BufferSink sink;
+    write(RawHits(hits), sink);  // shares the hits' storage: frees nothing of the caller's
+    return sink.take();
+}
+
+void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     const std::uint64_t n = hits.size();
     const std::uint64_t buckets = std::max<std::uint64_t>(1, n / 2);
     if (buckets + n >= kEnd) throw std::length_error("hash14: too many entries for 32-bit links");
@@ -46,13 +119,20 @@ ByteBuffer Hash14Table::build(const RawHits& hits) {
     auto part_of = [](std::uint64_t bucket) { return bucket >> kPartBits; };
     const std::size_t nchunks = hits.chunks.size();
     std::vector<std::uint64_t> count(nchunks * parts, 0);
-    tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
-        for (const RawHit& h : hits.chunks[c]) {
+    const std::vector<std::span<const Sorted>> compact =
+        compact_hits(hits, [&](const RawHit& h, std::size_t c) {
             if (h.a >= kMaxPoints || h.b >= kMaxPoints)
                 throw std::length_error("hash14: point id over 16 bits");
-            ++count[c * parts + part_of(bucket_of(h.a, h.b, buckets))];
-        }
-    });
+            const std::uint64_t bucket = bucket_of(h.a, h.b, buckets);
+            ++count[c * parts + part_of(bucket)];
+            const auto local = static_cast<std::uint16_t>(bucket & ((1u << kPartBits) - 1));
+            return Sorted{static_cast<std::uint16_t>(h.a),
+                          static_cast<std::uint16_t>(h.b),
+                          quantise_t(h.t),
+                          h.nu,
+                          h.nv,
+                          local};
+        });
     // Stable positions: partition by partition, chunk by chunk.
     std::vector<std::uint64_t> offset(nchunks * parts), part_start(parts + 1, 0);
     std::uint64_t pos = 0;
@@ -64,21 +144,13 @@ ByteBuffer Hash14Table::build(const RawHits& hits) {
         }
     }
     part_start[parts] = pos;
-    struct Sorted {
-        std::uint16_t a, b, t, nu, nv, bucket;  // bucket: within its partition
-    };
-    static_assert(sizeof(Sorted) == 12);
     ByteBuffer sorted_buf(n * sizeof(Sorted));
     auto* sorted = reinterpret_cast<Sorted*>(sorted_buf.data());
     tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
         std::uint64_t* off = &offset[c * parts];
-        for (const RawHit& h : hits.chunks[c]) {
-            const std::uint64_t bucket = bucket_of(h.a, h.b, buckets);
-            const auto a = static_cast<std::uint16_t>(h.a), b = static_cast<std::uint16_t>(h.b);
-            const auto local = static_cast<std::uint16_t>(bucket & ((1u << kPartBits) - 1));
-            sorted[off[part_of(bucket)]++] = {a, b, quantise_t(h.t), h.nu, h.nv, local};
-        }
+        for (const Sorted& e : compact[c]) sorted[off[part_of(bucket_of(e.a, e.b, buckets))]++] = e;
     });
+    hits = {};  // read for the last time above
 
     // Which buckets are used, per partition (partition p owns buckets [b0(p), b0(p + 1))), fixes
     // every partition's overflow area before anything is placed.
@@ -97,29 +169,47 @@ ByteBuffer Hash14Table::build(const RawHits& hits) {
     std::vector<std::uint64_t> over_start(parts + 1, buckets);
     for (std::uint64_t p = 0; p < parts; ++p) over_start[p + 1] = over_start[p] + over_count[p];
 
-    ByteBuffer payload(kHeader + over_start[parts] * sizeof(Hash14Entry));
-    std::memcpy(payload.data(), &buckets, 8);
-    auto* out = reinterpret_cast<Hash14Entry*>(payload.data() + kHeader);
-    tbb::parallel_for(std::uint64_t{0}, parts, [&](std::uint64_t p) {
-        Hash14Entry* part_out = out + b0(p);
-        for (std::uint64_t k = b0(p); k < b0(p + 1); ++k) out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, kEnd};
-        std::uint64_t next_over = over_start[p];
-        for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
-            const Sorted& h = sorted[i];
-            const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, kEnd};
-            Hash14Entry& head = part_out[h.bucket];
-            if (head.a == 0xFFFF) {
-                head = e;
-                continue;
+    // The payload, a group of partitions at a time: each group's buckets and overflow entries
+    // are two contiguous ranges of it, built in a buffer that is reused, then handed to the sink.
+    sink.reserve(kHeader + over_start[parts] * sizeof(Hash14Entry));
+    sink.write_at(0, &buckets, kHeader);
+    constexpr std::uint64_t kGroup = 64;  // partitions: about 8 MB of entries
+    std::uint64_t most = 0;
+    for (std::uint64_t g = 0; g < parts; g += kGroup) {
+        const std::uint64_t g1 = std::min(parts, g + kGroup);
+        most = std::max(most, (b0(g1) - b0(g)) + (over_start[g1] - over_start[g]));
+    }
+    ByteBuffer stage_buf(most * sizeof(Hash14Entry));
+    auto* stage = reinterpret_cast<Hash14Entry*>(stage_buf.data());
+    for (std::uint64_t g = 0; g < parts; g += kGroup) {
+        const std::uint64_t g1 = std::min(parts, g + kGroup);
+        const std::uint64_t nb = b0(g1) - b0(g);
+        // The stage holds the group's buckets, then its overflow entries.
+        Hash14Entry* const over_stage = stage + nb;
+        tbb::parallel_for(g, g1, [&](std::uint64_t p) {
+            Hash14Entry* part_out = stage + (b0(p) - b0(g));
+            for (std::uint64_t k = 0; k < b0(p + 1) - b0(p); ++k)
+                part_out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, kEnd};
+            std::uint64_t next_over = over_start[p];
+            for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
+                const Sorted& h = sorted[i];
+                const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, kEnd};
+                Hash14Entry& head = part_out[h.bucket];
+                if (head.a == 0xFFFF) {
+                    head = e;
+                    continue;
+                }
+                // Collisions go right after the bucket's head in its chain.
+                Hash14Entry& slot = over_stage[next_over - over_start[g]];
+                slot = e;
+                slot.next = head.next;
+                head.next = static_cast<std::uint32_t>(next_over++);
             }
-            // Collisions go right after the bucket's head in its chain.
-            Hash14Entry& slot = out[next_over];
-            slot = e;
-            slot.next = head.next;
-            head.next = static_cast<std::uint32_t>(next_over++);
-        }
-    });
-    return payload;
+        });
+        sink.write_at(kHeader + b0(g) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
+        sink.write_at(kHeader + over_start[g] * sizeof(Hash14Entry), stage + nb,
+                      (over_start[g1] - over_start[g]) * sizeof(Hash14Entry));
+    }
 }
 
 Hash14Table::Hash14Table(const std::uint8_t* payload, std::size_t size, std::uint64_t entries)

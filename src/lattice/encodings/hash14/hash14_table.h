@@ -15,6 +15,8 @@
 
 namespace lat {
 
+class PayloadSink;
+
 #pragma pack(push, 1)
 struct Hash14Entry {
     std::uint16_t a, b;
@@ -33,6 +35,8 @@ public:
     // From rasterized hits; every id must be below kMaxPoints. Parallel; the payload does not
     // depend on the thread count.
     static ByteBuffer build(const RawHits& hits);
+    // The same payload into a sink, freeing the hits (where nothing else holds them) once read.
+    static void write(RawHits&& hits, PayloadSink& sink);
     // Over a payload made by build (owned or memory-mapped; it must outlive the table).
     Hash14Table(const std::uint8_t* payload, std::size_t size, std::uint64_t entries);
 

@@ -1,0 +1,179 @@
+// Streamed payloads (Encoding::stream, encode_payload, the table file's sink) are byte for byte
+// what the encodings' whole builds give, every byte written once, and the file they make loads.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <numeric>
+#include <vector>
+
+#include "lattice/encoding.h"
+#include "lattice/encodings/hash14/hash14_table.h"
+#include "lattice/rasterizer.h"
+#include "lattice/table_file.h"
+#include "scene/scene_loader.h"
+#include "temp_dir.h"
+#include "test_paths.h"
+#include "util/hash.h"
+
+namespace lat {
+namespace {
+
+struct Rasterized {
+    TableContext ctx;
+    RasterizeResult raster;
+};
+
+// The Plate 3 hair's lattice refined k times, rasterized.
+const Rasterized& hair(int k) {
+    static const Scene scene = load_scene(test::source_path("examples/plate3-hair-closeup.json"));
+    static std::map<int, Rasterized> done;
+    auto [it, fresh] = done.try_emplace(k);
+    if (fresh) {
+        const Primitive& p = scene.primitives.at(0);
+        const LatticeSpec& l = *p.lattice;
+        it->second.ctx = {
+            {l.cells[0] * k, l.cells[1] * k, l.cells[2] * k}, l.sigma / k, l.sigma, p.shape.get()};
+        it->second.raster = rasterize(it->second.ctx);
+    }
+    return it->second;
+}
+
+// A sink that records how often each byte is written, and the bytes.
+class CountingSink final : public PayloadSink {
+public:
+    void reserve(std::size_t size) override {
+        ++reserves;
+        bytes.assign(size, 0);
+        writes.assign(size, 0);
+    }
+    void write_at(std::size_t offset, const void* data, std::size_t n) override {
+        ASSERT_LE(offset + n, bytes.size());
+        std::memcpy(bytes.data() + offset, data, n);
+        for (std::size_t i = 0; i < n; ++i) ++writes[offset + i];
+    }
+    int reserves = 0;
+    std::vector<std::uint8_t> bytes;
+    std::vector<int> writes;
+};
+
+// hash14's layout computed the plain way (docs/lattice-tables.md): N/2 buckets, hits taken
+// stably by partitions of 4,096 buckets; a bucket's first hit is its head, later ones take the
+// next overflow slot and go right after the head in its chain.
+std::vector<std::uint8_t> hash14_reference(const RawHits& hits) {
+    const std::uint64_t n = hits.size(), buckets = std::max<std::uint64_t>(1, n / 2);
+    const auto bucket_of = [&](const RawHit& h) {
+        return ((mix64(std::uint64_t{h.a} << 16 | h.b) >> 32) * buckets) >> 32;
+    };
+    const std::vector<RawHit> all = hits.flatten();
+    std::vector<std::size_t> order(all.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+        return bucket_of(all[x]) >> 12 < bucket_of(all[y]) >> 12;
+    });
+    std::vector<Hash14Entry> e(buckets, Hash14Entry{0xFFFF, 0xFFFF, 0, 0, 0, Hash14Table::kEnd});
+    for (const std::size_t i : order) {
+        const RawHit& h = all[i];
+        const auto t =
+            static_cast<std::uint16_t>(std::lround(std::clamp(double(h.t), 0.0, 1.0) * 65535));
+        const Hash14Entry entry{static_cast<std::uint16_t>(h.a),
+                                static_cast<std::uint16_t>(h.b),
+                                t,
+                                h.nu,
+                                h.nv,
+                                Hash14Table::kEnd};
+        Hash14Entry& head = e[bucket_of(h)];
+        if (head.a == 0xFFFF) {
+            head = entry;
+            continue;
+        }
+        e.push_back(entry);
+        Hash14Entry& head_again = e[bucket_of(h)];  // push_back may have moved it
+        e.back().next = head_again.next;
+        head_again.next = static_cast<std::uint32_t>(e.size() - 1);
+    }
+    std::vector<std::uint8_t> out(8 + e.size() * sizeof(Hash14Entry));
+    std::memcpy(out.data(), &buckets, 8);
+    std::memcpy(out.data() + 8, e.data(), e.size() * sizeof(Hash14Entry));
+    return out;
+}
+
+std::vector<std::uint8_t> whole_build(const Encoding& e, const Rasterized& r) {
+    const ByteBuffer b = e.build(r.raster.raw, r.ctx, {});
+    return {b.data(), b.data() + b.size()};
+}
+
+// hash14 streams; dense goes through its whole build: both must give the same bytes, on
+// lattices of two sizes (one group of bucket partitions, and three).
+TEST(PayloadStream, SameBytesAsTheWholeBuildEveryByteOnce) {
+    for (const char* name : {"hash14", "dense"})
+        for (const int k : {1, 2}) {
+            SCOPED_TRACE(std::string(name) + " at sigma^-1 = " + std::to_string(k));
+            const Encoding& e = find_encoding(name);
+            const Rasterized& r = hair(k);
+            CountingSink sink;
+            encode_payload(e, RawHits(r.raster.raw), r.ctx, {}, sink);
+            EXPECT_EQ(sink.reserves, 1);
+            EXPECT_EQ(sink.bytes, whole_build(e, r));
+            if (e.name == "hash14") {
+                EXPECT_TRUE(sink.bytes == hash14_reference(r.raster.raw));
+            }
+            for (std::size_t i = 0; i < sink.writes.size(); ++i)
+                ASSERT_EQ(sink.writes[i], 1) << "byte " << i;
+        }
+}
+
+// Hits that nothing else holds are made into entries in place, in their own buffers.
+TEST(PayloadStream, HitsHeldByTheEncoderAloneGiveTheSameBytes) {
+    const Encoding& e = find_encoding("hash14");
+    const Rasterized& r = hair(2);
+    RasterizeResult own = rasterize(r.ctx);
+    for (const auto& buffer : own.raw.storage) EXPECT_EQ(buffer.use_count(), 1);
+    CountingSink sink;
+    encode_payload(e, std::move(own.raw), r.ctx, {}, sink);
+    EXPECT_TRUE(sink.bytes == whole_build(e, r));
+}
+
+TEST(PayloadStream, NoHitsMakeTheSamePayload) {
+    const Encoding& e = find_encoding("hash14");
+    const Rasterized& r = hair(1);
+    CountingSink sink;
+    encode_payload(e, RawHits{}, r.ctx, {}, sink);
+    const ByteBuffer whole = e.build(RawHits{}, r.ctx, {});
+    EXPECT_EQ(sink.bytes, std::vector<std::uint8_t>(whole.data(), whole.data() + whole.size()));
+}
+
+// The file written through the sink equals the one written from the whole payload, and loads
+// (its checksum, read back from the file, is right).
+TEST(PayloadStream, StreamedTableFileEqualsTheWholeOne) {
+    const test::TempDir dir;
+    const Rasterized& r = hair(2);
+    const Encoding& e = find_encoding("hash14");
+    TableHeader h;
+    h.encoding = "hash14";
+    h.cells = r.ctx.cells;
+    h.sigma_inv = 2;
+    h.sigma = r.ctx.sigma;
+    h.cell = r.ctx.cell;
+    h.pairs = r.raster.pairs_eq2;
+    h.entries = r.raster.hits;
+    h.metadata = R"({"primitive": "hair"})";
+    const std::string whole = dir.file("whole.lht"), streamed = dir.file("streamed.lht");
+    write_table_file(whole, h, e.build(r.raster.raw, r.ctx, {}));
+    const std::uint64_t size = write_table_file(streamed, h, [&](PayloadSink& sink) {
+        encode_payload(e, RawHits(r.raster.raw), r.ctx, {}, sink);
+    });
+    EXPECT_EQ(size + kTableHeaderBytes + h.metadata.size(), std::filesystem::file_size(streamed));
+    EXPECT_TRUE(test::slurp(whole) == test::slurp(streamed));
+    const LoadedTable t = load_table_file(streamed);
+    EXPECT_EQ(t.table->entries(), r.raster.hits);
+    TableHit hit;
+    const RawHit& first = r.raster.raw.chunks.front().front();
+    EXPECT_TRUE(t.table->lookup(first.a, first.b, hit));
+}
+
+}  // namespace
+}  // namespace lat
