@@ -164,7 +164,8 @@ TEST(Coverage, GuessedSnapsAreSnaps) {
                 if (a == b || !BoundaryGrid::valid_pair(grid.faces(ga), grid.faces(gb))) continue;
                 const PairRays pr(grid, ga, gb);
                 for (int k = 0; k < kCoverageRays + 8; ++k) {
-                    const SubRay s = k < kCoverageRays ? coverage_ray(grid, ga, gb, k) : pr.ray(u(rng), u(rng));
+                    const SubRay s = k < kCoverageRays ? coverage_ray(grid, ga, gb, k, kCoverageRays)
+                                                        : pr.ray(u(rng), u(rng));
                     const PairRays::Snap g = pr.guess_snap(s);
                     if (g == PairRays::Snap::kUnsure) {
                         ++unsure;
