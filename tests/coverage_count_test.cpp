@@ -192,5 +192,16 @@ TEST(CoverageCount, TheCacheRefusesAnotherCount) {
     EXPECT_NE(e.table->details().find("16 sub-rays a pair"), std::string::npos);
 }
 
+// The level budget's estimate of a build counts its sub-rays: a quarter of the work with 16 a
+// pair as with 64, on the same lattice.
+TEST(CoverageCount, TheEstimateCountsSubRays) {
+    TableContext sixteen = test::kHookContext;
+    sixteen.coverage_rays = 16;
+    const double w16 = coverage_work(sixteen), w64 = coverage_work(test::kHookContext);
+    ASSERT_GT(w16, 0);
+    EXPECT_DOUBLE_EQ(w64, 4 * w16);
+    EXPECT_DOUBLE_EQ(coverage_cpu_seconds(sixteen), w16 / kCoverageTestsPerCpuSecond);
+}
+
 }  // namespace
 }  // namespace lat

@@ -404,28 +404,41 @@ std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool pro
     return all;
 }
 
-double coverage_work(const TableContext& ctx) {
+CoverageWork coverage_work_parts(const TableContext& ctx) {
     const ShapeSource shape(*ctx.primitive);
-    const double cost = std::max(1.0, shape.intersect_cost());
-    const double all_pairs = static_cast<double>(BoundaryGrid::pair_count(ctx.cells));
     const PairCuller culler(ctx);
-    if (!culler.by_pieces()) return all_pairs * cost;
-    // A pair's sub-rays evaluate the leaves kept for it: about their share of the tree's cost.
-    // Counted on about kSampled entry points spread evenly: the culling alone, a tenth of a second
-    // at sigma^-1 = 4 for the burr of the costly-primitive bench (every eighth point took a
-    // second, for an estimate 15 % higher).
+    // A part costs its share of the primitive's cost, at least one simple test (a chain's
+    // sphere or cylinder, a mesh's triangle; a CSG tree's leaf, a quartic about 12).
+    const double parts = culler.by_pieces() ? static_cast<double>(shape.piece_count())
+                                            : static_cast<double>(shape.parts().part_count());
+    const double per_part = std::max(1.0, shape.intersect_cost() / std::max(1.0, parts));
+    // Counted on about kSampled entry points spread evenly: the culling alone, a tenth of a
+    // second at sigma^-1 = 4 for the burr of the costly-primitive bench (every eighth point took
+    // a second, for an estimate 15 % higher).
     constexpr std::uint32_t kSampled = 64;
     const std::uint32_t npoints = culler.grid().count();
-    const std::uint32_t kStride = std::max<std::uint32_t>(1, npoints / kSampled);
+    const std::uint32_t stride = std::max<std::uint32_t>(1, npoints / kSampled);
     Scratch s;
-    double pieces = 0;
+    CoverageWork w;
     std::uint32_t sampled = 0;
-    for (std::uint32_t a = 0; a < npoints; a += kStride, ++sampled)
-        culler.pairs(a, s, [&](std::uint32_t, const std::vector<std::uint32_t>& parts) {
-            pieces += static_cast<double>(parts.size());
+    for (std::uint32_t a = 0; a < npoints; a += stride, ++sampled)
+        culler.pairs(a, s, [&](std::uint32_t, const std::vector<std::uint32_t>& near) {
+            w.pairs += 1;
+            w.part_tests += static_cast<double>(near.size()) * per_part;
         });
-    const double per_entry = pieces / std::max<std::uint32_t>(1, sampled);
-    return per_entry * npoints * cost / static_cast<double>(shape.piece_count());
+    const double scale = static_cast<double>(npoints) / std::max<std::uint32_t>(1, sampled);
+    w.pairs *= scale;
+    w.part_tests *= scale;
+    return w;
+}
+
+double coverage_work(const TableContext& ctx) {
+    const CoverageWork w = coverage_work_parts(ctx);
+    return ctx.coverage_rays * (w.pairs * kSubRayOverheadTests + w.part_tests);
+}
+
+double coverage_cpu_seconds(const TableContext& ctx) {
+    return coverage_work(ctx) / kCoverageTestsPerCpuSecond;
 }
 
 }  // namespace lat

@@ -71,11 +71,24 @@ CoverageSample pair_coverage(const TableContext& ctx, std::uint32_t a, std::uint
 // points, the same for any thread count. ctx.primitive must be set.
 std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool progress);
 
-// About the work of rasterize_coverage, in pair tests: a pair times the primitive's
-// intersect_cost (render/modes/scene_lattices.h, kPairTestsPerCpuSecond), summed over the pairs the
-// build samples. Every pair for most primitives; for a CSG tree (culled by its leaves,
-// PieceSolid) the pairs near a leaf, each weighed by the share of the leaves near it, counted on
-// a sample of the entry points.
+// About the work of rasterize_coverage, in simple tests (a sphere's, a cylinder's): for each
+// pair the build samples (those its culling keeps) and each of its sub-rays, the tests of the
+// parts culled near the pair (for a CSG tree, its leaves; a part weighs its share of the
+// primitive's intersect_cost, at least 1), plus kSubRayOverheadTests for the sub-ray itself
+// (its snap, the parts' shadows). Counted on a sample of the entry points. ctx.primitive must
+// be set.
 double coverage_work(const TableContext& ctx);
+// Its parts, for one sub-ray a pair: pairs sampled and part tests.
+struct CoverageWork {
+    double pairs = 0, part_tests = 0;
+};
+CoverageWork coverage_work_parts(const TableContext& ctx);
+// What a build does in a second of one core, and its cost of a sub-ray besides its parts:
+// calibrated on the builds of bench/notes/complexity-log.md (the burr, CSGs of 1 to 12
+// quartics, the Plate 3 hair; 2.5 GHz Xeon).
+inline constexpr double kCoverageTestsPerCpuSecond = 1.2e6;
+inline constexpr double kSubRayOverheadTests = 1.0;
+// The estimated CPU seconds of one core for the build.
+double coverage_cpu_seconds(const TableContext& ctx);
 
 }  // namespace lat

@@ -359,6 +359,7 @@ std::string answer_text(const PrimitiveAnswer& p, LatticeFilter filter) {
             text = std::string(filter == LatticeFilter::kBox ? "box" : "smooth") + "-filtered " +
                    p.encoding + " table" + (p.sigma_inv.size() == 1 ? ", " : "s, ") +
                    levels_text(p.sigma_inv);
+            if (p.coverage_rays > 0) text += ", " + std::to_string(p.coverage_rays) + " sub-rays a pair";
             break;
         case AnsweredBy::kSubRayCrossings:
             text = "its own crossings of " + std::to_string(kExactSubRays) + " x " +
