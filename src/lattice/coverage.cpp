@@ -434,7 +434,7 @@ CoverageWork coverage_work_parts(const TableContext& ctx) {
 
 double coverage_work(const TableContext& ctx) {
     const CoverageWork w = coverage_work_parts(ctx);
-    return ctx.coverage_rays * (w.pairs * kSubRayOverheadTests + w.part_tests);
+    return (ctx.coverage_rays + kPairOverheadRays) * (w.pairs * kSubRayOverheadTests + w.part_tests);
 }
 
 double coverage_cpu_seconds(const TableContext& ctx) {

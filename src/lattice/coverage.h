@@ -71,23 +71,26 @@ CoverageSample pair_coverage(const TableContext& ctx, std::uint32_t a, std::uint
 // points, the same for any thread count. ctx.primitive must be set.
 std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool progress);
 
-// About the work of rasterize_coverage, in simple tests (a sphere's, a cylinder's): for each
-// pair the build samples (those its culling keeps) and each of its sub-rays, the tests of the
-// parts culled near the pair (for a CSG tree, its leaves; a part weighs its share of the
+// About the work of a coverage table's build, in simple tests (a sphere's, a cylinder's): for
+// each pair the build samples (those its culling keeps) and each of its sub-rays, the tests of
+// the parts culled near the pair (for a CSG tree, its leaves; a part weighs its share of the
 // primitive's intersect_cost, at least 1), plus kSubRayOverheadTests for the sub-ray itself
-// (its snap, the parts' shadows). Counted on a sample of the entry points. ctx.primitive must
-// be set.
+// (its snap, the parts' shadows); and as much again for kPairOverheadRays more sub-rays a pair,
+// the work that does not grow with them (the pair's own segment, rasterized for its hit; its
+// culling and shadows). Counted on a sample of the entry points. ctx.primitive must be set.
 double coverage_work(const TableContext& ctx);
 // Its parts, for one sub-ray a pair: pairs sampled and part tests.
 struct CoverageWork {
     double pairs = 0, part_tests = 0;
 };
 CoverageWork coverage_work_parts(const TableContext& ctx);
-// What a build does in a second of one core, and its cost of a sub-ray besides its parts:
-// calibrated on the builds of bench/notes/complexity-log.md (the burr, CSGs of 1 to 12
-// quartics, the Plate 3 hair; 2.5 GHz Xeon).
-inline constexpr double kCoverageTestsPerCpuSecond = 1.2e6;
+// What a build does in a second of one core, and its costs besides its parts' tests: fitted to
+// the builds of bench/notes/complexity-log.md (CSGs of 1, 4 and 12 quartics, the burr, the
+// Plate 3 hair; 16 and 64 sub-rays a pair; 2.5 GHz Xeon), every estimate within 25 % of the
+// CPU time measured (the burr's 19 % low: its thin rings' many bounding spheres).
+inline constexpr double kCoverageTestsPerCpuSecond = 1.0e8;
 inline constexpr double kSubRayOverheadTests = 1.0;
+inline constexpr double kPairOverheadRays = 8.0;
 // The estimated CPU seconds of one core for the build.
 double coverage_cpu_seconds(const TableContext& ctx);
 
