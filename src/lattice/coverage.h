@@ -87,8 +87,8 @@ CoverageWork coverage_work_parts(const TableContext& ctx);
 // What a build does in a second of one core, and its costs besides its parts' tests: fitted to
 // the builds of bench/notes/complexity-log.md (CSGs of 1, 4 and 12 quartics, the burr, the
 // Plate 3 hair; 16 and 64 sub-rays a pair; 2.5 GHz Xeon): within 25 % of the CPU time
-// measured but for the burr at its finest level, a third low (its thin rings' many bounding
-// spheres, each a shadow test a sub-ray).
+// measured (the burr 14 to 23 % low: its thin rings' many bounding spheres, each a shadow test
+// a sub-ray).
 inline constexpr double kCoverageTestsPerCpuSecond = 1.0e8;
 inline constexpr double kSubRayOverheadTests = 1.0;
 inline constexpr double kPairOverheadRays = 8.0;
