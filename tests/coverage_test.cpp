@@ -724,6 +724,51 @@ TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
         << l.notes[0];
 }
 
+// The budget is the render's: the levels of a second primitive wanting the same get only what
+// the first left (here nothing past the lattice asked for, which is read whatever it costs),
+// and its note says what the first spent.
+TEST(Coverage, TheWorkBudgetIsSharedByThePrimitives) {
+    std::string scene = near_and_far(true, true);
+    const std::string head = R"("primitives": {"bead": )";
+    const std::size_t from = scene.find(head) + head.size();
+    const std::size_t to = scene.find("},\n  \"objects\"");
+    ASSERT_NE(to, std::string::npos);
+    std::string second = scene.substr(from, to - from);
+    second.replace(second.find("0.3, \"minor"), 3, "0.29");  // another primitive
+    scene.insert(to, ", \"bead2\": " + second);
+    scene.insert(scene.rfind("}]") + 1,
+                 R"(, {"type": "instance", "primitive": "bead2", "material": "w"},
+              {"type": "instance", "primitive": "bead2", "transform": [{"translate": [0, 400, 0]}],
+               "material": "w"})");
+    test::TempDir dir;
+    const std::string path = (dir.path() / "two-rows.json").string();
+    std::ofstream(path) << scene;
+    const Scene s = load_scene(path);
+    ASSERT_EQ(s.primitives.size(), 2u);
+    const Shape& first = *s.primitives[0].shape;
+    const int rays = coverage_rays_for(first);
+    const double all = coverage_work({{2, 1, 2}, 1.0, 1.0, &first, rays}) +
+                       coverage_work({{4, 2, 4}, 0.5, 1.0, &first, rays}) +
+                       coverage_work({{8, 4, 8}, 0.25, 1.0, &first, rays});
+    const TableCache cache(dir.path().string());
+    TableSpec spec;
+    spec.encoding = "coverage";
+    const SceneLattices l = scene_lattices(
+        s, cache, spec, false,
+        {LatticeFilter::kSmooth, true, 0.01, kMaxLodPairs, all * 1.001, LatticePolicy::kTables});
+    ASSERT_EQ(l.answers.size(), 2u);
+    EXPECT_EQ(l.answers[0].sigma_inv, (std::vector<long long>{1, 2, 4}));
+    EXPECT_EQ(l.answers[1].sigma_inv, (std::vector<long long>{1}));
+    EXPECT_EQ(l.answers[1].coverage_rays, kCostlyRays);
+    ASSERT_EQ(l.notes.size(), 1u);
+    EXPECT_NE(l.notes[0].find("primitives.bead2"), std::string::npos) << l.notes[0];
+    EXPECT_NE(l.notes[0].find("of it spent on the primitives before"), std::string::npos)
+        << l.notes[0];
+    ASSERT_EQ(l.builds.size(), 4u);
+    EXPECT_EQ(l.builds[0].coverage_rays, kCostlyRays);
+    EXPECT_GT(l.builds[0].estimated_cpu_seconds, 0);
+}
+
 // Levels left out for their size (the pair budget) are said too, with what their rays read.
 TEST(Coverage, LevelsLeftOutForTheirSizeAreSaid) {
     test::TempDir dir;
