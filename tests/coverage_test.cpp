@@ -164,7 +164,8 @@ TEST(Coverage, GuessedSnapsAreSnaps) {
                 if (a == b || !BoundaryGrid::valid_pair(grid.faces(ga), grid.faces(gb))) continue;
                 const PairRays pr(grid, ga, gb);
                 for (int k = 0; k < kCoverageRays + 8; ++k) {
-                    const SubRay s = k < kCoverageRays ? coverage_ray(grid, ga, gb, k) : pr.ray(u(rng), u(rng));
+                    const SubRay s = k < kCoverageRays ? coverage_ray(grid, ga, gb, k, kCoverageRays)
+                                                        : pr.ray(u(rng), u(rng));
                     const PairRays::Snap g = pr.guess_snap(s);
                     if (g == PairRays::Snap::kUnsure) {
                         ++unsure;
@@ -681,8 +682,8 @@ TEST(Coverage, LevelsOfDetailStopAtThePairBudget) {
     }
 }
 
-// Past the work budget (LatticeFiltering::max_work: pairs times the primitive's cost, the time
-// of a build) a costly primitive answers by its own crossings, as a cheap one does (no tables;
+// Past the work budget (LatticeFiltering::max_work: the render's, spent by every level it
+// builds) a costly primitive answers by its own crossings, as a cheap one does (no tables;
 // each instance's sub-rays bounded), and says so: the level wanted, the one left out, and why.
 TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
     const std::string scene = near_and_far(true, true);
@@ -692,21 +693,32 @@ TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
     const Scene loaded = load_scene(path);
     const Shape& bead = *loaded.primitives[0].shape;
     ASSERT_GT(ShapeSource(bead).intersect_cost(), kMaxExactCost);  // its levels are tables
-    // The builds' work (a CSG tree: the pairs near its leaves) at sigma^-1 = 2 and 4.
-    const double w1 = coverage_work({{4, 2, 4}, 0.5, 1.0, &bead});
-    const double w2 = coverage_work({{8, 4, 8}, 0.25, 1.0, &bead});
-    ASSERT_LT(w2, static_cast<double>(BoundaryGrid::pair_count({8, 4, 8})) * ShapeSource(bead).intersect_cost());
+    // The builds' work (a CSG tree: the pairs near its leaves) at sigma^-1 = 1, 2 and 4.
+    const int rays = coverage_rays_for(bead);
+    const double w0 = coverage_work({{2, 1, 2}, 1.0, 1.0, &bead, rays});
+    const double w1 = coverage_work({{4, 2, 4}, 0.5, 1.0, &bead, rays});
+    const double w2 = coverage_work({{8, 4, 8}, 0.25, 1.0, &bead, rays});
+    ASSERT_LT(w2, static_cast<double>(BoundaryGrid::pair_count({8, 4, 8})) * rays *
+                      ShapeSource(bead).intersect_cost());
     ASSERT_GT(w2, w1);
-    for (const double budget : {w2, w2 * 0.99, w1 * 0.99, 0.0}) {
+    // Every level the render builds spends from the one budget: all three levels, the finest
+    // alone (which cannot pay for level 1 too, so level 0 goes with it), or none.
+    const double all = w0 + w1 + w2;
+    for (const double budget : {all, w0 + w2, w2 * 0.99, w1 * 0.99, 0.0}) {
         test::TempDir dir;
         const SceneLattices l = levels_for(dir, scene, kMaxLodPairs, budget);
-        const bool within = budget >= w2;
-        EXPECT_EQ(l.paths.size(), within ? 3u : 0u) << budget;
-        EXPECT_EQ(l.built, within ? 3 : 0) << budget;
+        const std::size_t levels = budget >= all ? 3u : budget >= w2 ? 1u : 0u;
+        EXPECT_EQ(l.paths.size(), levels) << budget;
+        EXPECT_EQ(l.built, static_cast<int>(levels)) << budget;
         for (const double widest : l.widest_footprints)
-            EXPECT_EQ(std::isfinite(widest), !within) << budget;
-        ASSERT_EQ(l.notes.size(), within ? 0u : 1u) << budget;
-        if (within) continue;
+            EXPECT_EQ(std::isfinite(widest), levels == 0) << budget;
+        ASSERT_EQ(l.notes.size(), levels == 3 ? 0u : 1u) << budget;
+        if (levels == 1) {
+            EXPECT_NE(l.notes[0].find("sigma^-1 = 2 is over --lod-budget and not in the cache"),
+                      std::string::npos)
+                << l.notes[0];
+        }
+        if (levels != 0) continue;
         // The finest level wanted, what it would take, and the budget that builds it.
         const std::string& note = l.notes[0];
         const auto minutes = static_cast<long long>(std::ceil(lod_minutes(w2)));
@@ -725,6 +737,51 @@ TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
     ASSERT_EQ(l.notes.size(), 1u);
     EXPECT_NE(l.notes[0].find("level of detail sigma^-1 = 4 wanted"), std::string::npos)
         << l.notes[0];
+}
+
+// The budget is the render's: the levels of a second primitive wanting the same get only what
+// the first left (here nothing past the lattice asked for, which is read whatever it costs),
+// and its note says what the first spent.
+TEST(Coverage, TheWorkBudgetIsSharedByThePrimitives) {
+    std::string scene = near_and_far(true, true);
+    const std::string head = R"("primitives": {"bead": )";
+    const std::size_t from = scene.find(head) + head.size();
+    const std::size_t to = scene.find("},\n  \"objects\"");
+    ASSERT_NE(to, std::string::npos);
+    std::string second = scene.substr(from, to - from);
+    second.replace(second.find("0.3, \"minor"), 3, "0.29");  // another primitive
+    scene.insert(to, ", \"bead2\": " + second);
+    scene.insert(scene.rfind("}]") + 1,
+                 R"(, {"type": "instance", "primitive": "bead2", "material": "w"},
+              {"type": "instance", "primitive": "bead2", "transform": [{"translate": [0, 400, 0]}],
+               "material": "w"})");
+    test::TempDir dir;
+    const std::string path = (dir.path() / "two-rows.json").string();
+    std::ofstream(path) << scene;
+    const Scene s = load_scene(path);
+    ASSERT_EQ(s.primitives.size(), 2u);
+    const Shape& first = *s.primitives[0].shape;
+    const int rays = coverage_rays_for(first);
+    const double all = coverage_work({{2, 1, 2}, 1.0, 1.0, &first, rays}) +
+                       coverage_work({{4, 2, 4}, 0.5, 1.0, &first, rays}) +
+                       coverage_work({{8, 4, 8}, 0.25, 1.0, &first, rays});
+    const TableCache cache(dir.path().string());
+    TableSpec spec;
+    spec.encoding = "coverage";
+    const SceneLattices l = scene_lattices(
+        s, cache, spec, false,
+        {LatticeFilter::kSmooth, true, 0.01, kMaxLodPairs, all * 1.001, LatticePolicy::kTables});
+    ASSERT_EQ(l.answers.size(), 2u);
+    EXPECT_EQ(l.answers[0].sigma_inv, (std::vector<long long>{1, 2, 4}));
+    EXPECT_EQ(l.answers[1].sigma_inv, (std::vector<long long>{1}));
+    EXPECT_EQ(l.answers[1].coverage_rays, kCostlyRays);
+    ASSERT_EQ(l.notes.size(), 1u);
+    EXPECT_NE(l.notes[0].find("primitives.bead2"), std::string::npos) << l.notes[0];
+    EXPECT_NE(l.notes[0].find("of it spent on the primitives before"), std::string::npos)
+        << l.notes[0];
+    ASSERT_EQ(l.builds.size(), 4u);
+    EXPECT_EQ(l.builds[0].coverage_rays, kCostlyRays);
+    EXPECT_GT(l.builds[0].estimated_cpu_seconds, 0);
 }
 
 // Levels left out for their size (the pair budget) are said too, with what their rays read.

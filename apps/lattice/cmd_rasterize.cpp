@@ -10,6 +10,7 @@
 #include "distributed/timeline.h"
 #include "lattice/cache/table_build.h"
 #include "lattice/cache/table_cache.h"
+#include "lattice/coverage.h"
 #include "scene/scene_loader.h"
 #include "util/error.h"
 #include "util/memory.h"
@@ -120,6 +121,15 @@ int run_rasterize(const RasterizeArgs& a) {
             for (const auto& rank : ranks) cpu += rank["build_cpu_seconds"].get<double>();
         }
         j["build_cpu_seconds"] = cpu;
+        // A prefiltered table: its sub-rays a pair, and what the level budget (render
+        // --lod-budget) estimated the build would take.
+        if (plan->encoding->coverage && plan->context.primitive) {
+            j["coverage_rays"] = plan->context.coverage_rays;
+            j["estimated_build_cpu_seconds"] = coverage_cpu_seconds(plan->context);
+            const CoverageWork w = coverage_work_parts(plan->context);
+            j["estimate_pairs"] = w.pairs;
+            j["estimate_part_tests"] = w.part_tests;
+        }
         write_json_file(a.stats, j);
     }
     return 0;

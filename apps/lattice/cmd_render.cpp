@@ -40,6 +40,14 @@ void print_summary(const RenderRequest& a, const Scene& scene, const ModeResult&
                      human_bytes(static_cast<double>(lattices.table_bytes)).c_str(),
                      std::to_string(lattices.table_entries).c_str(), lattices.built,
                      lattices.build_seconds, static_cast<unsigned long long>(st.count(stats::Counter::kLatticeVisits)));
+    for (const SceneLattices::Built& b : lattices.builds) {
+        std::string what = "lattice: built " + b.primitive + "'s table at sigma^-1 = " + std::to_string(b.sigma_inv);
+        if (b.coverage_rays > 0) what += ", " + std::to_string(b.coverage_rays) + " sub-rays a pair";
+        std::fprintf(stderr, "%s, in %.1f s", what.c_str(), b.seconds);
+        if (b.coverage_rays > 0)
+            std::fprintf(stderr, " (estimated %.1f minutes of one core)", b.estimated_cpu_seconds / 60);
+        std::fprintf(stderr, "\n");
+    }
     if (a.answers_instances() && lattices.answers.empty())
         std::fprintf(stderr, "lattice: note: the scene has no instances of a primitive: every object is traced exactly\n");
     for (const std::string& note : lattices.notes) std::fprintf(stderr, "lattice: note: %s\n", note.c_str());

@@ -4,12 +4,15 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
+#include <cassert>
 #include <cmath>
 #include <numeric>
 
 #include "geometry/chain.h"
 #include "geometry/lattice_source.h"
 #include "geometry/scratch_spans.h"
+#include "lattice/answer_plan.h"
 #include "lattice/face_cones.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/octahedral.h"
@@ -82,10 +85,11 @@ bool snaps_to(const LatticeFrame& frame, double h, const SubRay& s, std::uint32_
 // elsewhere, or they clip to other faces) are not the pair's rays, and are left out of its share.
 template <class List>
 CoverageSample sample_pair(const ShapeParts& shape, const LatticeFrame& frame, const BoundaryGrid& grid,
-                           double h, std::uint32_t a, std::uint32_t b, const List& parts) {
+                           double h, int rays, std::uint32_t a, std::uint32_t b,
+                           const List& parts) {
     const PairRays pr(grid, grid.point(a), grid.point(b));
     Tally n;
-    for (const auto& off : coverage_offsets()) {
+    for (const auto& off : coverage_offsets(rays)) {
         const SubRay s = pr.ray(off[0], off[1]);
         if (s.p == s.q || !snaps_to(frame, h, s, a, b)) continue;  // squeezed onto a box edge: no ray
         ++n.rays;
@@ -96,23 +100,33 @@ CoverageSample sample_pair(const ShapeParts& shape, const LatticeFrame& frame, c
 
 }  // namespace
 
-const std::array<std::array<double, 2>, kCoverageRays>& coverage_offsets() {
-    static const auto offsets = [] {
-        std::array<std::array<double, 2>, kCoverageRays> o{};
-        for (int i = 0; i < kCoverageRays; ++i) {
-            // Hammersley: i / n on one axis, the bit-reversed i on the other, cell-centred.
-            double r = 0, f = 0.5;
-            for (int k = i; k; k >>= 1, f *= 0.5) r += (k & 1) * f;
-            o[static_cast<std::size_t>(i)] = {(i + 0.5) / kCoverageRays - 0.5,
-                                              r + 0.5 / kCoverageRays - 0.5};
-        }
-        return o;
-    }();
-    return offsets;
+int coverage_rays_for(const Shape& primitive) {
+    return answered_by_primitive(primitive) ? kCoverageRays : kCostlyRays;
 }
 
-SubRay coverage_ray(const BoundaryGrid& grid, const GridPoint& p, const GridPoint& q, int k) {
-    const auto& off = coverage_offsets()[static_cast<std::size_t>(k)];
+bool valid_coverage_rays(int n) { return n >= 1 && n <= 1024 && std::has_single_bit(unsigned(n)); }
+
+const std::vector<std::array<double, 2>>& coverage_offsets(int n) {
+    assert(valid_coverage_rays(n));
+    // Every count's, made once (a build asks for them once a pair).
+    static const auto sets = [] {
+        std::array<std::vector<std::array<double, 2>>, 11> all;
+        for (std::size_t m = 0; m < all.size(); ++m) {
+            const int count = 1 << m;
+            for (int i = 0; i < count; ++i) {
+                // Hammersley: i / n on one axis, the bit-reversed i on the other, cell-centred.
+                double r = 0, f = 0.5;
+                for (int k = i; k; k >>= 1, f *= 0.5) r += (k & 1) * f;
+                all[m].push_back({(i + 0.5) / count - 0.5, r + 0.5 / count - 0.5});
+            }
+        }
+        return all;
+    }();
+    return sets[static_cast<std::size_t>(std::countr_zero(unsigned(n)))];
+}
+
+SubRay coverage_ray(const BoundaryGrid& grid, const GridPoint& p, const GridPoint& q, int k, int n) {
+    const auto& off = coverage_offsets(n)[static_cast<std::size_t>(k)];
     return coverage_ray(grid, p, q, off[0], off[1]);
 }
 
@@ -127,7 +141,7 @@ CoverageSample pair_coverage(const TableContext& ctx, std::uint32_t a, std::uint
     const ShapeParts parts(*ctx.primitive);
     std::vector<std::uint32_t> all(parts.part_count());
     std::iota(all.begin(), all.end(), 0u);
-    return sample_pair(parts, frame, grid, ctx.cell, a, b, all);
+    return sample_pair(parts, frame, grid, ctx.cell, ctx.coverage_rays, a, b, all);
 }
 
 namespace {
@@ -161,11 +175,12 @@ struct PairWork {
 
 class PairSampler {
 public:
-    // by_pieces: the lists of parts given to sample are of pieces (Pieces::piece_count), each
-    // culled by its spheres (capsules of length 0, shadows of their own).
+    // rays: sub-rays a pair. by_pieces: the lists of parts given to sample are of pieces
+    // (Pieces::piece_count), each culled by its spheres (capsules of length 0, shadows of their
+    // own).
     PairSampler(const ShapeSource& shape, const LatticeFrame& frame, const BoundaryGrid& grid,
-                double h, bool by_pieces)
-        : frame_(frame), grid_(grid), h_(h) {
+                double h, int rays, bool by_pieces)
+        : frame_(frame), grid_(grid), h_(h), offsets_(coverage_offsets(rays)) {
         if (by_pieces) {
             const auto& n = grid.cells();
             const Vec3 cells{double(n[0]), double(n[1]), double(n[2])};
@@ -196,7 +211,7 @@ public:
         if (!near_parts(pr, parts, near)) return summarise(grid_, a, b, {});
         shadows(pr, near, w.shadows);
         Tally n;
-        for (const auto& off : coverage_offsets()) {
+        for (const auto& off : offsets_) {
             const SubRay s = pr.ray(off[0], off[1]);
             if (s.p == s.q) continue;
             const PairRays::Snap g = pr.guess_snap(s);
@@ -223,6 +238,7 @@ private:
     const LatticeFrame& frame_;
     const BoundaryGrid& grid_;
     double h_;
+    const std::vector<std::array<double, 2>>& offsets_;
     std::vector<Capsule> capsules_;  // per part, lattice units; empty when the shape has none
     // By pieces: piece i's capsules are [piece_first_[i], piece_first_[i + 1]) (else empty).
     std::vector<std::size_t> piece_first_;
@@ -351,7 +367,7 @@ std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool pro
     const PairCuller culler(ctx);
     const BoundaryGrid& grid = culler.grid();
     const LatticeFrame frame(ctx, kInfinity);
-    const PairSampler sampler(shape, frame, grid, ctx.cell, culler.by_pieces());
+    const PairSampler sampler(shape, frame, grid, ctx.cell, ctx.coverage_rays, culler.by_pieces());
     // Chains (the common primitive) are traced through their concrete type, without virtual
     // calls in the innermost loop.
     const ChainShape* chain = as_chain(shape.shape());
@@ -388,28 +404,41 @@ std::vector<CoverageSample> rasterize_coverage(const TableContext& ctx, bool pro
     return all;
 }
 
-double coverage_work(const TableContext& ctx) {
+CoverageWork coverage_work_parts(const TableContext& ctx) {
     const ShapeSource shape(*ctx.primitive);
-    const double cost = std::max(1.0, shape.intersect_cost());
-    const double all_pairs = static_cast<double>(BoundaryGrid::pair_count(ctx.cells));
     const PairCuller culler(ctx);
-    if (!culler.by_pieces()) return all_pairs * cost;
-    // A pair's sub-rays evaluate the leaves kept for it: about their share of the tree's cost.
-    // Counted on about kSampled entry points spread evenly: the culling alone, a tenth of a second
-    // at sigma^-1 = 4 for the burr of the costly-primitive bench (every eighth point took a
-    // second, for an estimate 15 % higher).
-    constexpr std::uint32_t kSampled = 64;
+    // A part costs its share of the primitive's cost, at least one simple test (a chain's
+    // sphere or cylinder, a mesh's triangle; a CSG tree's leaf, a quartic about 12).
+    const double parts = culler.by_pieces() ? static_cast<double>(shape.piece_count())
+                                            : static_cast<double>(shape.parts().part_count());
+    const double per_part = std::max(1.0, shape.intersect_cost() / std::max(1.0, parts));
+    // Counted on about kSampled entry points spread evenly: the culling alone, under half a
+    // second at sigma^-1 = 4 for the burr of the costly-primitive bench. 64 points read its
+    // work 13 % low there; 256 and 512 gave the same.
+    constexpr std::uint32_t kSampled = 256;
     const std::uint32_t npoints = culler.grid().count();
-    const std::uint32_t kStride = std::max<std::uint32_t>(1, npoints / kSampled);
+    const std::uint32_t stride = std::max<std::uint32_t>(1, npoints / kSampled);
     Scratch s;
-    double pieces = 0;
+    CoverageWork w;
     std::uint32_t sampled = 0;
-    for (std::uint32_t a = 0; a < npoints; a += kStride, ++sampled)
-        culler.pairs(a, s, [&](std::uint32_t, const std::vector<std::uint32_t>& parts) {
-            pieces += static_cast<double>(parts.size());
+    for (std::uint32_t a = 0; a < npoints; a += stride, ++sampled)
+        culler.pairs(a, s, [&](std::uint32_t, const std::vector<std::uint32_t>& near) {
+            w.pairs += 1;
+            w.part_tests += static_cast<double>(near.size()) * per_part;
         });
-    const double per_entry = pieces / std::max<std::uint32_t>(1, sampled);
-    return per_entry * npoints * cost / static_cast<double>(shape.piece_count());
+    const double scale = static_cast<double>(npoints) / std::max<std::uint32_t>(1, sampled);
+    w.pairs *= scale;
+    w.part_tests *= scale;
+    return w;
+}
+
+double coverage_work(const TableContext& ctx) {
+    const CoverageWork w = coverage_work_parts(ctx);
+    return (ctx.coverage_rays + kPairOverheadRays) * (w.pairs * kSubRayOverheadTests + w.part_tests);
+}
+
+double coverage_cpu_seconds(const TableContext& ctx) {
+    return coverage_work(ctx) / kCoverageTestsPerCpuSecond;
 }
 
 }  // namespace lat

@@ -64,11 +64,20 @@ struct RawHits {
 // The lattice a table is for, at its refinement, and the primitive: what rasterizing, building,
 // opening and tracing a table need besides its payload (encodings that intersect the primitive
 // exactly, or re-evaluate its normals, use it). Derived once from a table's header.
+// Sub-rays a pair of a prefiltered table is sampled with (lattice/coverage.h), unless its
+// primitive is costly to intersect (coverage_rays_for, the one place that chooses).
+inline constexpr int kCoverageRays = 64;
+// A count that any prefiltered payload satisfies: a table opened on its own, whose payload says.
+inline constexpr int kAnyCoverageRays = 0;
+
 struct TableContext {
     std::array<int, 3> cells{};  // at the refinement
     double cell = 1;             // primitive units per lattice unit (sigma / sigma^-1)
     double sigma = 1;            // the primitive's own grid spacing
     const Shape* primitive = nullptr;
+    // Prefiltered tables: the sub-rays a pair is sampled with when building, and required of
+    // the payload when opening (kAnyCoverageRays: whatever it records).
+    int coverage_rays = kCoverageRays;
 };
 
 // The one range of sigma^-1, the refinement of a lattice, for requests and for table files.

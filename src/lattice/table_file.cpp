@@ -113,6 +113,7 @@ TableHeader decode_header(const std::uint8_t* b, std::size_t file_size, const st
     for (char& c : enc) c = r.get<char>();
     enc[15] = 0;
     TableHeader h;
+    h.coverage_rays = kAnyCoverageRays;
     h.encoding = enc;
     for (int& c : h.cells) c = r.get<std::int32_t>();
     h.sigma_inv = r.get<std::int32_t>();
@@ -273,6 +274,7 @@ LoadedTable load_table_file(const std::string& path, const TableHeader* expected
         if (h.fingerprint != expected->fingerprint)
             throw InputError(path + ": lattice table was built for another primitive "
                              "(its geometry fingerprint differs); rebuild it");
+        h.coverage_rays = expected->coverage_rays;  // which the payload must have
     }
     const std::uint8_t* payload = bytes + kTableHeaderBytes;
     const std::uint8_t* meta = payload + h.payload_bytes;

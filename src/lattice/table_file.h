@@ -33,8 +33,14 @@ struct TableHeader {
     // JSON, after the payload: the primitive's name and definition and the scene it came from,
     // so that a table file can be inspected on its own.
     std::string metadata;
+    // Prefiltered encodings: the sub-rays a pair (TableContext::coverage_rays). Not a field of
+    // the file's header: the payload records it and the fingerprint includes it, so a header
+    // read from a file says kAnyCoverageRays.
+    int coverage_rays = kCoverageRays;
 
-    TableContext context(const Shape* primitive) const { return {cells, cell, sigma, primitive}; }
+    TableContext context(const Shape* primitive) const {
+        return {cells, cell, sigma, primitive, coverage_rays};
+    }
     // "hash14, 28 x 12 x 28 cells (sigma 0.1, sigma^-1 4)", for messages.
     std::string describe() const;
 };

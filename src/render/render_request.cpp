@@ -169,10 +169,12 @@ std::vector<OptionEntry<RenderRequest>> make_render_entries() {
                  [](RenderRequest& r) { return OptionField{&r.lod}; }, OptionCheck::one_of(keys(kOnOff)), tables});
     e.push_back({"--lod-budget",
                  "lattice and auto modes, --lod on: levels of detail beyond K are built only "
-                 "if each takes at most about this many minutes of one core (estimated from "
-                 "its pairs and the primitive's cost); past it lattice mode reads the finest "
-                 "level within it and auto mode answers the primitive by its sub-rays, and the "
-                 "summary says so. A level in the cache is read whatever the budget",
+                 "while all the tables the render builds take at most about this many minutes "
+                 "of one core together (estimated from the sub-rays each build traces near the "
+                 "primitive's parts; 10 minutes are about 5 on 2 cores); past it lattice mode "
+                 "reads the finest level within it and auto mode answers the primitive by its "
+                 "sub-rays, and the summary says so. A level in the cache is read whatever the "
+                 "budget, and costs none of it",
                  [](RenderRequest& r) { return OptionField{&r.lod_budget}; },
                  OptionCheck::by_text(minutes_check), tables});
     e.back().show_default = true;
@@ -359,6 +361,7 @@ std::string answer_text(const PrimitiveAnswer& p, LatticeFilter filter) {
             text = std::string(filter == LatticeFilter::kBox ? "box" : "smooth") + "-filtered " +
                    p.encoding + " table" + (p.sigma_inv.size() == 1 ? ", " : "s, ") +
                    levels_text(p.sigma_inv);
+            if (p.coverage_rays > 0) text += ", " + std::to_string(p.coverage_rays) + " sub-rays a pair";
             break;
         case AnsweredBy::kSubRayCrossings:
             text = "its own crossings of " + std::to_string(kExactSubRays) + " x " +

@@ -25,6 +25,7 @@ nlohmann::json answers_json(const RenderRequest& a, const SceneLattices& lattice
         if (!p.encoding.empty()) e["encoding"] = p.encoding;
         if (p.by == AnsweredBy::kFilteredTables) e["filter"] = a.filter;
         if (!p.sigma_inv.empty()) e["sigma_inv"] = p.sigma_inv;
+        if (p.coverage_rays > 0) e["coverage_rays"] = p.coverage_rays;
         if (p.by == AnsweredBy::kSubRayCrossings) e["sub_rays"] = kSubRays;
         if (!p.why.empty()) e["why"] = p.why;
         list.push_back(std::move(e));
@@ -77,6 +78,16 @@ nlohmann::json render_stats_json(const RenderRequest& a, const Scene& scene, con
         j["lattice_notes"] = lattices.notes;
         j["tables_ms"] = r.prepare_ms;
         j["tables_built"] = lattices.built;
+        nlohmann::json builds = nlohmann::json::array();
+        for (const SceneLattices::Built& b : lattices.builds) {
+            nlohmann::json e{{"primitive", b.primitive}, {"sigma_inv", b.sigma_inv}, {"seconds", b.seconds}};
+            if (b.coverage_rays > 0) {
+                e["coverage_rays"] = b.coverage_rays;
+                e["estimated_cpu_seconds"] = b.estimated_cpu_seconds;
+            }
+            builds.push_back(std::move(e));
+        }
+        j["tables_built_list"] = builds;
         j["table_bytes"] = lattices.table_bytes;
         j["table_entries"] = lattices.table_entries;
         j["table_files"] = lattices.paths;

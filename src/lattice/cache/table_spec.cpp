@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "lattice/coverage.h"
 #include "util/error.h"
 #include "util/hash.h"
 
@@ -61,6 +62,10 @@ TablePlan plan_table(const Primitive& p, const TableSpec& spec, const std::strin
     // Layout 1 is left out: the tables of the encodings whose payload never changed keep their
     // names.
     if (plan.encoding->layout != 1) f.add(plan.encoding->layout);
+    // A prefiltered table's sub-rays a pair: tables of different counts never share a name. The
+    // usual count is left out, so that the tables sampled with it keep theirs.
+    if (plan.encoding->coverage && p.shape) h.coverage_rays = coverage_rays_for(*p.shape);
+    if (h.coverage_rays != kCoverageRays) f.add(std::string("coverage rays")).add(h.coverage_rays);
     h.fingerprint = f.value();
     h.metadata = nlohmann::json{{"primitive", p.name},
                                 {"definition", nlohmann::json::parse(p.definition)},

@@ -75,28 +75,37 @@ struct LevelCosts {
 // pair budget (memory), and the finest affordable (time): within the work budget, or cached
 // already (the budget bounds what a render builds, not what it reads). Level 0, the lattice
 // asked for, is read whatever its size.
+// The budget is the render's (kLodBudgetMinutes): left is what the primitives before have not
+// spent, and the levels chosen spend from it, finest first.
 struct LevelChoice {
     std::pair<int, int> range;
     int fitting = 0;           // the finest level wanted within the size limits
     bool over_budget = false;  // range.second < fitting: a finer level past the work budget
+    double spent_before = 0;   // of the budget, by the primitives before
 };
 LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pair<int, int> wanted,
-                          const LatticeFiltering& filtering) {
+                          const LatticeFiltering& filtering, double& left) {
     const auto fits = [&](int j) {
         return c.sigma_inv(j) <= kMaxSigmaInv && c.pairs(j) <= filtering.max_pairs;
     };
-    const auto affordable = [&](int j) {
-        return j == 0 || c.work(j) <= filtering.max_work ||
-               cache.cached(level_plan(c.scene, c.p, c.spec, j));
+    // What building level j would spend: nothing when it is cached.
+    const auto cost = [&](int j) {
+        return cache.cached(level_plan(c.scene, c.p, c.spec, j)) ? 0.0 : c.work(j);
     };
+    // Level 0, the lattice asked for, is read whatever it costs.
+    const auto affordable = [&](int j) {
+        const double w = cost(j);
+        return j == 0 || w == 0 || w <= left;
+    };
+    const double spent_before = filtering.max_work - left;
     int fitting = 0;
     while (fitting < wanted.second && fits(fitting + 1)) ++fitting;
     int finest = fitting;
     while (!affordable(finest)) --finest;
-    int first = std::min(wanted.first, finest);
-    for (int j = finest; j > first; --j)
-        if (!affordable(j - 1)) first = j;
-    return {{first, finest}, fitting, finest < fitting};
+    left -= cost(finest);
+    int first = finest;
+    while (first > std::min(wanted.first, finest) && affordable(first - 1)) left -= cost(--first);
+    return {{first, finest}, fitting, finest < fitting, spent_before};
 }
 
 // What the user should know of a choice that leaves out levels wanted: which, why, and what
@@ -112,10 +121,12 @@ std::string levels_note(const LevelCosts& c, std::pair<int, int> wanted, const L
     std::string why, instead = "rays that want finer read " + c.name(finest);
     if (ch.over_budget) {
         const double minutes = lod_minutes(c.work(ch.fitting));
+        const double spent = lod_minutes(ch.spent_before);
         why = c.name(ch.fitting) + " would take about " + number(minutes) +
               " minutes of one core to build, over --lod-budget " +
-              number(lod_minutes(filtering.max_work)) + " (--lod-budget " +
-              std::to_string(static_cast<long long>(std::ceil(minutes))) +
+              number(lod_minutes(filtering.max_work)) +
+              (spent > 0 ? " (" + number(spent) + " of it spent on the primitives before)" : "") +
+              " (--lod-budget " + std::to_string(static_cast<long long>(std::ceil(minutes + spent))) +
               " builds it once, for every later render)";
     } else if (finest < wanted.second && c.sigma_inv(finest + 1) > kMaxSigmaInv) {
         why = c.name(finest + 1) + " is past the largest, " + std::to_string(kMaxSigmaInv);
@@ -158,11 +169,18 @@ double sub_ray_bounds(const Scene& scene, int prim, const TableContext& base, do
 std::shared_ptr<const LatticeTable> read_table(const TableCache& cache, const TablePlan& plan,
                                                bool progress, SceneLattices& out,
                                                PrimitiveAnswer& answer) {
+    const bool coverage = plan.encoding->coverage && plan.context.primitive;
+    const double estimate =
+        coverage && !cache.cached(plan) ? coverage_cpu_seconds(plan.context) : 0.0;
     const TableCache::Entry e = cache.get(plan, progress);
     out.table_bytes += e.bytes;
     out.table_entries += e.table->entries();
     out.built += e.built ? 1 : 0;
     out.build_seconds += e.build_seconds;
+    if (e.built)
+        out.builds.push_back({plan.primitive->name, plan.header.sigma_inv,
+                              coverage ? plan.context.coverage_rays : 0, e.build_seconds, estimate});
+    if (coverage) answer.coverage_rays = plan.context.coverage_rays;
     out.paths.push_back(e.path);
     answer.sigma_inv.push_back(std::llround(plan.context.sigma / plan.context.cell));
     return e.table;
@@ -178,15 +196,15 @@ std::shared_ptr<const LatticeTable> read_table(const TableCache& cache, const Ta
 // (AccelObject::widest_footprint); the shape's own bound is the widest over its instances.
 void filtered_lattice(const Scene& scene, int prim, const TableCache* cache, const TableSpec& spec,
                       bool progress, const LatticeFiltering& filtering, const TableContext& base,
-                      const AnswerQuery& q, AnswerPlan plan, SceneLattices& out,
-                      PrimitiveAnswer& answer) {
+                      const AnswerQuery& q, AnswerPlan plan, double& budget_left,
+                      SceneLattices& out, PrimitiveAnswer& answer) {
     const Primitive& p = scene.primitives[static_cast<std::size_t>(prim)];
     std::pair<int, int> range{0, 0};
     if (q.lod && plan.by == AnsweredBy::kFilteredTables) {
         const LevelCosts costs{scene, p, spec};
         const std::pair<int, int> wanted = lod_range(scene, prim, base, filtering.spread);
         assert(cache);  // every policy but kFootprint reads tables
-        const LevelChoice choice = choose_levels(costs, *cache, wanted, filtering);
+        const LevelChoice choice = choose_levels(costs, *cache, wanted, filtering, budget_left);
         if (choice.over_budget) plan_past_budget(q, base.primitive, plan);
         const bool by_crossings = plan.by == AnsweredBy::kSubRayCrossings;
         if (!by_crossings) range = choice.range;
@@ -266,6 +284,7 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const 
         throw InputError("--filter: filtered lattices need a table encoding that stores coverage "
                          "(--encoding coverage), not '" + spec.encoding + "'");
     assert(sub_rays || cache);
+    double budget_left = filtering.max_work;  // the render's, spent by the levels built
     for (std::size_t i = 0; i < scene.primitives.size(); ++i) {
         if (!used[i]) continue;
         const Primitive& p = scene.primitives[i];
@@ -285,7 +304,7 @@ SceneLattices scene_lattices(const Scene& scene, const TableCache* cache, const 
             answer.why = how.why;
         } else if (how.by != AnsweredBy::kTable) {
             filtered_lattice(scene, static_cast<int>(i), cache, spec, progress, filtering, base, q,
-                             how, out, answer);
+                             how, budget_left, out, answer);
         } else {
             const TablePlan plan = plan_table(p, spec, scene.file);
             answer.encoding = spec.encoding;

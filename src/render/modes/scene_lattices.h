@@ -8,6 +8,7 @@
 
 #include "lattice/cache/table_cache.h"
 #include "lattice/answer_plan.h"
+#include "lattice/coverage.h"
 #include "scene/scene.h"
 
 namespace lat {
@@ -19,6 +20,7 @@ struct PrimitiveAnswer {
     AnsweredBy by = AnsweredBy::kTable;
     std::string encoding;              // of the tables read; empty for sub-rays
     std::vector<long long> sigma_inv;  // the levels read, coarse to fine; empty for sub-rays
+    int coverage_rays = 0;             // of its filtered tables, sub-rays a pair; else 0
     std::string why;                   // how the mode chose (auto mode), else empty
 };
 
@@ -32,6 +34,15 @@ struct SceneLattices {
     std::uint64_t table_entries = 0;
     int built = 0;
     double build_seconds = 0;
+    // Each table built, for the summary line and --stats.
+    struct Built {
+        std::string primitive;
+        long long sigma_inv = 0;
+        int coverage_rays = 0;  // prefiltered tables; else 0
+        double seconds = 0;
+        double estimated_cpu_seconds = 0;  // the level budget's estimate (prefiltered tables)
+    };
+    std::vector<Built> builds;
     std::vector<std::string> paths;
     std::vector<PrimitiveAnswer> answers;  // per instanced primitive, in scene order
     // What the user should know about the lattices chosen: levels of detail left out for a
@@ -51,21 +62,19 @@ struct SceneLattices {
 // of 16 x 16 x 8 cells (`lattice-rings`, before its torus was answered by its crossings) stopped
 // at 2K (17 M pairs; 4K, 268 M pairs, was still building after 7 minutes in 5 GB).
 inline constexpr double kMaxLodPairs = 134217728.0;
-// They are also built only up to a work budget (LatticeFiltering::max_work) of pair tests: pairs
-// times the primitive's intersect_cost, the work of a coverage build, whose sub-rays each pay
-// about the whole cost for a primitive without parts to cull (a mesh costlier than
-// kMaxExactCost); a CSG tree's sub-rays evaluate only the leaves near them, and its pairs are
-// weighed by the share of its leaves near them (coverage_work). A build does about
-// kPairTestsPerCpuSecond (`ball-csg7`, 73 simple tests, every leaf evaluated: 12.1, 150 and
-// 1900 CPU seconds at sigma^-1 = 1, 2 and 4; 2.5 GHz Xeon, 2026-11-27; culled by its leaves,
-// 5.1, 65 and 930 CPU seconds, its 4K level estimated at 11 minutes, 2026-11-29), so the default
-// budget is a quarter of an hour of one core (`render --lod-budget`). A level in the cache is
-// read whatever the budget.
-inline constexpr double kPairTestsPerCpuSecond = 1.2e6;
-inline constexpr double kLodBudgetMinutes = 15;
+// They are also built only within a work budget (LatticeFiltering::max_work) of simple tests,
+// the coverage builds' estimate (lattice/coverage.h: coverage_work, which counts the table's
+// sub-rays a pair and is calibrated in CPU seconds by kCoverageTestsPerCpuSecond), so that the
+// budget is minutes of one core (`render --lod-budget`). The budget is the render's: every
+// level it builds, of every primitive (in scene order), the lattice asked for included, spends
+// from it; a level in the cache is read whatever the budget, and costs nothing. Ten minutes of
+// one core: a cold render builds for at most about 5 minutes on 2 cores (the builds keep both
+// busy). The levels of the benchmarks' fur take seconds to a minute; a CSG of quartics at 512^2
+// (the burr, 16 sub-rays a pair) about 5 minutes at its finest level.
+inline constexpr double kLodBudgetMinutes = 10;
 // The work budget of so many minutes of one core, and back.
-constexpr double lod_work(double minutes) { return minutes * 60 * kPairTestsPerCpuSecond; }
-constexpr double lod_minutes(double work) { return work / (60 * kPairTestsPerCpuSecond); }
+constexpr double lod_work(double minutes) { return minutes * 60 * kCoverageTestsPerCpuSecond; }
+constexpr double lod_minutes(double work) { return work / (60 * kCoverageTestsPerCpuSecond); }
 inline constexpr double kMaxLodWork = lod_work(kLodBudgetMinutes);
 struct LatticeFiltering {
     LatticeFilter filter = LatticeFilter::kNone;

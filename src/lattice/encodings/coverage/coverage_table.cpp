@@ -127,7 +127,8 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
     const Sections s = sections(index.slots(), groups);
     ByteBuffer out(s.total);
     std::memset(out.data(), 0, s.total);
-    const Header h{kMagic, index.grid().count(), kCoverageRays, entries.size(), centers,
+    const Header h{kMagic, index.grid().count(), static_cast<std::uint32_t>(ctx.coverage_rays),
+                   entries.size(), centers,
                    index.slots(), groups, {}};
     std::memcpy(out.data(), &h, sizeof h);
     auto* kept = reinterpret_cast<std::uint64_t*>(out.data() + s.kept);
@@ -163,7 +164,13 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
     if (h.magic != kMagic) fail("bad tag");
     if (h.points != index_.grid().count()) fail("boundary point count differs from the lattice's");
     if (h.slots != index_.slots()) fail("slot count differs from the lattice's");
-    if (h.rays != kCoverageRays) fail("sampled with a different number of sub-rays");
+    if (h.rays > 1024 || !valid_coverage_rays(static_cast<int>(h.rays)))
+        fail("its count of sub-rays a pair is not a power of two up to 1024");
+    if (ctx.coverage_rays != kAnyCoverageRays && h.rays != static_cast<std::uint32_t>(ctx.coverage_rays))
+        throw std::runtime_error("coverage payload: sampled with " + std::to_string(h.rays) +
+                                 " sub-rays a pair where " + std::to_string(ctx.coverage_rays) +
+                                 " are asked for; rebuild it");
+    rays_ = static_cast<int>(h.rays);
     if (h.center_hits != entries || h.occupied < entries || h.occupied > (std::uint64_t{1} << 40))
         fail("record counts inconsistent with the header");
     if (h.groups > h.occupied) fail("more kept groups than stored pairs");
@@ -297,7 +304,7 @@ std::string CoverageTable::details() const {
                   "pairs partly covered (0 < alpha < 1), %.0f pairs' worth in all, %.3f records "
                   "per hit",
                   static_cast<unsigned long long>(occupied_),
-                  static_cast<unsigned long long>(kept_groups_), kCoverageRays,
+                  static_cast<unsigned long long>(kept_groups_), rays_,
                   static_cast<unsigned long long>(partial_), alpha_sum_,
                   entries_ ? double(occupied_) / double(entries_) : 0.0);
     return buf;

@@ -68,6 +68,7 @@ private:
     const std::uint8_t* covers_ = nullptr;  // kGroupSlots coverage records a kept group
     const std::uint8_t* hits_ = nullptr;    // kGroupSlots hit records a kept group
     std::uint64_t occupied_ = 0, kept_groups_ = 0;
+    int rays_ = 0;  // sub-rays a pair
     std::uint64_t entries_;
     std::size_t size_;  // the payload's and the rank lines'
     // Coverage statistics for `inspect`, gathered when the records are checked at open.
