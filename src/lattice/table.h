@@ -61,15 +61,15 @@ struct RawHits {
     }
 };
 
-// The lattice a table is for, at its refinement, and the primitive: what rasterizing, building,
-// opening and tracing a table need besides its payload (encodings that intersect the primitive
-// exactly, or re-evaluate its normals, use it). Derived once from a table's header.
 // Sub-rays a pair of a prefiltered table is sampled with (lattice/coverage.h), unless its
 // primitive is costly to intersect (coverage_rays_for, the one place that chooses).
 inline constexpr int kCoverageRays = 64;
 // A count that any prefiltered payload satisfies: a table opened on its own, whose payload says.
 inline constexpr int kAnyCoverageRays = 0;
 
+// The lattice a table is for, at its refinement, and the primitive: what rasterizing, building,
+// opening and tracing a table need besides its payload (encodings that intersect the primitive
+// exactly, or re-evaluate its normals, use it). Derived once from a table's header.
 struct TableContext {
     std::array<int, 3> cells{};  // at the refinement
     double cell = 1;             // primitive units per lattice unit (sigma / sigma^-1)
