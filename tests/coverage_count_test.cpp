@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 
+#include "coverage_checks.h"
 #include "hook_primitive.h"
 #include "lattice/cache/table_build.h"
 #include "lattice/cache/table_cache.h"
@@ -75,21 +76,13 @@ TEST(CoverageCount, SixteenSubRaysBuildAsTheDefinition) {
 TEST(CoverageCount, ATableOfSixteenIsReadBack) {
     TableContext ctx = test::kHookContext;
     ctx.coverage_rays = 16;
-    const Encoding& e = find_encoding("coverage");
-    const RasterizeResult r = rasterize(ctx);
-    const ByteBuffer payload = e.build(r.raw, ctx, {});
-    const auto table = e.open(payload.data(), payload.size(), r.hits, ctx);
-    for (const CoverageSample& c : rasterize_coverage(ctx, false)) {
-        CoverageHit h;
-        ASSERT_TRUE(table->coverage(c.a, c.b, h));
-        EXPECT_NEAR(h.alpha, c.alpha, 1e-4);
-        EXPECT_NEAR(h.t, c.t, 1e-4);
-    }
-    EXPECT_NE(table->details().find("16 sub-rays a pair"), std::string::npos) << table->details();
+    const test::BuiltCoverageTable b = test::expect_table_answers_coverage(ctx);
+    EXPECT_NE(b.table->details().find("16 sub-rays a pair"), std::string::npos) << b.table->details();
     // Opened on its own (inspect), whatever it records is its count.
     TableContext any = ctx;
     any.coverage_rays = kAnyCoverageRays;
-    EXPECT_NE(e.open(payload.data(), payload.size(), r.hits, any)->details().find("16 sub-rays"),
+    const Encoding& e = find_encoding("coverage");
+    EXPECT_NE(e.open(b.payload.data(), b.payload.size(), b.rasterized.hits, any)->details().find("16 sub-rays"),
               std::string::npos);
 }
 

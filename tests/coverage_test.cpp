@@ -15,6 +15,7 @@
 #include "geometry/lattice_source.h"
 #include "geometry/named_shapes.h"
 #include "geometry/sphere.h"
+#include "coverage_checks.h"
 #include "hook_primitive.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/coverage.h"
@@ -183,18 +184,9 @@ TEST(Coverage, GuessedSnapsAreSnaps) {
 }
 
 TEST(Coverage, TheTableAnswersTheCoverage) {
-    const Encoding& e = find_encoding("coverage");
-    ASSERT_TRUE(e.coverage);
-    const RasterizeResult r = rasterize(kContext);
-    const ByteBuffer payload = e.build(r.raw, kContext, {});
-    const auto table = e.open(payload.data(), payload.size(), r.hits, kContext);
-    for (const CoverageSample& c : rasterize_coverage(kContext, false)) {
-        CoverageHit h;
-        ASSERT_TRUE(table->coverage(c.a, c.b, h));
-        EXPECT_NEAR(h.alpha, c.alpha, 1e-4);
-        EXPECT_NEAR(h.t, c.t, 1e-4);
-    }
-    EXPECT_NE(table->details().find("partly covered"), std::string::npos);
+    ASSERT_TRUE(find_encoding("coverage").coverage);
+    const test::BuiltCoverageTable b = test::expect_table_answers_coverage(kContext);
+    EXPECT_NE(b.table->details().find("partly covered"), std::string::npos);
 }
 
 // The lookups the smooth filter makes (coverage_many: locate_coverage, then coverage_at, as the
