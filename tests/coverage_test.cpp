@@ -731,32 +731,42 @@ TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
         << l.notes[0];
 }
 
-// The budget is the render's: the levels of a second primitive wanting the same get only what
-// the first left (here nothing past the lattice asked for, which is read whatever it costs),
-// and its note says what the first spent.
-TEST(Coverage, TheWorkBudgetIsSharedByThePrimitives) {
+// The near-and-far scene with a second primitive, bead2, of tube radius `minor2` (the first's
+// 0.3), placed as the first is.
+std::string two_primitives(const std::string& minor2) {
     std::string scene = near_and_far(true, true);
     const std::string head = R"("primitives": {"bead": )";
     const std::size_t from = scene.find(head) + head.size();
     const std::size_t to = scene.find("},\n  \"objects\"");
-    ASSERT_NE(to, std::string::npos);
+    EXPECT_NE(to, std::string::npos);
     std::string second = scene.substr(from, to - from);
-    second.replace(second.find("0.3, \"minor"), 3, "0.29");  // another primitive
+    second.replace(second.find("0.3, \"minor"), 3, minor2);
     scene.insert(to, ", \"bead2\": " + second);
     scene.insert(scene.rfind("}]") + 1,
                  R"(, {"type": "instance", "primitive": "bead2", "material": "w"},
               {"type": "instance", "primitive": "bead2", "transform": [{"translate": [0, 400, 0]}],
                "material": "w"})");
+    return scene;
+}
+
+// The builds' work of a primitive's three levels, sigma^-1 = 1, 2 and 4.
+double three_levels_work(const Shape& bead) {
+    const int rays = coverage_rays_for(bead);
+    return coverage_work({{2, 1, 2}, 1.0, 1.0, &bead, rays}) +
+           coverage_work({{4, 2, 4}, 0.5, 1.0, &bead, rays}) +
+           coverage_work({{8, 4, 8}, 0.25, 1.0, &bead, rays});
+}
+
+// The budget is the render's: the levels of a second primitive wanting the same get only what
+// the first left (here nothing past the lattice asked for, which is read whatever it costs),
+// and its note says what the first spent.
+TEST(Coverage, TheWorkBudgetIsSharedByThePrimitives) {
     test::TempDir dir;
     const std::string path = (dir.path() / "two-rows.json").string();
-    std::ofstream(path) << scene;
+    std::ofstream(path) << two_primitives("0.29");
     const Scene s = load_scene(path);
     ASSERT_EQ(s.primitives.size(), 2u);
-    const Shape& first = *s.primitives[0].shape;
-    const int rays = coverage_rays_for(first);
-    const double all = coverage_work({{2, 1, 2}, 1.0, 1.0, &first, rays}) +
-                       coverage_work({{4, 2, 4}, 0.5, 1.0, &first, rays}) +
-                       coverage_work({{8, 4, 8}, 0.25, 1.0, &first, rays});
+    const double all = three_levels_work(*s.primitives[0].shape);
     const TableCache cache(dir.path().string());
     TableSpec spec;
     spec.encoding = "coverage";
@@ -774,6 +784,36 @@ TEST(Coverage, TheWorkBudgetIsSharedByThePrimitives) {
     ASSERT_EQ(l.builds.size(), 4u);
     EXPECT_EQ(l.builds[0].coverage_rays, kCostlyRays);
     EXPECT_GT(l.builds[0].estimated_cpu_seconds, 0);
+}
+
+// In auto mode a primitive over the budget answers by its crossings and builds nothing, so it
+// spends nothing: a second, smaller primitive gets the whole budget for its finest level, which
+// it could not afford had the first spent on the coarser levels it left unread.
+TEST(Coverage, APrimitiveAnsweredByItsCrossingsSpendsNoBudget) {
+    test::TempDir dir;
+    const std::string path = (dir.path() / "two-rows.json").string();
+    std::ofstream(path) << two_primitives("0.1");
+    const Scene s = load_scene(path);
+    ASSERT_EQ(s.primitives.size(), 2u);
+    const auto work = [&](std::size_t prim, int level) {
+        const Shape& shape = *s.primitives[prim].shape;
+        const int n = 2 << level;
+        return coverage_work({{n, n / 2, n}, 1.0 / (1 << level), 1.0, &shape, coverage_rays_for(shape)});
+    };
+    const double budget = 0.99 * work(0, 2);  // the first's finest level is over it
+    ASSERT_LT(work(1, 2), budget);
+    ASSERT_GT(work(1, 2), budget - work(0, 0) - work(0, 1));
+    const TableCache cache(dir.path().string());
+    TableSpec spec;
+    spec.encoding = "coverage";
+    const SceneLattices l = scene_lattices(
+        s, cache, spec, false,
+        {LatticeFilter::kSmooth, true, 0.01, kMaxLodPairs, budget, LatticePolicy::kAuto});
+    ASSERT_EQ(l.answers.size(), 2u);
+    EXPECT_EQ(l.answers[0].by, AnsweredBy::kSubRayCrossings);
+    EXPECT_EQ(l.answers[1].by, AnsweredBy::kFilteredTables);
+    ASSERT_FALSE(l.answers[1].sigma_inv.empty());
+    EXPECT_EQ(l.answers[1].sigma_inv.back(), 4);
 }
 
 // Levels left out for their size (the pair budget) are said too, with what their rays read.

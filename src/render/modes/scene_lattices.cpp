@@ -76,15 +76,17 @@ struct LevelCosts {
 // already (the budget bounds what a render builds, not what it reads). Level 0, the lattice
 // asked for, is read whatever its size.
 // The budget is the render's (kLodBudgetMinutes): left is what the primitives before have not
-// spent, and the levels chosen spend from it, finest first.
+// spent; the levels chosen would spend `cost` of it, finest first, which the caller takes only
+// if they are read (auto mode answers a primitive over budget by its crossings instead).
 struct LevelChoice {
     std::pair<int, int> range;
     int fitting = 0;           // the finest level wanted within the size limits
     bool over_budget = false;  // range.second < fitting: a finer level past the work budget
     double spent_before = 0;   // of the budget, by the primitives before
+    double cost = 0;           // of the budget, by building the levels in range
 };
 LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pair<int, int> wanted,
-                          const LatticeFiltering& filtering, double& left) {
+                          const LatticeFiltering& filtering, double left) {
     const auto fits = [&](int j) {
         return c.sigma_inv(j) <= kMaxSigmaInv && c.pairs(j) <= filtering.max_pairs;
     };
@@ -97,7 +99,7 @@ LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pai
         const double w = cost(j);
         return j == 0 || w == 0 || w <= left;
     };
-    const double spent_before = filtering.max_work - left;
+    const double spent_before = filtering.max_work - left, budget = left;
     int fitting = 0;
     while (fitting < wanted.second && fits(fitting + 1)) ++fitting;
     int finest = fitting;
@@ -105,7 +107,7 @@ LevelChoice choose_levels(const LevelCosts& c, const TableCache& cache, std::pai
     left -= cost(finest);
     int first = finest;
     while (first > std::min(wanted.first, finest) && affordable(first - 1)) left -= cost(--first);
-    return {{first, finest}, fitting, finest < fitting, spent_before};
+    return {{first, finest}, fitting, finest < fitting, spent_before, budget - left};
 }
 
 // What the user should know of a choice that leaves out levels wanted: which, why, and what
@@ -207,7 +209,7 @@ void filtered_lattice(const Scene& scene, int prim, const TableCache* cache, con
         const LevelChoice choice = choose_levels(costs, *cache, wanted, filtering, budget_left);
         if (choice.over_budget) plan_past_budget(q, base.primitive, plan);
         const bool by_crossings = plan.by == AnsweredBy::kSubRayCrossings;
-        if (!by_crossings) range = choice.range;
+        if (!by_crossings) range = choice.range, budget_left -= choice.cost;
         const std::string note = levels_note(costs, wanted, choice, filtering, by_crossings);
         if (!note.empty()) out.notes.push_back(note);
     }
