@@ -196,22 +196,29 @@ TEST(Coverage, PastTheWorkBudgetACostlyPrimitiveAnswersByItsCrossings) {
         << l.notes[0];
 }
 
-// The near-and-far scene with a second primitive, bead2, of tube radius `minor2` (the first's
-// 0.3), placed as the first is.
-std::string two_primitives(const std::string& minor2) {
+// The near-and-far scene with a second primitive, bead2, whose tori have major radius `major2`
+// (the first's 0.3), placed as the first is.
+std::string two_primitives(const std::string& major2) {
     std::string scene = near_and_far(true, true);
     const std::string head = R"("primitives": {"bead": )";
     const std::size_t from = scene.find(head) + head.size();
     const std::size_t to = scene.find("},\n  \"objects\"");
     EXPECT_NE(to, std::string::npos);
     std::string second = scene.substr(from, to - from);
-    second.replace(second.find("0.3, \"minor"), 3, minor2);
+    second.replace(second.find("0.3, \"minor"), 3, major2);
     scene.insert(to, ", \"bead2\": " + second);
     scene.insert(scene.rfind("}]") + 1,
                  R"(, {"type": "instance", "primitive": "bead2", "material": "w"},
               {"type": "instance", "primitive": "bead2", "transform": [{"translate": [0, 400, 0]}],
                "material": "w"})");
     return scene;
+}
+
+// That scene, written into dir and loaded.
+Scene two_primitives_scene(const test::TempDir& dir, const std::string& major2) {
+    const std::string path = (dir.path() / "two-rows.json").string();
+    std::ofstream(path) << two_primitives(major2);
+    return load_scene(path);
 }
 
 // The builds' work of a primitive's three levels, sigma^-1 = 1, 2 and 4.
@@ -227,12 +234,11 @@ double three_levels_work(const Shape& bead) {
 // and its note says what the first spent.
 TEST(Coverage, TheWorkBudgetIsSharedByThePrimitives) {
     test::TempDir dir;
-    const std::string path = (dir.path() / "two-rows.json").string();
-    std::ofstream(path) << two_primitives("0.29");
-    const Scene s = load_scene(path);
+    const Scene s = two_primitives_scene(dir, "0.29");
     ASSERT_EQ(s.primitives.size(), 2u);
     const double all = three_levels_work(*s.primitives[0].shape);
-    const SceneLattices l = lattices_in(dir, s, {LatticeFilter::kSmooth, true, 0.01, kMaxLodPairs, all * 1.001, LatticePolicy::kTables});
+    const SceneLattices l = lattices_in(
+        dir, s, {LatticeFilter::kSmooth, true, 0.01, kMaxLodPairs, all * 1.001, LatticePolicy::kTables});
     ASSERT_EQ(l.answers.size(), 2u);
     EXPECT_EQ(l.answers[0].sigma_inv, (std::vector<long long>{1, 2, 4}));
     EXPECT_EQ(l.answers[1].sigma_inv, (std::vector<long long>{1}));
@@ -251,9 +257,7 @@ TEST(Coverage, TheWorkBudgetIsSharedByThePrimitives) {
 // it could not afford had the first spent on the coarser levels it left unread.
 TEST(Coverage, APrimitiveAnsweredByItsCrossingsSpendsNoBudget) {
     test::TempDir dir;
-    const std::string path = (dir.path() / "two-rows.json").string();
-    std::ofstream(path) << two_primitives("0.1");
-    const Scene s = load_scene(path);
+    const Scene s = two_primitives_scene(dir, "0.1");
     ASSERT_EQ(s.primitives.size(), 2u);
     const auto work = [&](std::size_t prim, int level) {
         const Shape& shape = *s.primitives[prim].shape;
@@ -263,7 +267,8 @@ TEST(Coverage, APrimitiveAnsweredByItsCrossingsSpendsNoBudget) {
     const double budget = 0.99 * work(0, 2);  // the first's finest level is over it
     ASSERT_LT(work(1, 2), budget);
     ASSERT_GT(work(1, 2), budget - work(0, 0) - work(0, 1));
-    const SceneLattices l = lattices_in(dir, s, {LatticeFilter::kSmooth, true, 0.01, kMaxLodPairs, budget, LatticePolicy::kAuto});
+    const SceneLattices l = lattices_in(
+        dir, s, {LatticeFilter::kSmooth, true, 0.01, kMaxLodPairs, budget, LatticePolicy::kAuto});
     ASSERT_EQ(l.answers.size(), 2u);
     EXPECT_EQ(l.answers[0].by, AnsweredBy::kSubRayCrossings);
     EXPECT_EQ(l.answers[1].by, AnsweredBy::kFilteredTables);
