@@ -1,19 +1,26 @@
 #include "render/layers.h"
 
+
 #include <cmath>
+
+#include "render/instance_shadows.h"
 
 namespace lat {
 namespace {
 
 // Radiance at a layer; `width`: its footprint (world units), which picks the lattices' levels
 // of detail for its shadow rays, narrowing to the point light.
-Vec3 shade_layer(const TracedScene& rs, const Ray& ray, const SurfaceHit& hit, double width,
-                 ShadeState& state) {
+Vec3 shade_layer(const TracedScene& rs, const InstanceShadows* maps, const Ray& ray,
+                 const SurfaceHit& hit, double width, ShadeState& state) {
     const auto visible = [&](std::size_t light, const Ray& r, double tmin, double tmax,
                              double dist) {
         // Narrowing to the light; sub-rays along the same world directions in every lattice
         // (coverage/sub_rays.h).
-        const TraceRay shadow = TraceRay::shadow(r, shadow_width(hit.n, ray.d, r.d, width), dist);
+        const double leaving = shadow_width(hit.n, ray.d, r.d, width);
+        const TraceRay shadow = TraceRay::shadow(r, leaving, dist);
+        if (maps && maps->mapped(light))
+            return maps->visible(light, shadow.ray(), tmin, tmax, hit.object, leaving,
+                                 state.kept_blocker(light));
         return transmittance(rs, shadow.ray(), tmin, tmax, hit.object, state.kept_blocker(light));
     };
     return shade_with(rs, ray, hit, state, visible);
@@ -28,7 +35,8 @@ double transmittance(const TracedScene& rs, const Ray& r, double tmin, double tm
     return transmitted(partial);
 }
 
-Vec3 trace_layers(const TracedScene& rs, const TraceRay& traced, ShadeState& state) {
+Vec3 trace_layers(const TracedScene& rs, const TraceRay& traced, ShadeState& state,
+                  const InstanceShadows* maps) {
     thread_local std::vector<SurfaceHit> partial;  // scratch, reused ray after ray
     const Ray ray = traced.line();  // shaded as its line
     const double spread = traced.footprint.spread;
@@ -40,10 +48,10 @@ Vec3 trace_layers(const TracedScene& rs, const TraceRay& traced, ShadeState& sta
     return composite_layers(
         std::span<const SurfaceHit>(partial),
         [&](const SurfaceHit& h) {
-            return shade_layer(rs, ray, h, sheet_width(h.alpha, h.sub_rays, spread * h.t), state);
+            return shade_layer(rs, maps, ray, h, sheet_width(h.alpha, h.sub_rays, spread * h.t), state);
         },
         [&] {
-            return found ? shade_layer(rs, ray, opaque, spread * opaque.t, state)
+            return found ? shade_layer(rs, maps, ray, opaque, spread * opaque.t, state)
                          : rs.scene().background;
         });
 }

@@ -8,9 +8,13 @@
 
 namespace lat {
 
+class InstanceShadows;
+
 // Radiance along a camera ray, whose footprint picks the lattices' levels of detail and spans
-// their sub-rays.
-Vec3 trace_layers(const TracedScene& rs, const TraceRay& ray, ShadeState& state);
+// their sub-rays. maps: where given, the shadows its instances cast on lights it maps
+// (render/instance_shadows.h); else shadow rays through everything.
+Vec3 trace_layers(const TracedScene& rs, const TraceRay& ray, ShadeState& state,
+                  const InstanceShadows* maps = nullptr);
 
 // The share of light that gets through from tmin to tmax along r (a shadow ray's
 // TraceRay::ray()) leaving a surface of object `self`,

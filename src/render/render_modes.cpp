@@ -10,6 +10,7 @@
 #include "geometry/chain.h"
 #include "lattice/encoding.h"
 #include "render/core/camera.h"
+#include "render/instance_shadows.h"
 #include "render/modes/integrators.h"
 #include "render/baselines/scene_parts.h"
 #include "util/memory.h"
@@ -68,6 +69,19 @@ std::optional<LatticeFiltering> lattice_policy(const Scene& scene, RenderMode mo
     }
     f.spread = PinholeCamera(scene.camera, settings.spp).spread();
     return f;
+}
+
+// What the instances' deep shadow maps came to, once the render has traced what it needed.
+ModeResult::ShadowMaps shadow_map_report(const InstanceShadows& maps, std::size_t lights) {
+    ModeResult::ShadowMaps m;
+    m.lights = lights;
+    m.lights_mapped = maps.lights_mapped();
+    m.size = maps.size();
+    m.tiles = maps.tiles();
+    m.tiles_traced = maps.tiles_traced();
+    m.bytes = maps.bytes();
+    m.knots = maps.knots();
+    return m;
 }
 
 }  // namespace
@@ -134,7 +148,18 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             // Partial hits are traced in layers, chosen here once: a filter makes them
             // (footprint filtering's is smooth); point-sampled tables and exact shapes have none.
             const bool layered = filtering && filtering->filter != LatticeFilter::kNone;
-            r.out = layered ? render_layered(rs, opt) : render_exact(rs, opt);
+            std::optional<InstanceShadows> maps;
+            // Maps of tables only: sheets of sub-rays (auto mode's cheap primitives, exact mode's
+            // footprint) want a shadow ray's own footprint (docs/scale.md).
+            if (layered && filtering->policy == LatticePolicy::kTables && scene.shadows &&
+                settings.instance_shadows == InstanceShadowing::kDeepMap)
+                maps.emplace(rs, instance_shape, accel,
+                             settings.shadow_map_size > 0 ? settings.shadow_map_size : kDeepShadowMapSize);
+            r.out = layered ? render_layered(rs, opt, maps ? &*maps : nullptr) : render_exact(rs, opt);
+            if (maps) {
+                r.shadow_maps = shadow_map_report(*maps, scene.lights.size());
+                r.bytes_added += r.shadow_maps->bytes;
+            }
             break;
         }
         case RenderMode::kTexture: {
@@ -154,7 +179,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             ParticleOptions po;
             po.spp = settings.spp;
             po.progress = settings.progress;
-            po.shadow_map_size = settings.shadow_map_size;
+            if (settings.shadow_map_size > 0) po.shadow_map_size = settings.shadow_map_size;
             if (settings.before_render) settings.before_render();
             r.out = render_particles(scene, set, po);
             break;

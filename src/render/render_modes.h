@@ -4,6 +4,7 @@
 // never dispatched by name twice.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -18,6 +19,11 @@
 namespace lat {
 
 enum class RenderMode { kExact, kLattice, kAuto, kTexture, kParticles };
+
+// How lattice mode with a filter finds the shadows its instances cast: shadow rays through
+// their tables, or deep shadow maps traced through the same tables (render/instance_shadows.h).
+enum class InstanceShadowing { kRays, kDeepMap };
+inline constexpr int kDeepShadowMapSize = 1024;
 
 struct ModeDescription {
     std::string_view name;
@@ -43,7 +49,10 @@ struct ModeSettings {
     bool footprint = false;
     AccelOptions accel;
     TextureOptions texture;
-    int shadow_map_size = ParticleOptions{}.shadow_map_size;
+    // Texels a side of each light's shadow map: particle mode's, or the deep maps'
+    // (instance_shadows); 0: the mode's own default.
+    int shadow_map_size = 0;
+    InstanceShadowing instance_shadows = InstanceShadowing::kRays;
     // Collective, for a mode that spreads_over_ranks: tables built once by all ranks together
     // and read by each from the cache, tiles dealt across ranks, the image on rank 0.
     bool across_ranks = false;
@@ -63,6 +72,15 @@ struct ModeResult {
     // maps in texture mode; the particle buffer in particle mode.
     std::uint64_t bytes_added = 0;
     SceneLattices lattices;  // lattice and auto modes, and exact mode's footprint filtering
+    // Deep shadow maps of the instances (InstanceShadowing::kDeepMap), when made: lights mapped,
+    // texels a side, tiles traced (as the render needed them; their time is the render's) and
+    // bytes (in bytes_added).
+    struct ShadowMaps {
+        std::size_t lights = 0, lights_mapped = 0;
+        int size = 0;
+        std::uint64_t tiles = 0, tiles_traced = 0, bytes = 0, knots = 0;
+    };
+    std::optional<ShadowMaps> shadow_maps;
 };
 
 // Whether the mode answers instances by lattices (tables or sub-rays: SceneLattices) rather

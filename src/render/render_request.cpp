@@ -53,6 +53,8 @@ std::string sampler_help() {
 const std::map<std::string, bool> kOnOff{{"on", true}, {"off", false}};
 const std::map<std::string, Instancing> kInstancing{
     {"auto", Instancing::kAuto}, {"always", Instancing::kAlways}, {"never", Instancing::kNever}};
+const std::map<std::string, InstanceShadowing> kInstanceShadowing{
+    {"rays", InstanceShadowing::kRays}, {"deep-map", InstanceShadowing::kDeepMap}};
 LatticeFilter filter_named(const std::string& name) {
     for (const auto& [n, f] : kLatticeFilterNames)
         if (n == name) return f;
@@ -147,9 +149,12 @@ std::vector<OptionEntry<RenderRequest>> make_render_entries() {
     e.push_back({"--texture-subsamples", "texture mode: rays per texel side when baking",
                  [](RenderRequest& r) { return OptionField{&r.texture.subsamples}; },
                  OptionCheck::in_range(1, 16), {M::kTexture}});
-    e.push_back({"--shadow-map-size", "particles mode: texels on a side of each light's shadow map",
+    e.push_back({"--shadow-map-size",
+                 "particles mode, and lattice mode's --instance-shadows deep-map: texels on a "
+                 "side of each light's shadow map (default: 2048 for particles, 1024 for deep "
+                 "maps)",
                  [](RenderRequest& r) { return OptionField{&r.shadow_map_size}; },
-                 OptionCheck::in_range(16, 16384), {M::kParticles}});
+                 OptionCheck::in_range(16, 16384), {M::kParticles, M::kLattice}});
     e.push_back({"--lattice-dir",
                  "Directory of cached lattice tables (default: $LATTICE_CACHE_DIR, "
                  "$XDG_CACHE_HOME/lattice or ~/.cache/lattice)",
@@ -177,6 +182,15 @@ std::vector<OptionEntry<RenderRequest>> make_render_entries() {
                  "budget, and costs none of it",
                  [](RenderRequest& r) { return OptionField{&r.lod_budget}; },
                  OptionCheck::by_text(minutes_check), tables});
+    e.back().show_default = true;
+    e.push_back({"--instance-shadows",
+                 "lattice mode with a filter: the shadows instances cast, from shadow rays "
+                 "through their tables (rays), or read from a deep shadow map per light traced "
+                 "through the same tables as lookups need it (deep-map: --shadow-map-size "
+                 "texels a side; shadows of everything else stay rays; a light among the "
+                 "instances keeps rays)",
+                 [](RenderRequest& r) { return OptionField{&r.instance_shadows}; },
+                 OptionCheck::one_of(keys(kInstanceShadowing)), {M::kLattice}});
     e.back().show_default = true;
     e.push_back({"--instancing",
                  "Multi-part objects as Embree instances (always), flattened into one "
@@ -233,6 +247,10 @@ std::vector<std::string> option_notes(const RenderRequest& r,
     const bool tables = r.render_mode() == RenderMode::kLattice || r.render_mode() == RenderMode::kAuto;
     if (tables && r.lattice_filter() == LatticeFilter::kNone && given("--lod"))
         notes.push_back("--lod has no effect with --filter none (point-sampled tables have one level)");
+    if (r.render_mode() == RenderMode::kLattice && r.lattice_filter() == LatticeFilter::kNone &&
+        given("--instance-shadows"))
+        notes.push_back("--instance-shadows has no effect with --filter none (point-sampled "
+                        "tables cast shadows by shadow rays)");
     if (tables && given("--lod-budget") && (r.lattice_filter() == LatticeFilter::kNone || !kOnOff.at(r.lod)))
         notes.push_back("--lod-budget has no effect without levels of detail (--lod on and a filter)");
     return notes;
@@ -348,6 +366,7 @@ ModeSettings mode_settings(const RenderRequest& r) {
     s.accel.instancing = kInstancing.at(r.instancing);
     s.texture = r.texture;
     s.shadow_map_size = r.shadow_map_size;
+    s.instance_shadows = kInstanceShadowing.at(r.instance_shadows);
     return s;
 }
 

@@ -31,7 +31,8 @@ struct RenderRequest {
     TableSpec spec;
     std::string instancing = "auto";
     TextureOptions texture;
-    int shadow_map_size = ParticleOptions{}.shadow_map_size;
+    int shadow_map_size = 0;  // 0: the mode's own (ModeSettings::shadow_map_size)
+    std::string instance_shadows = "rays";
     std::string filter = "smooth";
     std::string lod = "on";
     double lod_budget = kLodBudgetMinutes;  // of one core

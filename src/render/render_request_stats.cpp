@@ -93,6 +93,15 @@ nlohmann::json render_stats_json(const RenderRequest& a, const Scene& scene, con
         j["table_files"] = lattices.paths;
         j["table_visits"] = st.count(stats::Counter::kLatticeVisits);
     }
+    if (r.shadow_maps) {
+        const ModeResult::ShadowMaps& m = *r.shadow_maps;
+        j["instance_shadows"] = {{"by", "deep-map"},          {"size", m.size},
+                                 {"lights", m.lights},        {"lights_mapped", m.lights_mapped},
+                                 {"tiles", m.tiles},          {"tiles_traced", m.tiles_traced},
+                                 {"bytes", m.bytes},          {"knots", m.knots}};
+    } else if (a.answers_instances() && scene.shadows) {
+        j["instance_shadows"] = {{"by", "rays"}};
+    }
     j["option_notes"] = a.notes;
     j["render_ms"] = st.render_ms;
     j["render_cpu_ms"] = st.cpu_ms;

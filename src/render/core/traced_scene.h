@@ -58,6 +58,14 @@ public:
         AccelHit opaque;
         return accel_->intersect_layers(r, tmin, tmax, self, opaque, partial, stop, last);
     }
+    // Every crossing a ray from outside the objects meets, not made into surface hits: the
+    // closest opaque one (`opaque`, if any: the return) and the partial ones before it in ray
+    // order, as `stop` keeps them (a deep shadow map's rays, render/deep_shadow_map.h).
+    bool crossings(const Ray& r, double tmin, double tmax, std::vector<AccelHit>& partial,
+                   AccelHit& opaque, const LayerStop& stop) const {
+        return accel_->intersect_layers(r, tmin, tmax, EmbreeAccel::kNoObject, opaque, partial,
+                                        stop);
+    }
     // `self`: the object whose surface the ray leaves (see EmbreeAccel::occluded).
     bool occluded(const Ray& r, double tmin, double tmax,
                   std::uint32_t self = EmbreeAccel::kNoObject,

@@ -13,15 +13,16 @@ Vec3 ExactIntegrator::radiance(const TraceRay& traced, ShadeState& state) const 
 }
 
 Vec3 LayeredIntegrator::radiance(const TraceRay& ray, ShadeState& state) const {
-    return trace_layers(rs_, ray, state);
+    return trace_layers(rs_, ray, state, maps_);
 }
 
 RenderOutput render_exact(const TracedScene& rs, const RenderOptions& opt) {
     return render_image(rs.scene().camera, ExactIntegrator(rs), opt);
 }
 
-RenderOutput render_layered(const TracedScene& rs, const RenderOptions& opt) {
-    return render_image(rs.scene().camera, LayeredIntegrator(rs), opt);
+RenderOutput render_layered(const TracedScene& rs, const RenderOptions& opt,
+                            const InstanceShadows* maps) {
+    return render_image(rs.scene().camera, LayeredIntegrator(rs, maps), opt);
 }
 
 }  // namespace lat

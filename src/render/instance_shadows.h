@@ -1,0 +1,51 @@
+#pragma once
+// Shadows cast by a scene's instances read from deep shadow maps, one per light
+// (render/deep_shadow_map.h), and shadows cast by everything else from shadow rays against the
+// scene without its instances (its base): among fur, a shadow ray through the instances' tables
+// visits tens of them, a map lookup four texels.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "render/core/traced_scene.h"
+#include "render/deep_shadow_map.h"
+
+namespace lat {
+
+class InstanceShadows {
+public:
+    // The maps of rs's instances (traced as rs traces them), `size` texels a side, and the base
+    // traced with the same instance shapes (a CSG of instances, part of the base, keeps its
+    // lattices). A light within the instances' bounding sphere gets no map: its shadow rays go
+    // through the instances as without maps.
+    InstanceShadows(const TracedScene& rs, const TracedScene::InstanceShapeFn& instance_shape,
+                    const AccelOptions& accel, int size);
+    ~InstanceShadows();
+
+    bool mapped(std::size_t light) const { return maps_[light].valid(); }
+    // The share of light `light` (mapped) reaching the start of shadow ray r (tmin to tmax, as
+    // for_each_light gives it) on a surface of rs's object `self` whose footprint there is
+    // `width` wide: the base's transmittance times the map's.
+    double visible(std::size_t light, const Ray& r, double tmin, double tmax, std::uint32_t self,
+                   double width, EmbreeAccel::LastBlocker* last) const;
+
+    std::size_t lights_mapped() const;
+    int size() const { return size_; }
+    std::uint64_t bytes() const;
+    std::uint64_t knots() const;
+    // Tiles of the maps of mapped lights, and those traced so far (DeepShadowMap::kTile).
+    std::uint64_t tiles() const;
+    std::uint64_t tiles_traced() const;
+
+private:
+    std::unique_ptr<Scene> base_scene_;
+    std::unique_ptr<TracedScene> base_;
+    std::vector<std::uint32_t> base_object_;  // rs's object -> base's (kNoObject: an instance)
+    std::vector<DeepShadowMap> maps_;
+    int size_ = 0;
+};
+
+// The world bounds of a scene's instances as rs traces them.
+Bounds3 instance_bounds(const TracedScene& rs);
+
+}  // namespace lat
