@@ -48,17 +48,21 @@ void print_summary(const RenderRequest& a, const Scene& scene, const ModeResult&
             std::fprintf(stderr, " (estimated %.1f minutes of one core)", b.estimated_cpu_seconds / 60);
         std::fprintf(stderr, "\n");
     }
-    if (const auto& m = r.shadow_maps)
+    if (const auto& m = r.shadow_maps) {
+        std::string sizes;
+        for (const int n : m->sizes)
+            if (n > 0) sizes += (sizes.empty() ? "" : ", ") + std::to_string(n);
         std::fprintf(stderr,
                      "lattice: instances' shadows from deep shadow maps of %zu of %zu lights "
-                     "(%d x %d texels, %llu of %llu tiles traced, %s); %s\n",
-                     m->lights_mapped, m->lights, m->size, m->size,
+                     "(%s texels a side, %llu of %llu tiles traced, %s); %s\n",
+                     m->lights_mapped, m->lights, sizes.empty() ? "no" : sizes.c_str(),
                      static_cast<unsigned long long>(m->tiles_traced),
                      static_cast<unsigned long long>(m->tiles),
                      human_bytes(static_cast<double>(m->bytes)).c_str(),
                      m->lights_mapped == m->lights
                          ? "other shadows by shadow rays"
                          : "the other lights lie among the instances and cast shadow rays");
+    }
     if (a.answers_instances() && lattices.answers.empty())
         std::fprintf(stderr, "lattice: note: the scene has no instances of a primitive: every object is traced exactly\n");
     for (const std::string& note : lattices.notes) std::fprintf(stderr, "lattice: note: %s\n", note.c_str());

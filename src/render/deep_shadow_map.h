@@ -34,6 +34,7 @@ public:
     ~DeepShadowMap();
 
     bool valid() const { return valid_; }
+    int size() const { return size_; }
     // The share of the light reaching p on a surface of object `self` (as rs numbers it)
     // through the instances, their crossings less than `bias` nearer the light than p, and
     // self's, not counted; 1 outside the map. Thread-safe: it traces the tiles

@@ -1,6 +1,7 @@
 #include "render/instance_shadows.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "render/baselines/scene_parts.h"
 #include "render/layers.h"
@@ -14,6 +15,18 @@ namespace {
 // filtered tables blend into it. Of 0.5 to 4 tried on the bunny's fur, 1.5 was the most
 // faithful; less leaves the fur too dark, 2 and more too bright (bench/notes/scale-log.md).
 constexpr double kBiasFootprints = 1.5;
+
+// Texels a side for a map from `light` over the sphere around `target` whose texel at its centre
+// is as wide as a camera sample's footprint there.
+int matched_size(const Camera& camera, Vec3 light, const Bounds3& target, double spread) {
+    const Vec3 centre = target.center();
+    const double radius = length(target.extent()) * 0.5, dist = length(centre - light);
+    const double sample = spread * length(centre - camera.eye);
+    if (!(dist > radius) || !(sample > 0)) return InstanceShadows::kMinSize;
+    const double across = 2 * radius * dist / std::sqrt(dist * dist - radius * radius);
+    return static_cast<int>(std::clamp(std::ceil(across / sample), double(InstanceShadows::kMinSize),
+                                       double(InstanceShadows::kMaxSize)));
+}
 
 }  // namespace
 
@@ -35,8 +48,7 @@ Bounds3 instance_bounds(const TracedScene& rs) {
 
 InstanceShadows::InstanceShadows(const TracedScene& rs,
                                  const TracedScene::InstanceShapeFn& instance_shape,
-                                 const AccelOptions& accel, int size)
-    : size_(size) {
+                                 const AccelOptions& accel, int size, double spread) {
     const Scene& s = rs.scene();
     base_scene_ = std::make_unique<Scene>(base_scene(s));
     AccelOptions quiet = accel;
@@ -48,9 +60,12 @@ InstanceShadows::InstanceShadows(const TracedScene& rs,
         if (s.objects[i].primitive < 0) base_object_[i] = next++;
     const Bounds3 target = instance_bounds(rs);
     maps_.reserve(s.lights.size());
-    for (std::size_t i = 0; i < s.lights.size(); ++i)
-        maps_.emplace_back(rs, s.lights[i].position, target, size,
+    for (std::size_t i = 0; i < s.lights.size(); ++i) {
+        const Vec3 light = s.lights[i].position;
+        maps_.emplace_back(rs, light, target,
+                           size > 0 ? size : matched_size(s.camera, light, target, spread),
                            "lights[" + std::to_string(i) + "]");
+    }
 }
 
 InstanceShadows::~InstanceShadows() = default;
@@ -69,6 +84,12 @@ double InstanceShadows::visible(std::size_t light, const Ray& r, double tmin, do
 std::size_t InstanceShadows::lights_mapped() const {
     return static_cast<std::size_t>(std::count_if(maps_.begin(), maps_.end(),
                                                   [](const DeepShadowMap& m) { return m.valid(); }));
+}
+
+std::vector<int> InstanceShadows::sizes() const {
+    std::vector<int> out;
+    for (const DeepShadowMap& m : maps_) out.push_back(m.valid() ? m.size() : 0);
+    return out;
 }
 
 std::uint64_t InstanceShadows::bytes() const {

@@ -14,12 +14,15 @@ namespace lat {
 
 class InstanceShadows {
 public:
-    // The maps of rs's instances (traced as rs traces them), `size` texels a side, and the base
-    // traced with the same instance shapes (a CSG of instances, part of the base, keeps its
-    // lattices). A light within the instances' bounding sphere gets no map: its shadow rays go
-    // through the instances as without maps.
+    // The maps of rs's instances (traced as rs traces them), and the base traced with the same
+    // instance shapes (a CSG of instances, part of the base, keeps its lattices). Each map is
+    // `size` texels a side, or with size 0 as many as make a texel at the instances' centre as
+    // wide as a camera sample's footprint there (`spread`: its width per unit distance,
+    // PinholeCamera::spread), within kMinSize to kMaxSize. A light within the instances'
+    // bounding sphere gets no map: its shadow rays go through the instances as without maps.
     InstanceShadows(const TracedScene& rs, const TracedScene::InstanceShapeFn& instance_shape,
-                    const AccelOptions& accel, int size);
+                    const AccelOptions& accel, int size, double spread);
+    static constexpr int kMinSize = 64, kMaxSize = 4096;
     ~InstanceShadows();
 
     bool mapped(std::size_t light) const { return maps_[light].valid(); }
@@ -30,7 +33,8 @@ public:
                    double width, EmbreeAccel::LastBlocker* last) const;
 
     std::size_t lights_mapped() const;
-    int size() const { return size_; }
+    // Texels a side of each light's map (0: none).
+    std::vector<int> sizes() const;
     std::uint64_t bytes() const;
     std::uint64_t knots() const;
     // Tiles of the maps of mapped lights, and those traced so far (DeepShadowMap::kTile).
@@ -42,7 +46,6 @@ private:
     std::unique_ptr<TracedScene> base_;
     std::vector<std::uint32_t> base_object_;  // rs's object -> base's (kNoObject: an instance)
     std::vector<DeepShadowMap> maps_;
-    int size_ = 0;
 };
 
 // The world bounds of a scene's instances as rs traces them.

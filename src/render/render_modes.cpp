@@ -76,7 +76,7 @@ ModeResult::ShadowMaps shadow_map_report(const InstanceShadows& maps, std::size_
     ModeResult::ShadowMaps m;
     m.lights = lights;
     m.lights_mapped = maps.lights_mapped();
-    m.size = maps.size();
+    m.sizes = maps.sizes();
     m.tiles = maps.tiles();
     m.tiles_traced = maps.tiles_traced();
     m.bytes = maps.bytes();
@@ -153,8 +153,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             // footprint) want a shadow ray's own footprint (docs/scale.md).
             if (layered && filtering->policy == LatticePolicy::kTables && scene.shadows &&
                 settings.instance_shadows == InstanceShadowing::kDeepMap)
-                maps.emplace(rs, instance_shape, accel,
-                             settings.shadow_map_size > 0 ? settings.shadow_map_size : kDeepShadowMapSize);
+                maps.emplace(rs, instance_shape, accel, settings.shadow_map_size, filtering->spread);
             r.out = layered ? render_layered(rs, opt, maps ? &*maps : nullptr) : render_exact(rs, opt);
             if (maps) {
                 r.shadow_maps = shadow_map_report(*maps, scene.lights.size());

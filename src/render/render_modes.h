@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "accel/embree_accel.h"
 #include "lattice/cache/table_spec.h"
@@ -23,7 +24,6 @@ enum class RenderMode { kExact, kLattice, kAuto, kTexture, kParticles };
 // How lattice mode with a filter finds the shadows its instances cast: shadow rays through
 // their tables, or deep shadow maps traced through the same tables (render/instance_shadows.h).
 enum class InstanceShadowing { kRays, kDeepMap };
-inline constexpr int kDeepShadowMapSize = 1024;
 
 struct ModeDescription {
     std::string_view name;
@@ -50,7 +50,8 @@ struct ModeSettings {
     AccelOptions accel;
     TextureOptions texture;
     // Texels a side of each light's shadow map: particle mode's, or the deep maps'
-    // (instance_shadows); 0: the mode's own default.
+    // (instance_shadows); 0: the mode's own default (the deep maps': a texel a camera sample's
+    // footprint wide at the instances, InstanceShadows).
     int shadow_map_size = 0;
     InstanceShadowing instance_shadows = InstanceShadowing::kRays;
     // Collective, for a mode that spreads_over_ranks: tables built once by all ranks together
@@ -73,11 +74,11 @@ struct ModeResult {
     std::uint64_t bytes_added = 0;
     SceneLattices lattices;  // lattice and auto modes, and exact mode's footprint filtering
     // Deep shadow maps of the instances (InstanceShadowing::kDeepMap), when made: lights mapped,
-    // texels a side, tiles traced (as the render needed them; their time is the render's) and
-    // bytes (in bytes_added).
+    // texels a side of each light's map (0: none), tiles traced (as the render needed them;
+    // their time is the render's) and bytes (in bytes_added).
     struct ShadowMaps {
         std::size_t lights = 0, lights_mapped = 0;
-        int size = 0;
+        std::vector<int> sizes;
         std::uint64_t tiles = 0, tiles_traced = 0, bytes = 0, knots = 0;
     };
     std::optional<ShadowMaps> shadow_maps;

@@ -95,11 +95,11 @@ nlohmann::json render_stats_json(const RenderRequest& a, const Scene& scene, con
     }
     if (r.shadow_maps) {
         const ModeResult::ShadowMaps& m = *r.shadow_maps;
-        j["instance_shadows"] = {{"by", "deep-map"},          {"size", m.size},
+        j["instance_shadows"] = {{"by", "deep-map"},          {"sizes", m.sizes},
                                  {"lights", m.lights},        {"lights_mapped", m.lights_mapped},
                                  {"tiles", m.tiles},          {"tiles_traced", m.tiles_traced},
                                  {"bytes", m.bytes},          {"knots", m.knots}};
-    } else if (a.answers_instances() && scene.shadows) {
+    } else if (a.render_mode() == RenderMode::kLattice && scene.shadows) {
         j["instance_shadows"] = {{"by", "rays"}};
     }
     j["option_notes"] = a.notes;
