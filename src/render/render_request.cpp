@@ -151,8 +151,8 @@ std::vector<OptionEntry<RenderRequest>> make_render_entries() {
                  OptionCheck::in_range(1, 16), {M::kTexture}});
     e.push_back({"--shadow-map-size",
                  "particles mode, and lattice mode's --instance-shadows deep-map: texels on a "
-                 "side of each light's shadow map (default: 2048 for particles, 1024 for deep "
-                 "maps)",
+                 "side of each light's shadow map (default: 2048 for particles; for deep maps, "
+                 "a texel as wide as a camera sample's footprint at the instances)",
                  [](RenderRequest& r) { return OptionField{&r.shadow_map_size}; },
                  OptionCheck::in_range(16, 16384), {M::kParticles, M::kLattice}});
     e.push_back({"--lattice-dir",

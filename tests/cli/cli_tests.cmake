@@ -161,6 +161,17 @@ add_test(NAME cli.texture_size_range
 add_test(NAME cli.shadow_map_size_range
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;particles;--shadow-map-size;8;${BAD}/good.json;-o;${CLI_OUT}/sm.png"
           -DEXIT=2 "-DPATTERN=--shadow-map-size" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.instance_shadows_unknown
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;lattice;--instance-shadows;map;${BAD}/good.json;-o;${CLI_OUT}/is.png"
+          -DEXIT=2 "-DPATTERN=--instance-shadows" -DNO_FILE=${CLI_OUT}/is.png -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+# Deep maps say so on the summary line; asked for where they cannot act, a note says why.
+file(MAKE_DIRECTORY ${CLI_OUT}/is-cache)
+add_test(NAME cli.instance_shadows_deep_map_says_so
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--mode;lattice;--lod;off;--instance-shadows;deep-map;--lattice-dir;${CLI_OUT}/is-cache;${BAD}/furred-sphere.json;-o;${CLI_OUT}/isd.png"
+          -DEXIT=0 "-DPATTERN=instances' shadows from deep shadow maps of 1 of 1 lights" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
+add_test(NAME cli.instance_shadows_no_effect_in_exact_mode
+  COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;render;--instance-shadows;deep-map;${BAD}/good.json;-o;${CLI_OUT}/ise.png"
+          -DEXIT=0 "-DPATTERN=--instance-shadows has no effect in exact mode" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
 add_test(NAME cli.table2_unknown_encoding
   COMMAND ${CMAKE_COMMAND} "-DCMD=$<TARGET_FILE:lattice>;table2;${BAD}/good.json;-o;${CLI_OUT}/t2bad;--encodings;hash14,nope"
           -DEXIT=2 "-DPATTERN=nope" -DWORKDIR=${CLI_OUT} -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/expect.cmake)
