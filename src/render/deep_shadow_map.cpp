@@ -73,6 +73,7 @@ const DeepShadowMap::Tile& DeepShadowMap::tile(int ti, int tj) const {
 
 void DeepShadowMap::trace_tile(int ti, int tj, Tile& t) const {
     std::vector<Knot> texel;
+    t.knots.clear();  // a try that threw (InputError) may have left some
     t.first.assign(kTile * kTile + 1, 0);
     for (int y = 0; y < kTile; ++y)
         for (int x = 0; x < kTile; ++x) {
@@ -80,7 +81,8 @@ void DeepShadowMap::trace_tile(int ti, int tj, Tile& t) const {
             if (i < size_ && j < size_) trace_texel(i, j, texel);
             else texel.clear();
             t.knots.insert(t.knots.end(), texel.begin(), texel.end());
-            t.first[static_cast<std::size_t>(y * kTile + x + 1)] = static_cast<std::uint16_t>(t.knots.size());
+            t.first[static_cast<std::size_t>(y * kTile + x + 1)] =
+                static_cast<std::uint16_t>(t.knots.size());
         }
     t.knots.shrink_to_fit();
     traced_->tiles.fetch_add(1, std::memory_order_relaxed);
