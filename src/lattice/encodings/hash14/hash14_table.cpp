@@ -33,16 +33,18 @@ std::uint16_t quantise_t(float t) {
     return static_cast<std::uint16_t>(x - whole >= 0.5 ? whole + 1 : whole);
 }
 
-// A hit as its finished entry, with its bucket within its partition.
+// A hit as its finished entry, without its link. Its bucket is hashed again where it is needed
+// rather than kept: at 10 bytes, the half of a raw hit that compaction frees holds the whole
+// sorted copy, so that the copy touches no memory the system has not just freed (a first touch
+// of such memory is dear, on virtual machines above all).
 struct Sorted {
-    std::uint16_t a, b, t, nu, nv, bucket;
+    std::uint16_t a, b, t, nu, nv;
 };
-static_assert(sizeof(Sorted) == 12);
+static_assert(sizeof(Sorted) == 10);
 
 // Every chunk of hits made into entries by to_entry(hit, chunk), in place in its buffer where
-// the hits are held by nothing else: the 8 bytes a hit saves then go back to the system before
-// the sorted copy is made, which reuses them (a first touch of memory the system has not just
-// freed is dear, on virtual machines above all). Else into a new buffer, which `hits` keeps.
+// the hits are held by nothing else: the 10 bytes a hit saves then go back to the system before
+// the sorted copy is made, which reuses them. Else into a new buffer, which `hits` keeps.
 template <class ToEntry>
 std::vector<std::span<const Sorted>> compact_hits(RawHits& hits, ToEntry&& to_entry) {
     // The chunks of each buffer, in address order: compacted in that order, an entry never
@@ -112,26 +114,26 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     if (buckets + n >= kEnd) throw std::length_error("hash14: too many entries for 32-bit links");
     // Buckets are split into partitions small enough (4k buckets, 57 kB) to stay in cache
     // while their hits are placed; hits are first sorted stably into their partitions, as
-    // finished entries with their bucket within the partition (12 bytes instead of a raw
-    // hit's 20: the sorted copy is written once and read twice, and fresh memory is dear).
+    // finished entries (10 bytes instead of a raw hit's 20: the sorted copy is written once
+    // and read twice, and fresh memory is dear).
     constexpr int kPartBits = 12;
-    const std::uint64_t parts = (buckets + (1u << kPartBits) - 1) >> kPartBits;
+    constexpr std::uint64_t kLocal = (1u << kPartBits) - 1;
+    const std::uint64_t parts = (buckets + kLocal) >> kPartBits;
     auto part_of = [](std::uint64_t bucket) { return bucket >> kPartBits; };
+    // An entry's bucket within its partition.
+    auto local_of = [&](const Sorted& e) { return bucket_of(e.a, e.b, buckets) & kLocal; };
     const std::size_t nchunks = hits.chunks.size();
     std::vector<std::uint64_t> count(nchunks * parts, 0);
     const std::vector<std::span<const Sorted>> compact =
         compact_hits(hits, [&](const RawHit& h, std::size_t c) {
             if (h.a >= kMaxPoints || h.b >= kMaxPoints)
                 throw std::length_error("hash14: point id over 16 bits");
-            const std::uint64_t bucket = bucket_of(h.a, h.b, buckets);
-            ++count[c * parts + part_of(bucket)];
-            const auto local = static_cast<std::uint16_t>(bucket & ((1u << kPartBits) - 1));
+            ++count[c * parts + part_of(bucket_of(h.a, h.b, buckets))];
             return Sorted{static_cast<std::uint16_t>(h.a),
                           static_cast<std::uint16_t>(h.b),
                           quantise_t(h.t),
                           h.nu,
-                          h.nv,
-                          local};
+                          h.nv};
         });
     // Stable positions: partition by partition, chunk by chunk.
     std::vector<std::uint64_t> offset(nchunks * parts), part_start(parts + 1, 0);
@@ -160,7 +162,7 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
         std::uint64_t used[(1u << kPartBits) / 64] = {};
         std::uint64_t distinct = 0;
         for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
-            const unsigned k = sorted[i].bucket;
+            const auto k = static_cast<unsigned>(local_of(sorted[i]));
             distinct += !(used[k / 64] >> (k % 64) & 1);
             used[k / 64] |= std::uint64_t{1} << (k % 64);
         }
@@ -194,7 +196,7 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
             for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
                 const Sorted& h = sorted[i];
                 const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, kEnd};
-                Hash14Entry& head = part_out[h.bucket];
+                Hash14Entry& head = part_out[local_of(h)];
                 if (head.a == 0xFFFF) {
                     head = e;
                     continue;
