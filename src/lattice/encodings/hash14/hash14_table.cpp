@@ -1,6 +1,7 @@
 #include "lattice/encodings/hash14/hash14_table.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cassert>
@@ -172,7 +173,8 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     for (std::uint64_t p = 0; p < parts; ++p) over_start[p + 1] = over_start[p] + over_count[p];
 
     // The payload, a group of partitions at a time: each group's buckets and overflow entries
-    // are two contiguous ranges of it, built in a buffer that is reused, then handed to the sink.
+    // are two contiguous ranges of it, built in one of two buffers, then handed to the sink
+    // while the next group is built in the other (the write is one thread's work).
     sink.reserve(kHeader + over_start[parts] * sizeof(Hash14Entry));
     sink.write_at(0, &buckets, kHeader);
     constexpr std::uint64_t kGroup = 64;  // partitions: about 8 MB of entries
@@ -181,11 +183,13 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
         const std::uint64_t g1 = std::min(parts, g + kGroup);
         most = std::max(most, (b0(g1) - b0(g)) + (over_start[g1] - over_start[g]));
     }
-    ByteBuffer stage_buf(most * sizeof(Hash14Entry));
-    auto* stage = reinterpret_cast<Hash14Entry*>(stage_buf.data());
+    ByteBuffer stage_bufs[2] = {ByteBuffer(most * sizeof(Hash14Entry)),
+                                ByteBuffer(most * sizeof(Hash14Entry))};
+    tbb::task_group writing;  // destroyed first: it waits for its write before the buffers go
     for (std::uint64_t g = 0; g < parts; g += kGroup) {
         const std::uint64_t g1 = std::min(parts, g + kGroup);
         const std::uint64_t nb = b0(g1) - b0(g);
+        auto* stage = reinterpret_cast<Hash14Entry*>(stage_bufs[g / kGroup % 2].data());
         // The stage holds the group's buckets, then its overflow entries.
         Hash14Entry* const over_stage = stage + nb;
         tbb::parallel_for(g, g1, [&](std::uint64_t p) {
@@ -208,10 +212,14 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
                 head.next = static_cast<std::uint32_t>(next_over++);
             }
         });
-        sink.write_at(kHeader + b0(g) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
-        sink.write_at(kHeader + over_start[g] * sizeof(Hash14Entry), stage + nb,
-                      (over_start[g1] - over_start[g]) * sizeof(Hash14Entry));
+        writing.wait();  // the previous group's write, from the other buffer (rethrows its error)
+        writing.run([&sink, &b0, &over_start, stage, nb, g, g1] {
+            sink.write_at(kHeader + b0(g) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
+            sink.write_at(kHeader + over_start[g] * sizeof(Hash14Entry), stage + nb,
+                          (over_start[g1] - over_start[g]) * sizeof(Hash14Entry));
+        });
     }
+    writing.wait();
 }
 
 Hash14Table::Hash14Table(const std::uint8_t* payload, std::size_t size, std::uint64_t entries)
