@@ -136,17 +136,29 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
                           h.nu,
                           h.nv};
         });
-    // Stable positions: partition by partition, chunk by chunk.
-    std::vector<std::uint64_t> offset(nchunks * parts), part_start(parts + 1, 0);
-    std::uint64_t pos = 0;
-    for (std::uint64_t p = 0; p < parts; ++p) {
-        part_start[p] = pos;
-        for (std::size_t c = 0; c < nchunks; ++c) {
-            offset[c * parts + p] = pos;
-            pos += count[c * parts + p];
-        }
-    }
-    part_start[parts] = pos;
+    // Stable positions: partition by partition, chunk by chunk. Each partition's total first,
+    // then each chunk's start in it, made in place of the counts; ranges of partitions in
+    // parallel, reading the counts row by row (a partition's counts lie a row apart).
+    std::vector<std::uint64_t> part_start(parts + 1, 0);
+    std::vector<std::uint64_t>& offset = count;
+    constexpr std::uint64_t kRange = 256;  // partitions
+    tbb::parallel_for(std::uint64_t{0}, parts, kRange, [&](std::uint64_t p0) {
+        const std::uint64_t p1 = std::min(parts, p0 + kRange);
+        for (std::size_t c = 0; c < nchunks; ++c)
+            for (std::uint64_t p = p0; p < p1; ++p) part_start[p + 1] += count[c * parts + p];
+    });
+    for (std::uint64_t p = 0; p < parts; ++p) part_start[p + 1] += part_start[p];
+    tbb::parallel_for(std::uint64_t{0}, parts, kRange, [&](std::uint64_t p0) {
+        const std::uint64_t p1 = std::min(parts, p0 + kRange);
+        std::vector<std::uint64_t> pos(part_start.begin() + static_cast<std::ptrdiff_t>(p0),
+                                       part_start.begin() + static_cast<std::ptrdiff_t>(p1));
+        for (std::size_t c = 0; c < nchunks; ++c)
+            for (std::uint64_t p = p0; p < p1; ++p) {
+                const std::uint64_t here = count[c * parts + p];
+                offset[c * parts + p] = pos[p - p0];
+                pos[p - p0] += here;
+            }
+    });
     ByteBuffer sorted_buf(n * sizeof(Sorted));
     auto* sorted = reinterpret_cast<Sorted*>(sorted_buf.data());
     tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
