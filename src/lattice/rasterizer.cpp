@@ -211,25 +211,34 @@ private:
         };
         std::size_t i = 0;
         if constexpr (std::is_same_v<S, ChainShape>) {
-            // Two segments at a time (geometry/ray_fan.h), each lane as the scalar test.
+            // Two segments at a time (geometry/ray_fan.h), each lane as the scalar test; a run
+            // of pairs is tested before any of its hits is kept, so that no branch on a pair's
+            // answer (which is hard to predict) stands between the tests of the next pairs.
+            // Every exit appears once, so no test's range depends on a hit kept in the run.
+            constexpr std::size_t kRun = 16;
             RayFan f;
             f.o = p * h_;
             f.tmin = _mm_setzero_pd();
-            for (; i + 1 < s.batch.size(); i += 2) {
-                const Scratch::Exit& e0 = s.batch[i];
-                const Scratch::Exit& e1 = s.batch[i + 1];
-                const Vec3 d0 = (e0.q - p) * h_, d1 = (e1.q - p) * h_;
-                f.d = {_mm_set_pd(d1.x, d0.x), _mm_set_pd(d1.y, d0.y), _mm_set_pd(d1.z, d0.z)};
-                f.tmax = _mm_set_pd(std::min(s.best_t[e1.k], 1.0 + 1e-12), std::min(s.best_t[e0.k], 1.0 + 1e-12));
-                FanHits out;
-                const unsigned m = shape.intersect_fan(part, f, out);
-                if (m == 0) continue;
-                alignas(16) double t[2], sub[2];
-                _mm_store_pd(t, out.t);
-                _mm_store_pd(sub, out.part);
-                for (unsigned j = 0; j < 2; ++j)
-                    if (m >> j & 1)
+            unsigned m[kRun];
+            alignas(16) double t[2 * kRun], sub[2 * kRun];
+            while (i + 1 < s.batch.size()) {
+                const std::size_t run = std::min(kRun, (s.batch.size() - i) / 2);
+                for (std::size_t r = 0; r < run; ++r) {
+                    const Scratch::Exit& e0 = s.batch[i + 2 * r];
+                    const Scratch::Exit& e1 = s.batch[i + 2 * r + 1];
+                    const Vec3 d0 = (e0.q - p) * h_, d1 = (e1.q - p) * h_;
+                    f.d = {_mm_set_pd(d1.x, d0.x), _mm_set_pd(d1.y, d0.y), _mm_set_pd(d1.z, d0.z)};
+                    f.tmax = _mm_set_pd(std::min(s.best_t[e1.k], 1.0 + 1e-12),
+                                        std::min(s.best_t[e0.k], 1.0 + 1e-12));
+                    FanHits out;
+                    m[r] = shape.intersect_fan(part, f, out);
+                    _mm_store_pd(t + 2 * r, out.t);
+                    _mm_store_pd(sub + 2 * r, out.part);
+                }
+                for (std::size_t j = 0; j < 2 * run; ++j)
+                    if (m[j / 2] >> (j % 2) & 1)
                         keep(s.batch[i + j].k, Crossing(t[j], part << 2 | static_cast<std::uint32_t>(sub[j]), 0));
+                i += 2 * run;
             }
         }
         for (; i < s.batch.size(); ++i) {

@@ -73,6 +73,10 @@ void check_buildable(const TablePlan& plan) {
     if (avail > 0 && pairs * 0.01 * per_hit > 0.8 * avail)
         refuse_memory(plan, 0.01, pairs * 0.01 * per_hit, true);
     check_points(plan);
+    // Even if every pair were a hit, the build would fit: the estimate below could not refuse
+    // it, and its tracing (about 512 entry points: a twentieth of the Plate 3 hair at sigma^-1 = 4)
+    // would be spent for nothing.
+    if (avail <= 0 || pairs * per_hit <= 0.8 * avail) return;
     // Estimate the hit rate by tracing every n-th entry point.
     RasterizeOptions opt;
     opt.keep_hits = false;

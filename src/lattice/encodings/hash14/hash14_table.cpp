@@ -1,6 +1,7 @@
 #include "lattice/encodings/hash14/hash14_table.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cassert>
@@ -33,16 +34,18 @@ std::uint16_t quantise_t(float t) {
     return static_cast<std::uint16_t>(x - whole >= 0.5 ? whole + 1 : whole);
 }
 
-// A hit as its finished entry, with its bucket within its partition.
+// A hit as its finished entry, without its link. Its bucket is hashed again where it is needed
+// rather than kept: at 10 bytes, the half of a raw hit that compaction frees holds the whole
+// sorted copy, so that the copy touches no memory the system has not just freed (a first touch
+// of such memory is dear, on virtual machines above all).
 struct Sorted {
-    std::uint16_t a, b, t, nu, nv, bucket;
+    std::uint16_t a, b, t, nu, nv;
 };
-static_assert(sizeof(Sorted) == 12);
+static_assert(sizeof(Sorted) == 10);
 
 // Every chunk of hits made into entries by to_entry(hit, chunk), in place in its buffer where
-// the hits are held by nothing else: the 8 bytes a hit saves then go back to the system before
-// the sorted copy is made, which reuses them (a first touch of memory the system has not just
-// freed is dear, on virtual machines above all). Else into a new buffer, which `hits` keeps.
+// the hits are held by nothing else: the 10 bytes a hit saves then go back to the system before
+// the sorted copy is made, which reuses them. Else into a new buffer, which `hits` keeps.
 template <class ToEntry>
 std::vector<std::span<const Sorted>> compact_hits(RawHits& hits, ToEntry&& to_entry) {
     // The chunks of each buffer, in address order: compacted in that order, an entry never
@@ -112,38 +115,50 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     if (buckets + n >= kEnd) throw std::length_error("hash14: too many entries for 32-bit links");
     // Buckets are split into partitions small enough (4k buckets, 57 kB) to stay in cache
     // while their hits are placed; hits are first sorted stably into their partitions, as
-    // finished entries with their bucket within the partition (12 bytes instead of a raw
-    // hit's 20: the sorted copy is written once and read twice, and fresh memory is dear).
+    // finished entries (10 bytes instead of a raw hit's 20: the sorted copy is written once
+    // and read twice, and fresh memory is dear).
     constexpr int kPartBits = 12;
-    const std::uint64_t parts = (buckets + (1u << kPartBits) - 1) >> kPartBits;
+    constexpr std::uint64_t kLocal = (1u << kPartBits) - 1;
+    const std::uint64_t parts = (buckets + kLocal) >> kPartBits;
     auto part_of = [](std::uint64_t bucket) { return bucket >> kPartBits; };
+    // An entry's bucket within its partition.
+    auto local_of = [&](const Sorted& e) { return bucket_of(e.a, e.b, buckets) & kLocal; };
     const std::size_t nchunks = hits.chunks.size();
     std::vector<std::uint64_t> count(nchunks * parts, 0);
     const std::vector<std::span<const Sorted>> compact =
         compact_hits(hits, [&](const RawHit& h, std::size_t c) {
             if (h.a >= kMaxPoints || h.b >= kMaxPoints)
                 throw std::length_error("hash14: point id over 16 bits");
-            const std::uint64_t bucket = bucket_of(h.a, h.b, buckets);
-            ++count[c * parts + part_of(bucket)];
-            const auto local = static_cast<std::uint16_t>(bucket & ((1u << kPartBits) - 1));
+            ++count[c * parts + part_of(bucket_of(h.a, h.b, buckets))];
             return Sorted{static_cast<std::uint16_t>(h.a),
                           static_cast<std::uint16_t>(h.b),
                           quantise_t(h.t),
                           h.nu,
-                          h.nv,
-                          local};
+                          h.nv};
         });
-    // Stable positions: partition by partition, chunk by chunk.
-    std::vector<std::uint64_t> offset(nchunks * parts), part_start(parts + 1, 0);
-    std::uint64_t pos = 0;
-    for (std::uint64_t p = 0; p < parts; ++p) {
-        part_start[p] = pos;
-        for (std::size_t c = 0; c < nchunks; ++c) {
-            offset[c * parts + p] = pos;
-            pos += count[c * parts + p];
-        }
-    }
-    part_start[parts] = pos;
+    // Stable positions: partition by partition, chunk by chunk. Each partition's total first,
+    // then each chunk's start in it, made in place of the counts; ranges of partitions in
+    // parallel, reading the counts row by row (a partition's counts lie a row apart).
+    std::vector<std::uint64_t> part_start(parts + 1, 0);
+    std::vector<std::uint64_t>& offset = count;
+    constexpr std::uint64_t kRange = 256;  // partitions
+    tbb::parallel_for(std::uint64_t{0}, parts, kRange, [&](std::uint64_t p0) {
+        const std::uint64_t p1 = std::min(parts, p0 + kRange);
+        for (std::size_t c = 0; c < nchunks; ++c)
+            for (std::uint64_t p = p0; p < p1; ++p) part_start[p + 1] += count[c * parts + p];
+    });
+    for (std::uint64_t p = 0; p < parts; ++p) part_start[p + 1] += part_start[p];
+    tbb::parallel_for(std::uint64_t{0}, parts, kRange, [&](std::uint64_t p0) {
+        const std::uint64_t p1 = std::min(parts, p0 + kRange);
+        std::vector<std::uint64_t> pos(part_start.begin() + static_cast<std::ptrdiff_t>(p0),
+                                       part_start.begin() + static_cast<std::ptrdiff_t>(p1));
+        for (std::size_t c = 0; c < nchunks; ++c)
+            for (std::uint64_t p = p0; p < p1; ++p) {
+                const std::uint64_t here = count[c * parts + p];
+                offset[c * parts + p] = pos[p - p0];
+                pos[p - p0] += here;
+            }
+    });
     ByteBuffer sorted_buf(n * sizeof(Sorted));
     auto* sorted = reinterpret_cast<Sorted*>(sorted_buf.data());
     tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
@@ -160,7 +175,7 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
         std::uint64_t used[(1u << kPartBits) / 64] = {};
         std::uint64_t distinct = 0;
         for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
-            const unsigned k = sorted[i].bucket;
+            const auto k = static_cast<unsigned>(local_of(sorted[i]));
             distinct += !(used[k / 64] >> (k % 64) & 1);
             used[k / 64] |= std::uint64_t{1} << (k % 64);
         }
@@ -170,7 +185,8 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     for (std::uint64_t p = 0; p < parts; ++p) over_start[p + 1] = over_start[p] + over_count[p];
 
     // The payload, a group of partitions at a time: each group's buckets and overflow entries
-    // are two contiguous ranges of it, built in a buffer that is reused, then handed to the sink.
+    // are two contiguous ranges of it, built in one of two buffers, then handed to the sink
+    // while the next group is built in the other (the write is one thread's work).
     sink.reserve(kHeader + over_start[parts] * sizeof(Hash14Entry));
     sink.write_at(0, &buckets, kHeader);
     constexpr std::uint64_t kGroup = 64;  // partitions: about 8 MB of entries
@@ -179,11 +195,13 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
         const std::uint64_t g1 = std::min(parts, g + kGroup);
         most = std::max(most, (b0(g1) - b0(g)) + (over_start[g1] - over_start[g]));
     }
-    ByteBuffer stage_buf(most * sizeof(Hash14Entry));
-    auto* stage = reinterpret_cast<Hash14Entry*>(stage_buf.data());
+    ByteBuffer stage_bufs[2] = {ByteBuffer(most * sizeof(Hash14Entry)),
+                                ByteBuffer(most * sizeof(Hash14Entry))};
+    tbb::task_group writing;  // destroyed first: it waits for its write before the buffers go
     for (std::uint64_t g = 0; g < parts; g += kGroup) {
         const std::uint64_t g1 = std::min(parts, g + kGroup);
         const std::uint64_t nb = b0(g1) - b0(g);
+        auto* stage = reinterpret_cast<Hash14Entry*>(stage_bufs[g / kGroup % 2].data());
         // The stage holds the group's buckets, then its overflow entries.
         Hash14Entry* const over_stage = stage + nb;
         tbb::parallel_for(g, g1, [&](std::uint64_t p) {
@@ -194,7 +212,7 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
             for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
                 const Sorted& h = sorted[i];
                 const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, kEnd};
-                Hash14Entry& head = part_out[h.bucket];
+                Hash14Entry& head = part_out[local_of(h)];
                 if (head.a == 0xFFFF) {
                     head = e;
                     continue;
@@ -206,10 +224,14 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
                 head.next = static_cast<std::uint32_t>(next_over++);
             }
         });
-        sink.write_at(kHeader + b0(g) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
-        sink.write_at(kHeader + over_start[g] * sizeof(Hash14Entry), stage + nb,
-                      (over_start[g1] - over_start[g]) * sizeof(Hash14Entry));
+        writing.wait();  // the previous group's write, from the other buffer (rethrows its error)
+        writing.run([&sink, &b0, &over_start, stage, nb, g, g1] {
+            sink.write_at(kHeader + b0(g) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
+            sink.write_at(kHeader + over_start[g] * sizeof(Hash14Entry), stage + nb,
+                          (over_start[g1] - over_start[g]) * sizeof(Hash14Entry));
+        });
     }
+    writing.wait();
 }
 
 Hash14Table::Hash14Table(const std::uint8_t* payload, std::size_t size, std::uint64_t entries)
