@@ -12,19 +12,18 @@ namespace {
 // How much nearer the light than a point a crossing must lie to shadow it, in footprints (the
 // wider of the point's own and the map's texel there): the point's own object is left out, but
 // a sheet's blended point lies within about a footprint of its neighbours' crossings, which the
-// filtered tables blend into it. Of 0.5 to 4 tried on the bunny's fur, 1.5 was the most
-// faithful; less leaves the fur too dark, 2 and more too bright (bench/notes/scale-log.md).
+// filtered tables blend into it. The most faithful of those tried on the bunny's fur
+// (bench/notes/scale-log.md).
 constexpr double kBiasFootprints = 1.5;
 
 // Texels a side for a map from `light` over the sphere around `target` whose texel at its centre
 // is as wide as a camera sample's footprint there.
 int matched_size(const Camera& camera, Vec3 light, const Bounds3& target, double spread) {
-    const Vec3 centre = target.center();
-    const double radius = length(target.extent()) * 0.5, dist = length(centre - light);
-    const double sample = spread * length(centre - camera.eye);
-    if (!(dist > radius) || !(sample > 0)) return InstanceShadows::kMinSize;
-    const double across = 2 * radius * dist / std::sqrt(dist * dist - radius * radius);
-    return static_cast<int>(std::clamp(std::ceil(across / sample), double(InstanceShadows::kMinSize),
+    const MapFrame f = MapFrame::aimed(light, target);
+    const double sample = spread * length(target.center() - camera.eye);
+    const double texels = f.width_at_centre() / sample;
+    if (!f.valid || !std::isfinite(texels)) return InstanceShadows::kMinSize;
+    return static_cast<int>(std::clamp(std::ceil(texels), double(InstanceShadows::kMinSize),
                                        double(InstanceShadows::kMaxSize)));
 }
 
@@ -46,9 +45,11 @@ Bounds3 instance_bounds(const TracedScene& rs) {
     return b;
 }
 
-InstanceShadows::InstanceShadows(const TracedScene& rs,
+InstanceShadows::InstanceShadows(const TracedScene& rs, const Bounds3& target,
                                  const TracedScene::InstanceShapeFn& instance_shape,
-                                 const AccelOptions& accel, int size, double spread) {
+                                 const AccelOptions& accel, int size, double spread,
+                                 std::uint64_t max_bytes)
+    : budget_(std::make_unique<MapBudget>(max_bytes)) {
     const Scene& s = rs.scene();
     base_scene_ = std::make_unique<Scene>(base_scene(s));
     AccelOptions quiet = accel;
@@ -58,13 +59,12 @@ InstanceShadows::InstanceShadows(const TracedScene& rs,
     std::uint32_t next = 0;
     for (std::size_t i = 0; i < s.objects.size(); ++i)
         if (s.objects[i].primitive < 0) base_object_[i] = next++;
-    const Bounds3 target = instance_bounds(rs);
     maps_.reserve(s.lights.size());
     for (std::size_t i = 0; i < s.lights.size(); ++i) {
         const Vec3 light = s.lights[i].position;
         maps_.emplace_back(rs, light, target,
                            size > 0 ? size : matched_size(s.camera, light, target, spread),
-                           "lights[" + std::to_string(i) + "]");
+                           "lights[" + std::to_string(i) + "]", *budget_);
     }
 }
 

@@ -14,16 +14,20 @@ namespace lat {
 
 class InstanceShadows {
 public:
-    // The maps of rs's instances (traced as rs traces them), and the base traced with the same
-    // instance shapes (a CSG of instances, part of the base, keeps its lattices). Each map is
-    // `size` texels a side, or with size 0 as many as make a texel at the instances' centre as
-    // wide as a camera sample's footprint there (`spread`: its width per unit distance,
-    // PinholeCamera::spread), within kMinSize to kMaxSize. A light within the instances'
-    // bounding sphere gets no map: its shadow rays go through the instances as without maps.
-    InstanceShadows(const TracedScene& rs, const TracedScene::InstanceShapeFn& instance_shape,
-                    const AccelOptions& accel, int size, double spread);
-    static constexpr int kMinSize = 64, kMaxSize = 4096;
+    // The maps of rs's instances, lying in `target` (instance_bounds), traced as rs traces them;
+    // and the base, traced with the same instance shapes (a CSG of instances, part of the base,
+    // keeps its lattices). Each map is `size` texels a side, or with size 0 as many as make a
+    // texel at the instances' centre as wide as a camera sample's footprint there (`spread`: its
+    // width per unit distance, PinholeCamera::spread), within kMinSize to kMaxSize. A light
+    // within the instances' bounding sphere gets no map: its shadow rays go through the
+    // instances as without maps. The maps take at most max_bytes together (MapBudget).
+    InstanceShadows(const TracedScene& rs, const Bounds3& target,
+                    const TracedScene::InstanceShapeFn& instance_shape, const AccelOptions& accel,
+                    int size, double spread, std::uint64_t max_bytes = kMaxBytes);
     ~InstanceShadows();
+
+    static constexpr int kMinSize = 64, kMaxSize = 4096;
+    static constexpr std::uint64_t kMaxBytes = std::uint64_t{2} << 30;
 
     bool mapped(std::size_t light) const { return maps_[light].valid(); }
     // The share of light `light` (mapped) reaching the start of shadow ray r (tmin to tmax, as
@@ -45,6 +49,7 @@ private:
     std::unique_ptr<Scene> base_scene_;
     std::unique_ptr<TracedScene> base_;
     std::vector<std::uint32_t> base_object_;  // rs's object -> base's (kNoObject: an instance)
+    std::unique_ptr<MapBudget> budget_;
     std::vector<DeepShadowMap> maps_;
 };
 

@@ -1,6 +1,5 @@
 #include "render/layers.h"
 
-
 #include <cmath>
 
 #include "render/instance_shadows.h"

@@ -84,6 +84,27 @@ ModeResult::ShadowMaps shadow_map_report(const InstanceShadows& maps, std::size_
     return m;
 }
 
+// Lattice mode's deep shadow maps, made into `maps` when asked for and there is something to
+// map (instances, lights, shadows); the time of their base accelerator is r's build time.
+void make_instance_shadows(const TracedScene& rs, const LatticeFiltering& filtering,
+                           const ModeSettings& settings,
+                           const TracedScene::InstanceShapeFn& instance_shape,
+                           const AccelOptions& accel, std::optional<InstanceShadows>& maps,
+                           ModeResult& r) {
+    const Scene& scene = rs.scene();
+    // Maps of tables only: sheets of sub-rays (auto mode's cheap primitives, exact mode's
+    // footprint) want a shadow ray's own footprint (bench/notes/scale-log.md).
+    if (filtering.policy != LatticePolicy::kTables || !scene.shadows || scene.lights.empty() ||
+        settings.instance_shadows != InstanceShadowing::kDeepMap)
+        return;
+    const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = cpu_seconds();
+    if (const Bounds3 target = instance_bounds(rs); !target.empty())
+        maps.emplace(rs, target, instance_shape, accel, settings.shadow_map_size, filtering.spread);
+    r.build_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    r.build_cpu_ms += (cpu_seconds() - cpu0) * 1e3;
+}
+
 }  // namespace
 
 bool answers_instances(RenderMode mode, bool footprint) {
@@ -143,17 +164,13 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             const TracedScene rs(scene, instance_shape, accel, r.lattices.widest_footprints);
             r.build_ms = ms_since(t0);
             r.build_cpu_ms = (cpu_seconds() - cpu0) * 1e3;
-            dist::mark(dist::Step::kAccel);
-            if (settings.before_render) settings.before_render();
             // Partial hits are traced in layers, chosen here once: a filter makes them
             // (footprint filtering's is smooth); point-sampled tables and exact shapes have none.
             const bool layered = filtering && filtering->filter != LatticeFilter::kNone;
             std::optional<InstanceShadows> maps;
-            // Maps of tables only: sheets of sub-rays (auto mode's cheap primitives, exact mode's
-            // footprint) want a shadow ray's own footprint (docs/scale.md).
-            if (layered && filtering->policy == LatticePolicy::kTables && scene.shadows &&
-                settings.instance_shadows == InstanceShadowing::kDeepMap)
-                maps.emplace(rs, instance_shape, accel, settings.shadow_map_size, filtering->spread);
+            if (layered) make_instance_shadows(rs, *filtering, settings, instance_shape, accel, maps, r);
+            dist::mark(dist::Step::kAccel);
+            if (settings.before_render) settings.before_render();
             r.out = layered ? render_layered(rs, opt, maps ? &*maps : nullptr) : render_exact(rs, opt);
             if (maps) {
                 r.shadow_maps = shadow_map_report(*maps, scene.lights.size());

@@ -66,7 +66,8 @@ struct ModeSettings {
 struct ModeResult {
     RenderOutput out;
     double prepare_ms = 0;  // tables loaded or built, maps baked, particles made
-    double build_ms = 0;    // the acceleration structure (exact and lattice modes)
+    double build_ms = 0;    // the acceleration structures (exact and lattice modes; the deep
+                            // shadow maps' base accelerator)
     double build_cpu_ms = 0;  // its CPU time, all threads
     // Bytes the mode adds to the scene without its instances: the instances' exact geometry
     // (primitive parts and one transform per instance), plus the tables in lattice mode; the

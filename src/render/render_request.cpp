@@ -247,10 +247,15 @@ std::vector<std::string> option_notes(const RenderRequest& r,
     const bool tables = r.render_mode() == RenderMode::kLattice || r.render_mode() == RenderMode::kAuto;
     if (tables && r.lattice_filter() == LatticeFilter::kNone && given("--lod"))
         notes.push_back("--lod has no effect with --filter none (point-sampled tables have one level)");
+    const bool deep_maps = r.lattice_filter() != LatticeFilter::kNone &&
+                           kInstanceShadowing.at(r.instance_shadows) == InstanceShadowing::kDeepMap;
     if (r.render_mode() == RenderMode::kLattice && r.lattice_filter() == LatticeFilter::kNone &&
         given("--instance-shadows"))
         notes.push_back("--instance-shadows has no effect with --filter none (point-sampled "
                         "tables cast shadows by shadow rays)");
+    if (r.render_mode() == RenderMode::kLattice && !deep_maps && given("--shadow-map-size"))
+        notes.push_back("--shadow-map-size has no effect in lattice mode without "
+                        "--instance-shadows deep-map and a filter");
     if (tables && given("--lod-budget") && (r.lattice_filter() == LatticeFilter::kNone || !kOnOff.at(r.lod)))
         notes.push_back("--lod-budget has no effect without levels of detail (--lod on and a filter)");
     return notes;
