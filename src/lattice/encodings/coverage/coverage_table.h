@@ -6,7 +6,7 @@
 // rendering uses. The hit is a record of 16-bit fields: its t and normal (6 bytes); the coverage
 // a 32-bit word (4 bytes): alpha in 1/255, the mean t in 1/1023 and the mean normal
 // octahedral in 7 + 7 bits. A coverage is a mean over a cell-wide bundle, blended with its
-// neighbours: those steps (a third of an 8-bit pixel's in alpha, about 1.3 degrees of normal)
+// neighbours: its errors (at most half an 8-bit step of alpha, 1.3 degrees of normal)
 // do not show in images, and the word halves the bytes filtered rendering reads.
 //
 // Pairs are filed in slots where neighbours in ray space are neighbours in memory (pair_index.h:
