@@ -8,9 +8,11 @@
 #include <cstring>
 #include <map>
 
+#include "coverage_checks.h"
 #include "hook_primitive.h"
 #include "lattice/coverage.h"
 #include "lattice/encoding.h"
+#include "lattice/encodings/coverage/coverage_table.h"
 #include "lattice/encodings/coverage/pair_index.h"
 #include "lattice/octahedral.h"
 #include "lattice/rasterizer.h"
@@ -140,37 +142,44 @@ TEST(PairIndex, TableAnswersEveryPairAsItsInputs) {
             // A pair whose own segment hits is stored even if none of its sub-rays does: an
             // alpha of 0 is not an answer.
             const auto cov = cover.find({a, b});
-            const long alpha = cov == cover.end() ? 0 : std::lround(double(cov->second.alpha) * 65535.0);
-            ASSERT_EQ(table->coverage(a, b, c), alpha != 0) << a << " " << b;
+            ASSERT_EQ(table->coverage(a, b, c), cov != cover.end()) << a << " " << b;
             table->coverage_many(&a, &b, 1, &many, &found, true);
-            ASSERT_EQ(found, alpha != 0);
-            if (alpha == 0) continue;
-            EXPECT_EQ(c.alpha, double(alpha) / 65535.0);
-            EXPECT_EQ(c.t, t_of(cov->second.t));
-            EXPECT_EQ(c.normal, oct_decode({cov->second.nu, cov->second.nv}, kRawNormalBits));
+            ASSERT_EQ(found, cov != cover.end());
+            if (cov == cover.end()) continue;
+            CoverageHit kept;
+            CoverageTable::unpack_cover(CoverageTable::pack_cover(cov->second), kept, true);
+            EXPECT_EQ(c.alpha, kept.alpha);
+            EXPECT_EQ(c.t, kept.t);
+            EXPECT_EQ(c.normal, kept.normal);
+            test::expect_within_quantisation(c, cov->second);
             EXPECT_EQ(many.alpha, c.alpha);
             EXPECT_EQ(many.t, c.t);
             EXPECT_EQ(many.normal, c.normal);
         }
 }
 
-// A table of the layout before (tag COVER1, pairs indexed a * N + b) is refused, not misread
-// (the table cache never opens one: the layout is part of the file names it looks for).
+// Tables of the layouts before (tag COVER1, pairs indexed a * N + b; COVER2, coverage
+// records of 8 bytes) are refused, not misread (the table cache never opens one: the layout is
+// part of the file names it looks for).
 TEST(PairIndex, OlderLayoutIsRefused) {
     const TableContext& ctx = test::kHookContext;
     const Encoding& e = find_encoding("coverage");
     HookTable hook = hook_table();
     const RasterizeResult& raster = hook.raster;
     ByteBuffer& payload = hook.payload;
-    ASSERT_EQ(std::memcmp(payload.data(), "COVER2", 6), 0);
-    payload.data()[5] = '1';
-    try {
-        e.open(payload.data(), payload.size(), raster.hits, ctx);
-        FAIL() << "opened";
-    } catch (const std::runtime_error& err) {
-        EXPECT_NE(std::string(err.what()).find("older layout (COVER1)"), std::string::npos) << err.what();
+    ASSERT_EQ(std::memcmp(payload.data(), "COVER3", 6), 0);
+    for (const char old : {'1', '2'}) {
+        payload.data()[5] = static_cast<std::uint8_t>(old);
+        try {
+            e.open(payload.data(), payload.size(), raster.hits, ctx);
+            FAIL() << "opened";
+        } catch (const std::runtime_error& err) {
+            EXPECT_NE(std::string(err.what()).find(std::string("older layout (COVER") + old + ")"),
+                      std::string::npos)
+                << err.what();
+        }
     }
-    EXPECT_GT(e.layout, 1);
+    EXPECT_GT(e.layout, 2);
 }
 
 }  // namespace

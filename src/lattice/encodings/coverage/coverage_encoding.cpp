@@ -14,12 +14,13 @@ const Encoding kCoverageEncoding{
     // (about N^2: the valid pairs and the tiles' padding) stay few enough to index.
     .max_points = 0xFFFFull,
     // While building: the rasterized hit (20 bytes), about 1.5 coverage samples of 20 bytes, and
-    // the records (14 bytes, up to twice that with the empty slots of their groups), per stored
+    // the records (10 bytes, up to twice that with the empty slots of their groups), per stored
     // hit.
     .bytes_per_hit = 72.0,
     .needs_hits = true,
     .coverage = true,
-    .layout = 2,  // 2: pairs filed by face pair in tiles (pair_index.h); 1: a * N + b
+    .layout = 3,  // 3: 4-byte coverage records; 2: 8-byte ones, pairs filed by face pair in
+                 // tiles (pair_index.h); 1: a * N + b
     .build = &CoverageTable::build,
     .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                const TableContext& ctx) -> std::unique_ptr<LatticeTable> {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -15,16 +16,21 @@
 namespace lat {
 namespace {
 
-constexpr std::uint64_t kMagic = 0x3252'4556'4F43ull;  // "COVER2"
-// The layout before (pairs indexed a * N + b, with a rank directory): refused with a word on
-// what to do (the table cache never meets one: Encoding::layout is in its file names).
-constexpr std::uint64_t kOldMagic = 0x3152'4556'4F43ull;  // "COVER1"
+constexpr std::uint64_t kMagic = 0x3352'4556'4F43ull;  // "COVER3"
+// The layouts before, refused with a word on what to do (the table cache never meets one:
+// Encoding::layout is in its file names): "COVER1", pairs indexed a * N + b with a rank
+// directory; "COVER2", coverage records of four 16-bit fields. Their tags differ from this
+// one in the last character alone.
+constexpr std::uint64_t kOldMagics[] = {0x3152'4556'4F43ull, 0x3252'4556'4F43ull};
 constexpr std::size_t kHitBytes = CoverageTable::kHitBytes, kCoverBytes = CoverageTable::kCoverBytes;
 constexpr int kGroupSlots = CoverageTable::kGroupSlots;
 constexpr double kTScale = 65534.0;
-constexpr double kAlphaScale = 65535.0;
-// A coverage record's fields.
-enum { kCoverT, kCoverNu, kCoverNv, kCoverAlpha };
+constexpr std::uint32_t kAlphaTop = (1u << CoverageTable::kAlphaBits) - 1;
+constexpr std::uint32_t kMeanTTop = (1u << CoverageTable::kMeanTBits) - 1;
+constexpr std::uint32_t kMeanNormalTop = (1u << CoverageTable::kMeanNormalBits) - 1;
+constexpr int kMeanTShift = CoverageTable::kAlphaBits;
+constexpr int kNuShift = kMeanTShift + CoverageTable::kMeanTBits;
+constexpr int kNvShift = kNuShift + CoverageTable::kMeanNormalBits;
 
 struct Header {
     std::uint64_t magic;
@@ -63,6 +69,12 @@ std::uint16_t field(const std::uint8_t* rec, int f) {
     return v;
 }
 
+std::uint32_t cover_of(const std::uint8_t* rec) {
+    std::uint32_t v;
+    std::memcpy(&v, rec, 4);
+    return v;
+}
+
 std::uint16_t quantise_t(double t) {
     return static_cast<std::uint16_t>(std::lround(std::clamp(t, 0.0, 1.0) * kTScale));
 }
@@ -71,6 +83,7 @@ std::uint16_t quantise_t(double t) {
 struct Entry {
     std::uint64_t pair;
     std::array<std::uint16_t, CoverageTable::kFields> f;
+    std::uint32_t cover;
 };
 
 // The records of a table: the rasterized hits and the coverage samples merged by pair, filed
@@ -84,7 +97,7 @@ std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
     for (const auto& chunk : hits.chunks)
         for (const RawHit& h : chunk) {
             const std::uint16_t t = quantise_t(static_cast<double>(h.t));
-            entries.push_back({h.a * n + h.b, {t, h.nu, h.nv, 0, 0, 0, 0}});
+            entries.push_back({h.a * n + h.b, {t, h.nu, h.nv}, 0});
         }
     const auto by_pair = [](const Entry& x, const Entry& y) { return x.pair < y.pair; };
     std::sort(entries.begin(), entries.end(), by_pair);
@@ -99,12 +112,10 @@ std::vector<Entry> entries_by_slot(const RawHits& hits, const TableContext& ctx,
         if (next < centers && entries[next].pair == pair) {
             e = &entries[next];
         } else {
-            entries.push_back({pair, {kNoHit, 0, 0, 0, 0, 0, 0}});
+            entries.push_back({pair, {kNoHit, 0, 0}, 0});
             e = &entries.back();
         }
-        e->f[CoverageTable::kMeanT] = quantise_t(static_cast<double>(c.t));
-        e->f[CoverageTable::kMeanNu] = c.nu, e->f[CoverageTable::kMeanNv] = c.nv;
-        e->f[CoverageTable::kAlpha] = static_cast<std::uint16_t>(std::lround(double(c.alpha) * kAlphaScale));
+        e->cover = CoverageTable::pack_cover(c);
     }
     for (Entry& e : entries) {
         e.pair = index.slot(static_cast<std::uint32_t>(e.pair / n), static_cast<std::uint32_t>(e.pair % n));
@@ -145,8 +156,8 @@ ByteBuffer CoverageTable::build(const RawHits& hits, const TableContext& ctx, co
         }
         const std::uint64_t j = entries[i].pair % kGroupSlots;
         std::memcpy(hit + j * kHitBytes, entries[i].f.data(), kHitBytes);
-        std::memcpy(out.data() + s.covers + (k * kGroupSlots + j) * kCoverBytes,
-                    entries[i].f.data() + kMeanT, kCoverBytes);
+        std::memcpy(out.data() + s.covers + (k * kGroupSlots + j) * kCoverBytes, &entries[i].cover,
+                    kCoverBytes);
     }
     return out;
 }
@@ -160,7 +171,10 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
     if (size < sizeof(Header)) fail("shorter than its header");
     Header h;
     std::memcpy(&h, payload, sizeof h);
-    if (h.magic == kOldMagic) fail("an older layout (COVER1); rebuild the table");
+    for (const std::uint64_t old : kOldMagics)
+        if (h.magic == old)
+            throw std::runtime_error(std::string("coverage payload: an older layout (COVER") +
+                                     static_cast<char>(old >> 40) + "); rebuild the table");
     if (h.magic != kMagic) fail("bad tag");
     if (h.points != index_.grid().count()) fail("boundary point count differs from the lattice's");
     if (h.slots != index_.slots()) fail("slot count differs from the lattice's");
@@ -209,7 +223,6 @@ void CoverageTable::check_records(const std::uint64_t* kept) {
     auto fail = [](const char* why) {
         throw std::runtime_error(std::string("coverage payload: ") + why);
     };
-    constexpr std::uint8_t kNoCover[kCoverBytes] = {};
     static_assert(PairIndex::kTileSlots == 16 * kGroupSlots);  // a tile's bits: 16 of a word
     const std::uint64_t tiles = index_.slots() / PairIndex::kTileSlots;
     std::uint64_t count = 0, centers = 0, group = 0;
@@ -223,20 +236,21 @@ void CoverageTable::check_records(const std::uint64_t* kept) {
             for (unsigned j = 0; j < kGroupSlots; ++j) {
                 const Place p{group, j, true};
                 const std::uint8_t *c = cover_at(p), *h = hit_at(p);
-                const std::uint16_t tt = field(h, kT), alpha = field(c, kCoverAlpha);
+                const std::uint16_t tt = field(h, kT);
+                const std::uint32_t cover = cover_of(c), alpha = cover & kAlphaTop;
+                // (Every value of a coverage record's fields is in range.)
+                if (alpha == 0 && cover != 0) fail("a coverage record without alpha not empty");
                 if (tt == kNoHit && alpha == 0) {
-                    if (field(h, kNu) || field(h, kNv) || std::memcmp(c, kNoCover, kCoverBytes))
-                        fail("an empty slot's records not empty");
+                    if (field(h, kNu) || field(h, kNv)) fail("an empty slot's records not empty");
                     continue;
                 }
-                if ((tt != kNoHit && tt > kTScale) || field(c, kCoverT) > kTScale)
-                    fail("a record out of range");
+                if (tt != kNoHit && tt > kTScale) fail("a record out of range");
                 const unsigned inner = g * kGroupSlots + j;
                 stored[inner / 64] |= std::uint64_t{1} << (inner % 64);
                 ++in_group;
                 centers += tt != kNoHit;
-                partial_ += alpha > 0 && alpha < kAlphaScale;
-                alpha_sum_ += alpha / kAlphaScale;
+                partial_ += alpha > 0 && alpha < kAlphaTop;
+                alpha_sum_ += double(alpha) / kAlphaTop;
             }
             if (!in_group) fail("a kept group without records");
             count += static_cast<unsigned>(in_group);
@@ -263,16 +277,30 @@ bool CoverageTable::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) cons
     return true;
 }
 
-void CoverageTable::decode(const std::uint8_t* c, CoverageHit& hit, bool normal) {
-    hit.alpha = field(c, kCoverAlpha) / kAlphaScale;
-    hit.t = field(c, kCoverT) / kTScale;
-    if (normal) hit.normal = oct_decode({field(c, kCoverNu), field(c, kCoverNv)}, kRawNormalBits);
+std::uint32_t CoverageTable::pack_cover(const CoverageSample& c) {
+    assert(c.alpha > 0);
+    // At least one step: a sample kept has alpha >= kCoverageMinAlpha, several steps.
+    const auto alpha = std::max<std::uint32_t>(
+        1, static_cast<std::uint32_t>(std::lround(std::clamp(double(c.alpha), 0.0, 1.0) * kAlphaTop)));
+    const auto t = static_cast<std::uint32_t>(std::lround(std::clamp(double(c.t), 0.0, 1.0) * kMeanTTop));
+    const Oct o = oct_encode_precise(oct_decode({c.nu, c.nv}, kRawNormalBits), kMeanNormalBits);
+    return alpha | t << kMeanTShift | o.u << kNuShift | o.v << kNvShift;
+}
+
+void CoverageTable::unpack_cover(std::uint32_t cover, CoverageHit& hit, bool normal) {
+    hit.alpha = (cover & kAlphaTop) / double(kAlphaTop);
+    hit.t = (cover >> kMeanTShift & kMeanTTop) / double(kMeanTTop);
+    if (normal)
+        hit.normal = oct_decode({cover >> kNuShift & kMeanNormalTop, cover >> kNvShift & kMeanNormalTop},
+                                kMeanNormalBits);
 }
 
 bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const {
     const Place p = place(a, b);
-    if (!p.kept || field(cover_at(p), kCoverAlpha) == 0) return false;
-    decode(cover_at(p), hit, true);
+    if (!p.kept) return false;
+    const std::uint32_t cover = cover_of(cover_at(p));
+    if ((cover & kAlphaTop) == 0) return false;
+    unpack_cover(cover, hit, true);
     return true;
 }
 
@@ -292,8 +320,9 @@ void CoverageTable::coverage_at(const std::uint64_t* ref, int n, CoverageHit* ou
                                 bool normals) const {
     for (int i = 0; i < n; ++i) {
         const auto* c = reinterpret_cast<const std::uint8_t*>(static_cast<std::uintptr_t>(ref[i]));
-        found[i] = c && field(c, kCoverAlpha) != 0;
-        if (found[i]) decode(c, out[i], normals);
+        const std::uint32_t cover = c ? cover_of(c) : 0;
+        found[i] = (cover & kAlphaTop) != 0;
+        if (found[i]) unpack_cover(cover, out[i], normals);
     }
 }
 

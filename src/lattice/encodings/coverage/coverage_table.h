@@ -3,14 +3,17 @@
 // hit of the pair's own segment, as every table does (lookup: what point sampling, CSG, inside
 // tests and certification use), and the pair's coverage (lattice/coverage.h): the share of the
 // sub-rays snapping to the pair that meet the primitive and their mean hit, which filtered
-// rendering uses. Each is a record of 16-bit fields: the hit's t and normal (6 bytes), the
-// coverage's mean t, mean normal and alpha in 1/65535 (8 bytes).
+// rendering uses. The hit is a record of 16-bit fields: its t and normal (6 bytes); the coverage
+// a 32-bit word (4 bytes): alpha in 1/255, the mean t in 1/1023 and the mean normal
+// octahedral in 7 + 7 bits. A coverage is a mean over a cell-wide bundle, blended with its
+// neighbours: its errors (at most half an 8-bit step of alpha, 1.3 degrees of normal)
+// do not show in images, and the word halves the bytes filtered rendering reads.
 //
 // Pairs are filed in slots where neighbours in ray space are neighbours in memory (pair_index.h:
 // tiles of 256 slots, each 16 consecutive slots a 2 x 2 x 2 x 2 cell of the 4-D grid of entry
 // and exit points). Records are kept densely for every group of 16 slots that holds a stored
 // pair (an empty slot's records say so), with a bit per group saying whether it is kept; the
-// groups' coverage records (128 bytes a group: two cache lines) apart from their hits, which
+// groups' coverage records (64 bytes a group: one cache line) apart from their hits, which
 // filtered rendering does not read. Read through rank lines built at open (a line: the rank
 // of its first bit and 448 bits; 1 MB at sigma^-1 = 4 for Plate 4's hair, where one bit per
 // pair took 16 MB), a pair's record is found from a line that is often in cache: about one
@@ -19,6 +22,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "lattice/coverage.h"
 #include "lattice/encoding.h"
 #include "lattice/encodings/coverage/pair_index.h"
 #include "lattice/table.h"
@@ -43,11 +47,18 @@ public:
     std::uint64_t entries() const override { return entries_; }
     std::uint64_t bytes() const override { return size_; }
 
-    // The fields of a pair, in this order: its hit record, then its coverage record.
-    enum Field { kT, kNu, kNv, kMeanT, kMeanNu, kMeanNv, kAlpha, kFields };
-    static constexpr std::size_t kHitBytes = kMeanT * 2, kCoverBytes = (kFields - kMeanT) * 2;
+    // The fields of a pair's hit record, 16 bits each.
+    enum Field { kT, kNu, kNv, kFields };
+    static constexpr std::size_t kHitBytes = kFields * 2, kCoverBytes = 4;
     static constexpr std::uint16_t kNoHit = 0xFFFF;  // kT of a pair whose own segment misses
     static constexpr int kGroupSlots = PairIndex::kCellSlots;
+    // A coverage record's fields: their widths in bits, from bit 0 up in this order.
+    static constexpr int kAlphaBits = 8, kMeanTBits = 10, kMeanNormalBits = 7;
+    static_assert(kAlphaBits + kMeanTBits + 2 * kMeanNormalBits == 8 * kCoverBytes);
+    // A sample (alpha > 0) as its record, and a record back (alpha 0: no coverage). normal:
+    // false when only alpha and t are wanted.
+    static std::uint32_t pack_cover(const CoverageSample& c);
+    static void unpack_cover(std::uint32_t cover, CoverageHit& hit, bool normal);
 
 private:
     // A line of the kept-group bits: the rank of its first bit and the 448 that follow.
@@ -96,7 +107,6 @@ private:
     const std::uint8_t* hit_at(const Place& p) const {
         return hits_ + (p.group * kGroupSlots + p.slot) * kHitBytes;
     }
-    static void decode(const std::uint8_t* cover, CoverageHit& hit, bool normal);
 };
 
 }  // namespace lat
