@@ -81,39 +81,19 @@ double InstanceShadows::visible(std::size_t light, const Ray& r, double tmin, do
     return base * map.transmittance(r.o, bias, self);
 }
 
-std::size_t InstanceShadows::lights_mapped() const {
-    return static_cast<std::size_t>(std::count_if(maps_.begin(), maps_.end(),
-                                                  [](const DeepShadowMap& m) { return m.valid(); }));
-}
-
-std::vector<int> InstanceShadows::sizes() const {
-    std::vector<int> out;
-    for (const DeepShadowMap& m : maps_) out.push_back(m.valid() ? m.size() : 0);
-    return out;
-}
-
-std::uint64_t InstanceShadows::bytes() const {
-    std::uint64_t b = 0;
-    for (const DeepShadowMap& m : maps_) b += m.bytes();
-    return b;
-}
-
-std::uint64_t InstanceShadows::knots() const {
-    std::uint64_t n = 0;
-    for (const DeepShadowMap& m : maps_) n += m.knots();
-    return n;
-}
-
-std::uint64_t InstanceShadows::tiles() const {
-    std::uint64_t n = 0;
-    for (const DeepShadowMap& m : maps_) n += m.valid() ? m.tiles() : 0;
-    return n;
-}
-
-std::uint64_t InstanceShadows::tiles_traced() const {
-    std::uint64_t n = 0;
-    for (const DeepShadowMap& m : maps_) n += m.tiles_traced();
-    return n;
+ShadowMapReport InstanceShadows::report() const {
+    ShadowMapReport r;
+    r.lights = maps_.size();
+    for (const DeepShadowMap& m : maps_) {
+        r.sizes.push_back(m.valid() ? m.size() : 0);
+        if (!m.valid()) continue;
+        ++r.lights_mapped;
+        r.tiles += m.tiles();
+        r.tiles_traced += m.tiles_traced();
+        r.bytes += m.bytes();
+        r.knots += m.knots();
+    }
+    return r;
 }
 
 }  // namespace lat

@@ -12,6 +12,15 @@
 
 namespace lat {
 
+// What a render's maps came to, once it has traced what it needed: lights mapped, texels a
+// side of each light's map (0: none), their tiles and those traced (DeepShadowMap::kTile),
+// knots and bytes.
+struct ShadowMapReport {
+    std::size_t lights = 0, lights_mapped = 0;
+    std::vector<int> sizes;
+    std::uint64_t tiles = 0, tiles_traced = 0, bytes = 0, knots = 0;
+};
+
 class InstanceShadows {
 public:
     // The maps of rs's instances, lying in `target` (instance_bounds), traced as rs traces them;
@@ -36,14 +45,7 @@ public:
     double visible(std::size_t light, const Ray& r, double tmin, double tmax, std::uint32_t self,
                    double width, EmbreeAccel::LastBlocker* last) const;
 
-    std::size_t lights_mapped() const;
-    // Texels a side of each light's map (0: none).
-    std::vector<int> sizes() const;
-    std::uint64_t bytes() const;
-    std::uint64_t knots() const;
-    // Tiles of the maps of mapped lights, and those traced so far (DeepShadowMap::kTile).
-    std::uint64_t tiles() const;
-    std::uint64_t tiles_traced() const;
+    ShadowMapReport report() const;
 
 private:
     std::unique_ptr<Scene> base_scene_;

@@ -71,19 +71,6 @@ std::optional<LatticeFiltering> lattice_policy(const Scene& scene, RenderMode mo
     return f;
 }
 
-// What the instances' deep shadow maps came to, once the render has traced what it needed.
-ModeResult::ShadowMaps shadow_map_report(const InstanceShadows& maps, std::size_t lights) {
-    ModeResult::ShadowMaps m;
-    m.lights = lights;
-    m.lights_mapped = maps.lights_mapped();
-    m.sizes = maps.sizes();
-    m.tiles = maps.tiles();
-    m.tiles_traced = maps.tiles_traced();
-    m.bytes = maps.bytes();
-    m.knots = maps.knots();
-    return m;
-}
-
 // Lattice mode's deep shadow maps, made into `maps` when asked for and there is something to
 // map (instances, lights, shadows); the time of their base accelerator is r's build time.
 void make_instance_shadows(const TracedScene& rs, const LatticeFiltering& filtering,
@@ -173,7 +160,7 @@ ModeResult render_in_mode(const Scene& scene, RenderMode mode, const ModeSetting
             if (settings.before_render) settings.before_render();
             r.out = layered ? render_layered(rs, opt, maps ? &*maps : nullptr) : render_exact(rs, opt);
             if (maps) {
-                r.shadow_maps = shadow_map_report(*maps, scene.lights.size());
+                r.shadow_maps = maps->report();
                 r.bytes_added += r.shadow_maps->bytes;
             }
             break;

@@ -14,6 +14,7 @@
 #include "lattice/cache/table_spec.h"
 #include "render/baselines/particle_mode.h"
 #include "render/core/renderer.h"
+#include "render/instance_shadows.h"
 #include "render/modes/scene_lattices.h"
 #include "render/baselines/texture_mode.h"
 
@@ -74,15 +75,9 @@ struct ModeResult {
     // maps in texture mode; the particle buffer in particle mode.
     std::uint64_t bytes_added = 0;
     SceneLattices lattices;  // lattice and auto modes, and exact mode's footprint filtering
-    // Deep shadow maps of the instances (InstanceShadowing::kDeepMap), when made: lights mapped,
-    // texels a side of each light's map (0: none), tiles traced (as the render needed them;
-    // their time is the render's) and bytes (in bytes_added).
-    struct ShadowMaps {
-        std::size_t lights = 0, lights_mapped = 0;
-        std::vector<int> sizes;
-        std::uint64_t tiles = 0, tiles_traced = 0, bytes = 0, knots = 0;
-    };
-    std::optional<ShadowMaps> shadow_maps;
+    // Deep shadow maps of the instances (InstanceShadowing::kDeepMap), when made (their bytes
+    // are in bytes_added; their tiles were traced within the render's time).
+    std::optional<ShadowMapReport> shadow_maps;
 };
 
 // Whether the mode answers instances by lattices (tables or sub-rays: SceneLattices) rather

@@ -94,7 +94,7 @@ nlohmann::json render_stats_json(const RenderRequest& a, const Scene& scene, con
         j["table_visits"] = st.count(stats::Counter::kLatticeVisits);
     }
     if (r.shadow_maps) {
-        const ModeResult::ShadowMaps& m = *r.shadow_maps;
+        const ShadowMapReport& m = *r.shadow_maps;
         j["instance_shadows"] = {{"by", "deep-map"},          {"sizes", m.sizes},
                                  {"lights", m.lights},        {"lights_mapped", m.lights_mapped},
                                  {"tiles", m.tiles},          {"tiles_traced", m.tiles_traced},
