@@ -159,16 +159,16 @@ TEST(PairIndex, TableAnswersEveryPairAsItsInputs) {
 }
 
 // Tables of the layouts before (tag COVER1, pairs indexed a * N + b; COVER2, coverage
-// records of 8 bytes) are refused, not misread (the table cache never opens one: the layout is
-// part of the file names it looks for).
+// records of 8 bytes; COVER3, records without the normals' spread) are refused, not misread
+// (the table cache never opens one: the layout is part of the file names it looks for).
 TEST(PairIndex, OlderLayoutIsRefused) {
     const TableContext& ctx = test::kHookContext;
     const Encoding& e = find_encoding("coverage");
     HookTable hook = hook_table();
     const RasterizeResult& raster = hook.raster;
     ByteBuffer& payload = hook.payload;
-    ASSERT_EQ(std::memcmp(payload.data(), "COVER3", 6), 0);
-    for (const char old : {'1', '2'}) {
+    ASSERT_EQ(std::memcmp(payload.data(), "COVER4", 6), 0);
+    for (const char old : {'1', '2', '3'}) {
         payload.data()[5] = static_cast<std::uint8_t>(old);
         try {
             e.open(payload.data(), payload.size(), raster.hits, ctx);
@@ -179,7 +179,7 @@ TEST(PairIndex, OlderLayoutIsRefused) {
                 << err.what();
         }
     }
-    EXPECT_GT(e.layout, 2);
+    EXPECT_GT(e.layout, 3);
 }
 
 }  // namespace

@@ -39,6 +39,8 @@ CoverageSample summarise(const BoundaryGrid& grid, std::uint32_t a, std::uint32_
     const double len = length(n.nsum);
     const Oct o = oct_encode(len > 1e-9 ? n.nsum / len : Vec3{0, 0, 1}, kRawNormalBits);
     s.nu = static_cast<std::uint16_t>(o.u), s.nv = static_cast<std::uint16_t>(o.v);
+    const double mean = std::min(1.0, len / n.hits);
+    s.spread = static_cast<std::uint8_t>(std::lround(255 * std::sqrt(1 - mean * mean)));
     return s;
 }
 

@@ -45,6 +45,11 @@ struct CoverageSample {
     // The normalised mean of the hits' unit normals, octahedral in kRawNormalBits bits a
     // component (tens of millions of samples are kept while a fine table is built).
     std::uint16_t nu = 0, nv = 0;
+    // How far the hits' unit normals spread about that mean: sqrt(1 - len^2) for a mean of
+    // length len, in 1/255 (0: all alike). A thin hair seen across a cell shows the half of
+    // it that faces the ray, whose normals' mean is about pi/4 long: the shading needs it
+    // (render/core/shading.h: diffuse_mean) and the direction alone would lose it.
+    std::uint8_t spread = 0;
 };
 
 // The n shifts (in cells, each coordinate in (-1/2, 1/2)) of the sub-rays on the entry face

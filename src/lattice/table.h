@@ -102,7 +102,7 @@ struct CandidateList {
 struct CoverageHit {
     double alpha = 0;  // in (0, 1]
     double t = 0;      // the mean hit point, projected on the segment p_a -> p_b
-    Vec3 normal;       // their mean unit normal
+    Vec3 normal;       // the mean of their unit normals: shorter than 1 where they spread
 };
 
 class LatticeTable {

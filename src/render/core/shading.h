@@ -37,10 +37,9 @@ struct ShadeState {
 // ("Mipmapping normal maps", 2005): for a mean normal of length len the exponent s becomes
 // s' = len s / (len + s (1 - len)), and the lobe is scaled by (s' + 1) / (s + 1) so that the
 // light it reflects stays the same (the integral of cos^s over the sphere is 2 pi / (s + 1)).
-// len is normal_length^kToksvigWidening: a lattice's mean normal blends its pairs' mean
-// normals, and a pair's own spread is lost (tables store its mean as a unit vector), so the
-// spread 1 - len is widened k times; k is the best of those tried on the fur plates
-// (bench/notes/shading-constants.md).
+// len is normal_length^kToksvigWidening: the lobe is widened more than the mean's length
+// alone says; k is the best of those tried on the fur plates (bench/notes/shading-constants.md),
+// and still the best of 1, 3 and 6 at a million hairs once tables kept their pairs' spread.
 inline constexpr double kToksvigWidening = 6;
 // E[max(0, X)] for X normal with mean len * nl and variance (1 - len^2) / 3 (see phong_term).
 inline double diffuse_mean(double nl, double len) {

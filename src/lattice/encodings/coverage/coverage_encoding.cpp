@@ -5,6 +5,9 @@
 
 namespace lat {
 
+// The build's memory estimate below counts the samples at this size.
+static_assert(sizeof(CoverageSample) == 24);
+
 extern const Encoding kCoverageEncoding;
 const Encoding kCoverageEncoding{
     .name = "coverage",
@@ -13,13 +16,13 @@ const Encoding kCoverageEncoding{
     // A point's tile on a face then fits the 24 bits pair_index.h gives it, and the slots
     // (about N^2: the valid pairs and the tiles' padding) stay few enough to index.
     .max_points = 0xFFFFull,
-    // While building: the rasterized hit (20 bytes), about 1.5 coverage samples of 20 bytes, and
+    // While building: the rasterized hit (20 bytes), about 1.5 coverage samples of 24 bytes, and
     // the records (10 bytes, up to twice that with the empty slots of their groups), per stored
     // hit.
-    .bytes_per_hit = 72.0,
+    .bytes_per_hit = 78.0,
     .needs_hits = true,
     .coverage = true,
-    .layout = 3,  // 3: 4-byte coverage records; 2: 8-byte ones, pairs filed by face pair in
+    .layout = 4,  // 4: 4-byte records with the normals' spread; 3: 4-byte coverage records without it; 2: 8-byte ones, pairs filed by face pair in
                  // tiles (pair_index.h); 1: a * N + b
     .build = &CoverageTable::build,
     .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,

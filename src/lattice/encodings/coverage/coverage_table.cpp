@@ -16,12 +16,12 @@
 namespace lat {
 namespace {
 
-constexpr std::uint64_t kMagic = 0x3352'4556'4F43ull;  // "COVER3"
+constexpr std::uint64_t kMagic = 0x3452'4556'4F43ull;  // "COVER4"
 // The layouts before, refused with a word on what to do (the table cache never meets one:
 // Encoding::layout is in its file names): "COVER1", pairs indexed a * N + b with a rank
-// directory; "COVER2", coverage records of four 16-bit fields. Their tags differ from this
-// one in the last character alone.
-constexpr std::uint64_t kOldMagics[] = {0x3152'4556'4F43ull, 0x3252'4556'4F43ull};
+// directory; "COVER2", coverage records of four 16-bit fields; "COVER3", 32-bit records
+// without the normals' spread. Their tags differ from this one in the last character alone.
+constexpr std::uint64_t kOldMagics[] = {0x3152'4556'4F43ull, 0x3252'4556'4F43ull, 0x3352'4556'4F43ull};
 constexpr std::size_t kHitBytes = CoverageTable::kHitBytes, kCoverBytes = CoverageTable::kCoverBytes;
 constexpr int kGroupSlots = CoverageTable::kGroupSlots;
 constexpr double kTScale = 65534.0;
@@ -31,6 +31,17 @@ constexpr std::uint32_t kMeanNormalTop = (1u << CoverageTable::kMeanNormalBits) 
 constexpr int kMeanTShift = CoverageTable::kAlphaBits;
 constexpr int kNuShift = kMeanTShift + CoverageTable::kMeanTBits;
 constexpr int kNvShift = kNuShift + CoverageTable::kMeanNormalBits;
+constexpr int kSpreadShift = kNvShift + CoverageTable::kMeanNormalBits;
+constexpr std::uint32_t kSpreadTop = (1u << CoverageTable::kSpreadBits) - 1;
+// The mean normal's length for each spread code k: sqrt(1 - (k / kSpreadTop)^2).
+const std::array<double, kSpreadTop + 1> kSpreadLength = [] {
+    std::array<double, kSpreadTop + 1> len{};
+    for (std::uint32_t k = 0; k <= kSpreadTop; ++k) {
+        const double s = k / double(kSpreadTop);
+        len[k] = std::sqrt(1 - s * s);
+    }
+    return len;
+}();
 
 struct Header {
     std::uint64_t magic;
@@ -284,15 +295,17 @@ std::uint32_t CoverageTable::pack_cover(const CoverageSample& c) {
         1, static_cast<std::uint32_t>(std::lround(std::clamp(double(c.alpha), 0.0, 1.0) * kAlphaTop)));
     const auto t = static_cast<std::uint32_t>(std::lround(std::clamp(double(c.t), 0.0, 1.0) * kMeanTTop));
     const Oct o = oct_encode_precise(oct_decode({c.nu, c.nv}, kRawNormalBits), kMeanNormalBits);
-    return alpha | t << kMeanTShift | o.u << kNuShift | o.v << kNvShift;
+    const auto spread = static_cast<std::uint32_t>(std::lround(c.spread / 255.0 * kSpreadTop));
+    return alpha | t << kMeanTShift | o.u << kNuShift | o.v << kNvShift | spread << kSpreadShift;
 }
 
 void CoverageTable::unpack_cover(std::uint32_t cover, CoverageHit& hit, bool normal) {
     hit.alpha = (cover & kAlphaTop) / double(kAlphaTop);
     hit.t = (cover >> kMeanTShift & kMeanTTop) / double(kMeanTTop);
-    if (normal)
-        hit.normal = oct_decode({cover >> kNuShift & kMeanNormalTop, cover >> kNvShift & kMeanNormalTop},
-                                kMeanNormalBits);
+    if (!normal) return;
+    hit.normal = kSpreadLength[cover >> kSpreadShift & kSpreadTop] *
+                 oct_decode({cover >> kNuShift & kMeanNormalTop, cover >> kNvShift & kMeanNormalTop},
+                            kMeanNormalBits);
 }
 
 bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit) const {

@@ -4,10 +4,13 @@
 // tests and certification use), and the pair's coverage (lattice/coverage.h): the share of the
 // sub-rays snapping to the pair that meet the primitive and their mean hit, which filtered
 // rendering uses. The hit is a record of 16-bit fields: its t and normal (6 bytes); the coverage
-// a 32-bit word (4 bytes): alpha in 1/255, the mean t in 1/1023 and the mean normal
-// octahedral in 7 + 7 bits. A coverage is a mean over a cell-wide bundle, blended with its
-// neighbours: its errors (at most half an 8-bit step of alpha, 1.3 degrees of normal)
-// do not show in images, and the word halves the bytes filtered rendering reads.
+// a 32-bit word (4 bytes): alpha in 1/255, the mean t in 1/511, the mean normal's direction
+// octahedral in 6 + 6 bits (at most 2.6 degrees off) and how far the normals spread about it
+// in 3 bits (CoverageSample::spread, in steps of 1/7). A coverage is a mean over a cell-wide
+// bundle, blended with its neighbours, so its direction and t need few bits; the spread is
+// what shades a hair thinner than a cell right: its mean normal is about pi/4 long, and read
+// as a unit vector its diffuse light was a quarter too bright (0.5 to 1.6 dB at a million
+// hairs: bench/notes/scale-log.md).
 //
 // Pairs are filed in slots where neighbours in ray space are neighbours in memory (pair_index.h:
 // tiles of 256 slots, each 16 consecutive slots a 2 x 2 x 2 x 2 cell of the 4-D grid of entry
@@ -53,8 +56,8 @@ public:
     static constexpr std::uint16_t kNoHit = 0xFFFF;  // kT of a pair whose own segment misses
     static constexpr int kGroupSlots = PairIndex::kCellSlots;
     // A coverage record's fields: their widths in bits, from bit 0 up in this order.
-    static constexpr int kAlphaBits = 8, kMeanTBits = 10, kMeanNormalBits = 7;
-    static_assert(kAlphaBits + kMeanTBits + 2 * kMeanNormalBits == 8 * kCoverBytes);
+    static constexpr int kAlphaBits = 8, kMeanTBits = 9, kMeanNormalBits = 6, kSpreadBits = 3;
+    static_assert(kAlphaBits + kMeanTBits + 2 * kMeanNormalBits + kSpreadBits == 8 * kCoverBytes);
     // A sample (alpha > 0) as its record, and a record back (alpha 0: no coverage). normal:
     // false when only alpha and t are wanted.
     static std::uint32_t pack_cover(const CoverageSample& c);
