@@ -38,9 +38,9 @@ struct ShadeState {
 // s' = len s / (len + s (1 - len)), and the lobe is scaled by (s' + 1) / (s + 1) so that the
 // light it reflects stays the same (the integral of cos^s over the sphere is 2 pi / (s + 1)).
 // len is normal_length^kToksvigWidening: the lobe is widened more than the mean's length
-// alone says; k is the best of those tried on the fur plates (bench/notes/shading-constants.md),
-// and still the best of 1, 3 and 6 at a million hairs once tables kept their pairs' spread.
-inline constexpr double kToksvigWidening = 6;
+// alone says. k = 3 is the best of 1, 2, 3, 6 and 10 on Plates 2 and 4 and grass, and within
+// 0.1 dB of the best at a million hairs (bench/notes/shading-constants.md).
+inline constexpr double kToksvigWidening = 3;
 // E[max(0, X)] for X normal with mean len * nl and variance (1 - len^2) / 3 (see phong_term).
 inline double diffuse_mean(double nl, double len) {
     const double mean = len * nl, sd = std::sqrt((1 - len * len) / 3);
