@@ -17,6 +17,7 @@
 #include "lattice/table_file.h"
 #include "scene/table_metadata.h"
 #include "temp_dir.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace lat {
@@ -156,6 +157,32 @@ TEST(TableCacheTest, StaleTemporariesAreRemoved) {
     EXPECT_FALSE(std::filesystem::exists(old_one));
     EXPECT_TRUE(std::filesystem::exists(fresh));
     EXPECT_TRUE(std::filesystem::exists(other));  // not ours
+}
+
+// A coverage build creates its temporary, then computes for minutes without writing to it: a
+// second run opening the cache meanwhile must leave it alone, however old it looks, while its
+// writer lives (it holds the temporary's lock), and remove it once the writer is gone.
+TEST(TableCacheTest, ALiveWritersTemporaryIsKeptHoweverOld) {
+    test::TempDir dir;
+    const std::string target = (dir.path() / "ball-s4-coverage-0123456789abcdef.lht").string();
+    const auto long_ago = std::filesystem::file_time_type::clock::now() - std::chrono::hours(2);
+    std::string temp;
+    {
+        AtomicFile writing(target, "lattice table");
+        temp = writing.temp_path();
+        std::filesystem::last_write_time(temp, long_ago);
+        const TableCache cache(dir.path().string());
+        EXPECT_TRUE(std::filesystem::exists(temp));
+        writing.write("table", 5);
+        writing.commit();
+    }
+    EXPECT_TRUE(std::filesystem::exists(target));
+    // A writer that died without cleaning up: its temporary holds no lock.
+    const auto orphan = dir.path() / "ball-s4-coverage-0123456789abcdef.lht.tmp-Orphan";
+    std::ofstream(orphan) << "partial";
+    std::filesystem::last_write_time(orphan, long_ago);
+    const TableCache cache(dir.path().string());
+    EXPECT_FALSE(std::filesystem::exists(orphan));
 }
 
 }  // namespace

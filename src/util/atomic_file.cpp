@@ -1,6 +1,7 @@
 #include "util/atomic_file.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -78,6 +79,10 @@ AtomicFile::AtomicFile(std::string target, std::string what)
     if (fd < 0) throw_write_errno(target_, errno, what_);
     temp_ = name.data();
     register_temp(temp_);
+    // Held until the descriptor closes (commit, destruction or the process's death), so that
+    // remove_abandoned_temp leaves a live writer's temporary alone. A filesystem without flock
+    // support gets none, and only the cache's age rule protects its temporaries.
+    (void)::flock(fd, LOCK_EX | LOCK_NB);
     // mkstemp creates 0600; the target should get the usual permissions.
     static const mode_t mask = current_umask();
     file_ = ::fchmod(fd, 0666 & ~mask) == 0 ? ::fdopen(fd, "wb") : nullptr;
@@ -123,6 +128,15 @@ void AtomicFile::commit() {
     if (std::rename(temp_.c_str(), target_.c_str()) != 0) throw_write_errno(target_, errno, what_);
     committed_ = true;
     unregister_temp(temp_);
+}
+
+bool remove_abandoned_temp(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return false;
+    const bool abandoned = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+    const bool removed = abandoned && ::unlink(path.c_str()) == 0;
+    ::close(fd);
+    return removed;
 }
 
 void remove_temp_files() {

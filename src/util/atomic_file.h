@@ -46,6 +46,12 @@ private:
     bool committed_ = false;
 };
 
+// Removes the temporary at `path` if no live writer holds it (each AtomicFile holds an
+// exclusive flock on its temporary while it exists, released when its process dies); false
+// if one does, or it could not be removed. A table build can leave its temporary untouched
+// for many minutes while it computes, so age alone does not tell an abandoned one.
+bool remove_abandoned_temp(const std::string& path);
+
 // Removes every registered temporary that still exists; for the exit path of an interrupted
 // process (the destructors do the same when the stack unwinds).
 void remove_temp_files();

@@ -13,6 +13,7 @@
 
 #include "distributed/job.h"
 #include "lattice/cache/table_build.h"
+#include "util/atomic_file.h"
 #include "util/error.h"
 
 namespace lat {
@@ -57,9 +58,12 @@ void TableCache::open_dir() const {
                          std::strerror(errno));
 }
 
-// A table is written whole into TARGET.tmp-XXXXXX and renamed (util/atomic_file.h), which takes
-// seconds; one untouched for kStaleTemporary was left by a process that was killed, and no
-// writer can still own it, so it is removed. Failures are ignored: another run may race us.
+// A table is written whole into TARGET.tmp-XXXXXX and renamed (util/atomic_file.h). A coverage
+// build creates its temporary before it computes for minutes, writing nothing meanwhile, so age
+// alone does not tell an abandoned one: one untouched for kStaleTemporary is removed only if no
+// live writer holds its lock (remove_abandoned_temp); by age alone, a second render opening
+// the cache would remove a slow build's temporary, and the build fail at its end ("cannot
+// write lattice table"). Failures are ignored: another run may race us.
 void TableCache::remove_stale_temporaries() const {
     std::error_code ec;
     const auto now = std::filesystem::file_time_type::clock::now();
@@ -67,7 +71,7 @@ void TableCache::remove_stale_temporaries() const {
         const std::string name = entry.path().filename().string();
         if (name.find(".lht.tmp-") == std::string::npos || !entry.is_regular_file(ec)) continue;
         const auto modified = entry.last_write_time(ec);
-        if (!ec && now - modified > kStaleTemporary) std::filesystem::remove(entry.path(), ec);
+        if (!ec && now - modified > kStaleTemporary) remove_abandoned_temp(entry.path().string());
     }
 }
 
