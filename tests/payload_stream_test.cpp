@@ -137,6 +137,35 @@ TEST(PayloadStream, HitsHeldByTheEncoderAloneGiveTheSameBytes) {
     EXPECT_TRUE(sink.bytes == whole_build(e, r));
 }
 
+// Hits rasterized as PointHits are the raw hits in hash14's stored form, in the same order;
+// hash14 makes the same payload from them (the buffers its own, freed as it reads them).
+TEST(PayloadStream, PointHitsGiveTheSameBytes) {
+    for (const int k : {1, 2}) {
+        SCOPED_TRACE("sigma^-1 = " + std::to_string(k));
+        const Rasterized& r = hair(k);
+        RasterizeOptions opt;
+        opt.point_hits = true;
+        RasterizeResult own = rasterize(r.ctx, opt);
+        EXPECT_EQ(own.raw.size(), 0u);
+        const std::vector<PointHit> points = own.points.flatten();
+        const std::vector<RawHit> raw = r.raster.raw.flatten();
+        ASSERT_EQ(points.size(), raw.size());
+        for (std::size_t i = 0; i < raw.size(); ++i) {
+            const PointHit& p = points[i];
+            const RawHit& h = raw[i];
+            ASSERT_TRUE(p.a == h.a && p.b == h.b && p.nu == h.nu && p.nv == h.nv) << "hit " << i;
+            ASSERT_EQ(p.t, std::lround(std::clamp(double(h.t), 0.0, 1.0) * 65535)) << "hit " << i;
+        }
+        for (const auto& buffer : own.points.storage) EXPECT_EQ(buffer.use_count(), 1);
+        CountingSink sink;
+        find_encoding("hash14").stream_points(std::move(own.points), r.ctx, {}, sink);
+        EXPECT_EQ(sink.reserves, 1);
+        EXPECT_TRUE(sink.bytes == hash14_reference(r.raster.raw));
+        for (std::size_t i = 0; i < sink.writes.size(); ++i)
+            ASSERT_EQ(sink.writes[i], 1) << "byte " << i;
+    }
+}
+
 TEST(PayloadStream, NoHitsMakeTheSamePayload) {
     const Encoding& e = find_encoding("hash14");
     const Rasterized& r = hair(1);

@@ -25,31 +25,14 @@ std::uint64_t bucket_of(std::uint32_t a, std::uint32_t b, std::uint64_t buckets)
     return ((h >> 32) * buckets) >> 32;
 }
 
-// lround(clamp(t, 0, 1) * 65535) (halves away from zero; NaN as 0), inline: the call into
-// libm was a tenth of the build's instructions.
-std::uint16_t quantise_t(float t) {
-    const double x = std::clamp(double(t), 0.0, 1.0) * 65535.0;
-    if (!(x >= 0)) return 0;
-    const double whole = std::trunc(x);  // x - whole is exact
-    return static_cast<std::uint16_t>(x - whole >= 0.5 ? whole + 1 : whole);
-}
-
 // A hit as its finished entry, without its link. Its bucket is hashed again where it is needed
 // rather than kept: at 10 bytes, the half of a raw hit that compaction frees holds the whole
-// sorted copy, so that the copy touches no memory the system has not just freed (a first touch
-// of such memory is dear, on virtual machines above all).
-struct Sorted {
-    std::uint16_t a, b, t, nu, nv;
-};
-static_assert(sizeof(Sorted) == 10);
+// sorted copy.
+using Sorted = PointHit;
 
-// Every chunk of hits made into entries by to_entry(hit, chunk), in place in its buffer where
-// the hits are held by nothing else: the 10 bytes a hit saves then go back to the system before
-// the sorted copy is made, which reuses them. Else into a new buffer, which `hits` keeps.
-template <class ToEntry>
-std::vector<std::span<const Sorted>> compact_hits(RawHits& hits, ToEntry&& to_entry) {
-    // The chunks of each buffer, in address order: compacted in that order, an entry never
-    // overwrites a hit not yet read.
+// The indices of hits.chunks that lie in each buffer of hits.storage, in address order.
+template <class Hit>
+std::vector<std::vector<std::size_t>> chunks_by_buffer(const HitChunks<Hit>& hits) {
     const std::size_t nbuf = hits.storage.size();
     std::vector<std::vector<std::size_t>> in_buffer(nbuf);
     const auto holds = [&](std::size_t j, const std::uint8_t* p) {
@@ -64,13 +47,26 @@ std::vector<std::span<const Sorted>> compact_hits(RawHits& hits, ToEntry&& to_en
         assert(j < nbuf && "every chunk lies in one of the hits' buffers");
         in_buffer[j].push_back(c);
     }
-    std::vector<std::span<const Sorted>> out(hits.chunks.size());
-    std::vector<std::shared_ptr<const ByteBuffer>> fresh(nbuf);
-    tbb::parallel_for(std::size_t{0}, nbuf, [&](std::size_t j) {
-        std::vector<std::size_t>& cs = in_buffer[j];
+    for (std::vector<std::size_t>& cs : in_buffer)
         std::sort(cs.begin(), cs.end(), [&](std::size_t x, std::size_t y) {
             return hits.chunks[x].data() < hits.chunks[y].data();
         });
+    return in_buffer;
+}
+
+// Every chunk of hits made into entries by to_entry(hit, chunk), in place in its buffer where
+// the hits are held by nothing else: the 10 bytes a hit saves then go back to the system before
+// the sorted copy is made, which reuses them. Else into a new buffer.
+template <class ToEntry>
+PointHits compact_hits(RawHits&& hits, ToEntry&& to_entry) {
+    // Compacted in address order, an entry never overwrites a hit not yet read.
+    const std::vector<std::vector<std::size_t>> in_buffer = chunks_by_buffer(hits);
+    const std::size_t nbuf = hits.storage.size();
+    PointHits out;
+    out.chunks.resize(hits.chunks.size());
+    std::vector<std::shared_ptr<const ByteBuffer>> fresh(nbuf);
+    tbb::parallel_for(std::size_t{0}, nbuf, [&](std::size_t j) {
+        const std::vector<std::size_t>& cs = in_buffer[j];
         std::size_t total = 0;
         for (const std::size_t c : cs) total += hits.chunks[c].size();
         // RawHits' buffers are never const objects (table.h).
@@ -91,15 +87,37 @@ std::vector<std::span<const Sorted>> compact_hits(RawHits& hits, ToEntry&& to_en
                 std::memcpy(w, &e, sizeof e);
                 w += sizeof e;
             }
-            out[c] = {first, hits.chunks[c].size()};
+            out.chunks[c] = {first, hits.chunks[c].size()};
         }
         if (ours) target->shrink(total * sizeof(Sorted));
     });
     for (std::size_t j = 0; j < nbuf; ++j)
-        if (fresh[j]) hits.storage[j] = std::move(fresh[j]);
-    hits.chunks.clear();
+        out.storage.push_back(fresh[j] ? std::move(fresh[j]) : std::move(hits.storage[j]));
+    hits = {};
     return out;
 }
+
+// Buckets are split into partitions small enough (4k buckets, 57 kB) to stay in cache while
+// their hits are placed; hits are first sorted stably into their partitions, as finished
+// entries (10 bytes: the sorted copy is written once and read twice, and fresh memory is dear).
+constexpr int kPartBits = 12;
+constexpr std::uint64_t kLocal = (1u << kPartBits) - 1;
+
+struct Partitioning {
+    std::uint64_t buckets, parts;
+    explicit Partitioning(std::uint64_t n)
+        : buckets(std::max<std::uint64_t>(1, n / 2)), parts((buckets + kLocal) >> kPartBits) {
+        if (buckets + n >= Hash14Table::kEnd)
+            throw std::length_error("hash14: too many entries for 32-bit links");
+    }
+    std::uint64_t bucket(std::uint32_t a, std::uint32_t b) const { return bucket_of(a, b, buckets); }
+    std::uint64_t part(std::uint32_t a, std::uint32_t b) const { return bucket(a, b) >> kPartBits; }
+};
+
+// The payload from the entries (chunks in entry order; count[c * parts + p]: chunk c's entries
+// in partition p), freeing the entries' buffers (where nothing else holds them) once read.
+void place(PointHits&& entries, std::vector<std::uint64_t>&& count, const Partitioning& pt,
+           std::uint64_t n, PayloadSink& sink);
 
 }  // namespace
 
@@ -111,31 +129,42 @@ ByteBuffer Hash14Table::build(const RawHits& hits) {
 
 void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     const std::uint64_t n = hits.size();
-    const std::uint64_t buckets = std::max<std::uint64_t>(1, n / 2);
-    if (buckets + n >= kEnd) throw std::length_error("hash14: too many entries for 32-bit links");
-    // Buckets are split into partitions small enough (4k buckets, 57 kB) to stay in cache
-    // while their hits are placed; hits are first sorted stably into their partitions, as
-    // finished entries (10 bytes instead of a raw hit's 20: the sorted copy is written once
-    // and read twice, and fresh memory is dear).
-    constexpr int kPartBits = 12;
-    constexpr std::uint64_t kLocal = (1u << kPartBits) - 1;
-    const std::uint64_t parts = (buckets + kLocal) >> kPartBits;
-    auto part_of = [](std::uint64_t bucket) { return bucket >> kPartBits; };
-    // An entry's bucket within its partition.
-    auto local_of = [&](const Sorted& e) { return bucket_of(e.a, e.b, buckets) & kLocal; };
-    const std::size_t nchunks = hits.chunks.size();
-    std::vector<std::uint64_t> count(nchunks * parts, 0);
-    const std::vector<std::span<const Sorted>> compact =
-        compact_hits(hits, [&](const RawHit& h, std::size_t c) {
+    const Partitioning pt(n);
+    std::vector<std::uint64_t> count(hits.chunks.size() * pt.parts, 0);
+    PointHits entries = compact_hits(std::move(hits), [&](const RawHit& h, std::size_t c) {
+        if (h.a >= kMaxPoints || h.b >= kMaxPoints)
+            throw std::length_error("hash14: point id over 16 bits");
+        ++count[c * pt.parts + pt.part(h.a, h.b)];
+        return Sorted{static_cast<std::uint16_t>(h.a), static_cast<std::uint16_t>(h.b),
+                      quantise_t16(h.t), h.nu, h.nv};
+    });
+    place(std::move(entries), std::move(count), pt, n, sink);
+}
+
+void Hash14Table::write(PointHits&& hits, PayloadSink& sink) {
+    const std::uint64_t n = hits.size();
+    const Partitioning pt(n);
+    std::vector<std::uint64_t> count(hits.chunks.size() * pt.parts, 0);
+    tbb::parallel_for(std::size_t{0}, hits.chunks.size(), [&](std::size_t c) {
+        std::uint64_t* row = &count[c * pt.parts];
+        for (const PointHit& h : hits.chunks[c]) {
             if (h.a >= kMaxPoints || h.b >= kMaxPoints)
                 throw std::length_error("hash14: point id over 16 bits");
-            ++count[c * parts + part_of(bucket_of(h.a, h.b, buckets))];
-            return Sorted{static_cast<std::uint16_t>(h.a),
-                          static_cast<std::uint16_t>(h.b),
-                          quantise_t(h.t),
-                          h.nu,
-                          h.nv};
-        });
+            ++row[pt.part(h.a, h.b)];
+        }
+    });
+    place(std::move(hits), std::move(count), pt, n, sink);
+}
+
+namespace {
+
+void place(PointHits&& entries, std::vector<std::uint64_t>&& count, const Partitioning& pt,
+           std::uint64_t n, PayloadSink& sink) {
+    const std::uint64_t buckets = pt.buckets, parts = pt.parts;
+    auto part_of = [](std::uint64_t bucket) { return bucket >> kPartBits; };
+    // An entry's bucket within its partition.
+    auto local_of = [&](const Sorted& e) { return pt.bucket(e.a, e.b) & kLocal; };
+    const std::size_t nchunks = entries.chunks.size();
     // Stable positions: partition by partition, chunk by chunk. Each partition's total first,
     // then each chunk's start in it, made in place of the counts; ranges of partitions in
     // parallel, reading the counts row by row (a partition's counts lie a row apart).
@@ -159,14 +188,23 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
                 pos[p - p0] += here;
             }
     });
-    ByteBuffer sorted_buf(n * sizeof(Sorted));
+    // The sorted copy is filled a buffer of entries at a time, each buffer freed once read, in
+    // small pages: every partition's range fills from its start, so the pages a buffer's entries
+    // first touch are about as many as the last buffer gave back (a first touch of memory the
+    // process has just freed is cheap; of memory new to it, dear).
+    ByteBuffer sorted_buf(n * sizeof(Sorted), ByteBuffer::Pages::kSmall);
     auto* sorted = reinterpret_cast<Sorted*>(sorted_buf.data());
-    tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
-        std::uint64_t* off = &offset[c * parts];
-        for (const Sorted& e : compact[c]) sorted[off[part_of(bucket_of(e.a, e.b, buckets))]++] = e;
-    });
-    hits = {};  // read for the last time above
-
+    const std::vector<std::vector<std::size_t>> in_buffer = chunks_by_buffer(entries);
+    for (std::size_t j = 0; j < in_buffer.size(); ++j) {
+        const std::vector<std::size_t>& cs = in_buffer[j];
+        tbb::parallel_for(std::size_t{0}, cs.size(), [&](std::size_t i) {
+            const std::size_t c = cs[i];
+            std::uint64_t* off = &offset[c * parts];
+            for (const Sorted& e : entries.chunks[c]) sorted[off[part_of(pt.bucket(e.a, e.b))]++] = e;
+        });
+        entries.storage[j].reset();
+    }
+    entries = {};
     // Which buckets are used, per partition (partition p owns buckets [b0(p), b0(p + 1))), fixes
     // every partition's overflow area before anything is placed.
     auto b0 = [&](std::uint64_t p) { return std::min(buckets, p << kPartBits); };
@@ -207,11 +245,11 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
         tbb::parallel_for(g, g1, [&](std::uint64_t p) {
             Hash14Entry* part_out = stage + (b0(p) - b0(g));
             for (std::uint64_t k = 0; k < b0(p + 1) - b0(p); ++k)
-                part_out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, kEnd};
+                part_out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, Hash14Table::kEnd};
             std::uint64_t next_over = over_start[p];
             for (std::uint64_t i = part_start[p]; i < part_start[p + 1]; ++i) {
                 const Sorted& h = sorted[i];
-                const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, kEnd};
+                const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, Hash14Table::kEnd};
                 Hash14Entry& head = part_out[local_of(h)];
                 if (head.a == 0xFFFF) {
                     head = e;
@@ -233,6 +271,8 @@ void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     }
     writing.wait();
 }
+
+}  // namespace
 
 Hash14Table::Hash14Table(const std::uint8_t* payload, std::size_t size, std::uint64_t entries)
     : entries_(entries), size_(size) {
