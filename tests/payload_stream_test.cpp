@@ -107,7 +107,7 @@ std::vector<std::uint8_t> whole_build(const Encoding& e, const Rasterized& r) {
 }
 
 // hash14 streams; dense goes through its whole build: both must give the same bytes, on
-// lattices of two sizes (one group of bucket partitions, and three).
+// lattices of two sizes (one group of bucket partitions, and ten).
 TEST(PayloadStream, SameBytesAsTheWholeBuildEveryByteOnce) {
     for (const char* name : {"hash14", "dense"})
         for (const int k : {1, 2}) {

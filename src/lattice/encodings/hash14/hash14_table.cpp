@@ -99,12 +99,13 @@ PointHits compact_hits(RawHits&& hits, ToEntry&& to_entry) {
 }
 
 // Buckets are split into partitions small enough (4k buckets, 57 kB) to stay in cache while
-// their entries are placed, and partitions into groups (64: about 8 MB of entries). Entries are
-// sorted stably by group (one pass over memory, to few places), then each group by partition
-// in a buffer of its own thread's, which the placement reads while it is still in cache.
+// their entries are placed, and partitions into groups (16: about 1.3 MB of entries and 2 MB of
+// payload, near what a core's cache holds). Entries are sorted stably by group (one pass over
+// memory, to few places), then each group by partition in a buffer of its own thread's, which
+// the placement reads while it is still in cache.
 constexpr int kPartBits = 12;
 constexpr std::uint64_t kLocal = (1u << kPartBits) - 1;
-constexpr std::uint64_t kGroup = 64;  // partitions
+constexpr std::uint64_t kGroup = 16;  // partitions
 
 struct Partitioning {
     std::uint64_t buckets, parts, groups;
