@@ -15,7 +15,8 @@ namespace lat {
 struct RasterizeOptions {
     bool keep_hits = true;  // false: only count (Table 1)
     // Keep the hits as PointHits (every point id must be below 0xFFFF) instead of RawHits:
-    // for encodings that store no more (Encoding::stream_points). Not with across_ranks.
+    // for encodings that store no more (Encoding::stream_points). Not with across_ranks in a
+    // job of several ranks, whose messages carry raw hits.
     bool point_hits = false;
     bool progress = false;
     // Trace only every n-th entry point (to estimate a table's size before building it).

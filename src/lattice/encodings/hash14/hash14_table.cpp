@@ -26,9 +26,9 @@ std::uint64_t bucket_of(std::uint32_t a, std::uint32_t b, std::uint64_t buckets)
     return ((h >> 32) * buckets) >> 32;
 }
 
-// A hit as its finished entry, without its link. Its bucket is hashed again where it is needed
-// rather than kept: at 10 bytes, the half of a raw hit that compaction frees holds the whole
-// sorted copy.
+// A hit as its finished entry, without its link (the form the rasterizer can keep hits in). Its
+// bucket is hashed again where it is needed rather than kept: at 10 bytes, the half of a raw
+// hit that compaction frees holds the whole sorted copy.
 using Sorted = PointHit;
 
 // The indices of hits.chunks that lie in each buffer of hits.storage, in address order.
@@ -55,7 +55,7 @@ std::vector<std::vector<std::size_t>> chunks_by_buffer(const HitChunks<Hit>& hit
     return in_buffer;
 }
 
-// Every chunk of hits made into entries by to_entry(hit, chunk), in place in its buffer where
+// Every chunk of hits made into entries by to_entry(hit), in place in its buffer where
 // the hits are held by nothing else: the 10 bytes a hit saves then go back to the system before
 // the sorted copy is made, which reuses them. Else into a new buffer.
 template <class ToEntry>
@@ -84,7 +84,7 @@ PointHits compact_hits(RawHits&& hits, ToEntry&& to_entry) {
             for (const RawHit& in : hits.chunks[c]) {
                 RawHit h;
                 std::memcpy(&h, &in, sizeof h);  // read whole before its bytes are overwritten
-                const Sorted e = to_entry(h, c);
+                const Sorted e = to_entry(h);
                 std::memcpy(w, &e, sizeof e);
                 w += sizeof e;
             }
@@ -283,7 +283,7 @@ ByteBuffer Hash14Table::build(const RawHits& hits) {
 
 void Hash14Table::write(RawHits&& hits, PayloadSink& sink) {
     place(compact_hits(std::move(hits),
-                       [&](const RawHit& h, std::size_t) {
+                       [&](const RawHit& h) {
                            if (h.a >= kMaxPoints || h.b >= kMaxPoints)
                                throw std::length_error("hash14: point id over 16 bits");
                            return Sorted{static_cast<std::uint16_t>(h.a),
