@@ -1,6 +1,7 @@
 // Streamed payloads (Encoding::stream, encode_payload, the table file's sink) are byte for byte
 // what the encodings' whole builds give, every byte written once, and the file they make loads.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -107,7 +108,7 @@ std::vector<std::uint8_t> whole_build(const Encoding& e, const Rasterized& r) {
 }
 
 // hash14 streams; dense goes through its whole build: both must give the same bytes, on
-// lattices of two sizes (one group of bucket partitions, and three).
+// lattices of two sizes (one group of bucket partitions, and ten).
 TEST(PayloadStream, SameBytesAsTheWholeBuildEveryByteOnce) {
     for (const char* name : {"hash14", "dense"})
         for (const int k : {1, 2}) {
@@ -135,6 +136,41 @@ TEST(PayloadStream, HitsHeldByTheEncoderAloneGiveTheSameBytes) {
     CountingSink sink;
     encode_payload(e, std::move(own.raw), r.ctx, {}, sink);
     EXPECT_TRUE(sink.bytes == whole_build(e, r));
+}
+
+// Hits rasterized as PointHits are the raw hits in hash14's stored form, in the same order;
+// hash14 makes the same payload from them (the buffers its own, freed as it reads them), on
+// one thread or two.
+TEST(PayloadStream, PointHitsGiveTheSameBytes) {
+    for (const int k : {1, 2})
+        for (const int threads : {1, 2}) {
+            SCOPED_TRACE("sigma^-1 = " + std::to_string(k) + ", threads " + std::to_string(threads));
+            tbb::task_arena arena(threads);
+            const Rasterized& r = hair(k);
+            RasterizeOptions opt;
+            opt.point_hits = true;
+            RasterizeResult own;
+            arena.execute([&] { own = rasterize(r.ctx, opt); });
+            EXPECT_EQ(own.raw.size(), 0u);
+            const std::vector<PointHit> points = own.points.flatten();
+            const std::vector<RawHit> raw = r.raster.raw.flatten();
+            ASSERT_EQ(points.size(), raw.size());
+            for (std::size_t i = 0; i < raw.size(); ++i) {
+                const PointHit& p = points[i];
+                const RawHit& h = raw[i];
+                ASSERT_TRUE(p.a == h.a && p.b == h.b && p.nu == h.nu && p.nv == h.nv) << "hit " << i;
+                ASSERT_EQ(p.t, std::lround(std::clamp(double(h.t), 0.0, 1.0) * 65535)) << "hit " << i;
+            }
+            for (const auto& buffer : own.points.storage) EXPECT_EQ(buffer.use_count(), 1);
+            CountingSink sink;
+            arena.execute([&] {
+                find_encoding("hash14").stream_points(std::move(own.points), r.ctx, {}, sink);
+            });
+            EXPECT_EQ(sink.reserves, 1);
+            EXPECT_TRUE(sink.bytes == hash14_reference(r.raster.raw));
+            for (std::size_t i = 0; i < sink.writes.size(); ++i)
+                ASSERT_EQ(sink.writes[i], 1) << "byte " << i;
+        }
 }
 
 TEST(PayloadStream, NoHitsMakeTheSamePayload) {

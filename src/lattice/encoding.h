@@ -81,6 +81,11 @@ struct Encoding {
     // hits, a copy of them and the payload at once. encode_payload chooses between the two.
     void (*stream)(RawHits&& hits, const TableContext& ctx, const EncodeOptions& opt,
                    PayloadSink& sink) = nullptr;
+    // Optional: the same payload from the hits as PointHits (rasterized in that form, half the
+    // memory of raw hits), for encodings that store no more of a hit; a build that rasterizes
+    // in one process uses it when set.
+    void (*stream_points)(PointHits&& hits, const TableContext& ctx, const EncodeOptions& opt,
+                          PayloadSink& sink) = nullptr;
     // The table over a payload (which must outlive it); throws std::runtime_error when the
     // payload is inconsistent.
     std::unique_ptr<LatticeTable> (*open)(const std::uint8_t* payload, std::size_t size,

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <type_traits>
 
 #include "distributed/deal.h"
@@ -43,29 +44,30 @@ struct Counts {
 };
 
 // Per-thread output: hits go into large huge-page buffers; a block's hits stay contiguous.
+template <class Hit>
 class HitArena {
 public:
-    static constexpr std::size_t kHits = std::size_t{4} << 20;  // 64 MB per buffer
+    static constexpr std::size_t kHits = std::size_t{4} << 20;  // 80 MB of raw hits per buffer
 
     void begin_block() { block_start_ = used_; }
-    void push(const RawHit& h) {
+    void push(const Hit& h) {
         if (used_ == cap_) grow();
         cur_[used_++] = h;
     }
-    std::span<const RawHit> end_block() const { return {cur_ + block_start_, used_ - block_start_}; }
+    std::span<const Hit> end_block() const { return {cur_ + block_start_, used_ - block_start_}; }
     std::vector<std::shared_ptr<const ByteBuffer>>& buffers() { return buffers_; }
 
 private:
     std::vector<std::shared_ptr<const ByteBuffer>> buffers_;
-    RawHit* cur_ = nullptr;
+    Hit* cur_ = nullptr;
     std::size_t used_ = 0, cap_ = 0, block_start_ = 0;
 
     void grow() {
         // Move the unfinished block to the new buffer so that it stays in one piece.
         const std::size_t partial = used_ - block_start_;
         const std::size_t cap = std::max(kHits, 2 * partial);
-        auto buf = std::make_shared<ByteBuffer>(cap * sizeof(RawHit));
-        auto* next = reinterpret_cast<RawHit*>(buf->data());
+        auto buf = std::make_shared<ByteBuffer>(cap * sizeof(Hit));
+        auto* next = reinterpret_cast<Hit*>(buf->data());
         std::copy(cur_ + block_start_, cur_ + used_, next);
         buffers_.push_back(buf);
         cur_ = next, cap_ = cap, used_ = partial, block_start_ = 0;
@@ -83,7 +85,21 @@ struct Scratch {
         Vec3 q;
     };
     std::vector<Exit> batch;  // exits in the cones of one part, to test against it
-    HitArena arena;
+    bool point_hits = false;  // hits kept in `points`, else in `raw`
+    HitArena<RawHit> raw;
+    HitArena<PointHit> points;
+
+    void keep(const RawHit& h) {
+        if (!point_hits) {
+            raw.push(h);
+            return;
+        }
+        // The table's build checked every id against the encoding's limit before tracing.
+        if (h.a >= 0xFFFF || h.b >= 0xFFFF)
+            throw std::length_error("point hits: point id over 16 bits");
+        points.push({static_cast<std::uint16_t>(h.a), static_cast<std::uint16_t>(h.b),
+                     quantise_t16(h.t), h.nu, h.nv});
+    }
 };
 
 // The primitive as a Shape, for the tracer's loops over its parts (a chain's concrete type, or
@@ -140,7 +156,7 @@ public:
                 if (fl.ids[k] == a || !BoundaryGrid::valid_pair(fa, fl.mask[k])) continue;
                 ++cnt.hits;
                 cnt.counted += static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fl.mask[k]));
-                if (keep) s.arena.push(make_hit(shape, a, p, fl.ids[k], at[k], start_inside, s, k));
+                if (keep) s.keep(make_hit(shape, a, p, fl.ids[k], at[k], start_inside, s, k));
             }
             if (!start_inside)
                 for (const std::size_t k : s.touched) s.best_t[k] = kInfinity;
@@ -344,7 +360,11 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
 
     const std::uint32_t npoints = tracer.grid().count();
     const std::uint32_t nblocks = (npoints + kBlock - 1) / kBlock;
-    std::vector<std::span<const RawHit>> block_hits(opt.keep_hits ? nblocks : 0);
+    assert(!(opt.point_hits && opt.across_ranks && dist::distributed()));
+    const bool keep_raw = opt.keep_hits && !opt.point_hits;
+    const bool keep_points = opt.keep_hits && opt.point_hits;
+    std::vector<std::span<const RawHit>> block_hits(keep_raw ? nblocks : 0);
+    std::vector<std::span<const PointHit>> block_points(keep_points ? nblocks : 0);
     std::vector<Counts> block_counts(nblocks);
     tbb::enumerable_thread_specific<Scratch> scratch;
     ProgressBar bar("rasterize", nblocks, opt.progress && dist::is_root());
@@ -354,23 +374,27 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
     deal_opt.progress = &bar;
     const dist::DealReport deal = dist::deal(nblocks, [&](std::uint32_t blk) {
         Scratch& s = scratch.local();
+        s.point_hits = opt.point_hits;
         Counts cnt;
-        s.arena.begin_block();
+        s.raw.begin_block();
+        s.points.begin_block();
         const std::uint32_t a_end = std::min(npoints, (blk + 1) * kBlock);
         for (std::uint32_t a = blk * kBlock; a < a_end; ++a) {
             if (a % opt.entry_stride != 0) continue;
             if (chain) tracer.trace_entry(*chain, a, opt.keep_hits, s, cnt);
             else tracer.trace_entry(parts, a, opt.keep_hits, s, cnt);
         }
-        if (opt.keep_hits) block_hits[blk] = s.arena.end_block();
+        if (keep_raw) block_hits[blk] = s.raw.end_block();
+        if (keep_points) block_points[blk] = s.points.end_block();
         block_counts[blk] = cnt;
     }, deal_opt);
     bar.finish();
 
     RasterizeResult res;
-    if (opt.keep_hits)
-        for (Scratch& s : scratch)
-            for (auto& b : s.arena.buffers()) res.raw.storage.push_back(std::move(b));
+    for (Scratch& s : scratch) {
+        for (auto& b : s.raw.buffers()) res.raw.storage.push_back(std::move(b));
+        for (auto& b : s.points.buffers()) res.points.storage.push_back(std::move(b));
+    }
     for (const dist::Chunk& c : deal.chunks)
         for (std::uint32_t blk = c.begin; blk != c.end; ++blk) {
             res.pairs_traced_here += block_counts[blk].traced;
@@ -378,7 +402,7 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
         }
     // Rank 0 gets the other ranks' blocks; theirs keep only what they counted themselves.
     if (deal_opt.across_ranks) {
-        gather_blocks(deal, opt.keep_hits, block_counts, block_hits, res.raw.storage);
+        gather_blocks(deal, keep_raw, block_counts, block_hits, res.raw.storage);
         dist::mark(dist::Step::kGathered);
     }
     res.pairs_eq2 = tracer.grid().pairs_eq2();
@@ -389,8 +413,9 @@ RasterizeResult rasterize(const TableContext& ctx, const RasterizeOptions& opt) 
         res.hits_counted += c.counted;
         res.tests += c.tests;
     }
-    if (opt.keep_hits && (!deal_opt.across_ranks || dist::is_root())) res.raw.chunks = std::move(block_hits);
+    if (keep_raw && (!deal_opt.across_ranks || dist::is_root())) res.raw.chunks = std::move(block_hits);
     else res.raw = {};
+    if (keep_points) res.points.chunks = std::move(block_points);
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return res;
 }

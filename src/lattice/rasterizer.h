@@ -14,6 +14,10 @@ namespace lat {
 
 struct RasterizeOptions {
     bool keep_hits = true;  // false: only count (Table 1)
+    // Keep the hits as PointHits (every point id must be below 0xFFFF) instead of RawHits:
+    // for encodings that store no more (Encoding::stream_points). Not with across_ranks in a
+    // job of several ranks, whose messages carry raw hits.
+    bool point_hits = false;
     bool progress = false;
     // Trace only every n-th entry point (to estimate a table's size before building it).
     std::uint32_t entry_stride = 1;
@@ -33,7 +37,10 @@ struct RasterizeResult {
     double seconds = 0;
     // With across_ranks: this rank's own share (segments traced, hits); else the same as above.
     std::uint64_t pairs_traced_here = 0, hits_here = 0;
-    RawHits raw;  // when keep_hits: in entry point order, the same for any thread count
+    // When keep_hits, in entry point order, the same for any thread count: raw, or points
+    // with point_hits.
+    RawHits raw;
+    PointHits points;
 };
 
 // The lattice and the primitive (which must be set) are ctx's.

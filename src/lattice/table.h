@@ -2,7 +2,9 @@
 // The Lattice Hash Table interface (paper 2.3): for an ordered pair (p_i, p_o) of boundary grid
 // points, the intersection closest to p_i of the segment p_i -> p_o with the primitive, if any.
 // The renderer only sees this interface; the encodings (lattice/encoding.h) live behind it.
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -41,25 +43,46 @@ struct RawHit {
 static_assert(sizeof(RawHit) == 20);
 inline constexpr int kRawNormalBits = 16;
 
+// A hit as the tables keyed by 16-bit point ids store it (hash14): both ids, t quantised
+// (quantise_t16) and the octahedral normal. The rasterizer can keep hits in this form, half a
+// raw hit, when the encoding asks for no more: fresh memory is dear (first touches, on virtual
+// machines above all), and rasterization's hits are most of a build's.
+struct PointHit {
+    std::uint16_t a, b, t, nu, nv;
+};
+static_assert(sizeof(PointHit) == 10);
+
+// lround(clamp(t, 0, 1) * 65535) (halves away from zero; NaN as 0), inline: a call into libm
+// was a tenth of hash14's build.
+inline std::uint16_t quantise_t16(float t) {
+    const double x = std::clamp(double(t), 0.0, 1.0) * 65535.0;
+    if (!(x >= 0)) return 0;
+    const double whole = std::trunc(x);  // x - whole is exact
+    return static_cast<std::uint16_t>(x - whole >= 0.5 ? whole + 1 : whole);
+}
+
 // Rasterized hits in chunks (one per block of entry points, in a fixed order) that point into
 // large buffers, so that a big rasterization is never copied or grown piecewise. The buffers
 // are made non-const: an encoding that holds the only reference to one may reuse its memory.
-struct RawHits {
+template <class Hit>
+struct HitChunks {
     std::vector<std::shared_ptr<const ByteBuffer>> storage;
-    std::vector<std::span<const RawHit>> chunks;
+    std::vector<std::span<const Hit>> chunks;
 
     std::uint64_t size() const {
         std::uint64_t n = 0;
         for (const auto& c : chunks) n += c.size();
         return n;
     }
-    std::vector<RawHit> flatten() const {
-        std::vector<RawHit> out;
+    std::vector<Hit> flatten() const {
+        std::vector<Hit> out;
         out.reserve(size());
         for (const auto& c : chunks) out.insert(out.end(), c.begin(), c.end());
         return out;
     }
 };
+using RawHits = HitChunks<RawHit>;
+using PointHits = HitChunks<PointHit>;
 
 // Sub-rays a pair of a prefiltered table is sampled with (lattice/coverage.h), unless its
 // primitive is costly to intersect (coverage_rays_for, the one place that chooses).

@@ -7,7 +7,9 @@
 
 namespace lat {
 
-ByteBuffer::ByteBuffer(std::size_t size) : size_(size) {
+ByteBuffer::ByteBuffer(std::size_t size) : ByteBuffer(size, Pages::kHuge) {}
+
+ByteBuffer::ByteBuffer(std::size_t size, Pages pages) : size_(size) {
     if (size == 0) return;
     constexpr std::size_t kHuge = std::size_t{2} << 20;
     if (size > SIZE_MAX - 2 * kHuge) throw std::bad_alloc();  // the roundings below would wrap
@@ -23,7 +25,7 @@ ByteBuffer::ByteBuffer(std::size_t size) : size_(size) {
     if (const std::uintptr_t end = start + mapped_ + kHuge; end > aligned + mapped_)
         ::munmap(reinterpret_cast<void*>(aligned + mapped_), end - aligned - mapped_);
     data_ = reinterpret_cast<std::uint8_t*>(aligned);
-    ::madvise(data_, mapped_, MADV_HUGEPAGE);  // a hint; fine if refused
+    if (pages == Pages::kHuge) ::madvise(data_, mapped_, MADV_HUGEPAGE);  // a hint; fine if refused
 }
 
 void ByteBuffer::shrink(std::size_t size) {

@@ -12,6 +12,11 @@ class ByteBuffer {
 public:
     ByteBuffer() = default;
     explicit ByteBuffer(std::size_t size);
+    // Pages as the system gives them, 4 kB where it does not make them huge by itself: for a
+    // buffer filled bit by bit across its whole range while others are freed (the pages of a
+    // huge-page buffer are all first touched at once, before anything is freed).
+    enum class Pages { kHuge, kSmall };
+    ByteBuffer(std::size_t size, Pages pages);
     ~ByteBuffer();
     ByteBuffer(ByteBuffer&& o) noexcept : data_(o.data_), size_(o.size_), mapped_(o.mapped_) {
         o.data_ = nullptr, o.size_ = 0, o.mapped_ = 0;

@@ -100,6 +100,10 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
     opt.progress = progress;
     opt.keep_hits = plan.encoding->needs_hits;
     opt.across_ranks = across_ranks;
+    // Hits in the compact form where the encoding takes it (half the memory first touched),
+    // unless other ranks send theirs (as raw hits).
+    opt.point_hits = opt.keep_hits && plan.encoding->stream_points &&
+                     !(across_ranks && dist::distributed());
     b.raster = naming_the_primitive(plan, [&] { return rasterize(plan.context, opt); });
     const auto encode_and_write = [&] {
         const auto t0 = std::chrono::steady_clock::now();
@@ -113,11 +117,16 @@ TableBuild build_table_file(const TablePlan& plan, const std::string& path, bool
         const std::uint64_t payload_bytes =
             write_table_file(path, b.header, [&](PayloadSink& sink) {
                 naming_the_primitive(plan, [&] {
-                    encode_payload(*plan.encoding, std::move(b.raster.raw), plan.context, options,
-                                   sink);
+                    if (opt.point_hits)
+                        plan.encoding->stream_points(std::move(b.raster.points), plan.context,
+                                                     options, sink);
+                    else
+                        encode_payload(*plan.encoding, std::move(b.raster.raw), plan.context,
+                                       options, sink);
                 });
             });
         b.raster.raw = {};
+        b.raster.points = {};
         b.encode_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         b.bytes = payload_bytes + kTableHeaderBytes + b.header.metadata.size();

@@ -17,6 +17,8 @@ const Encoding kHash14Encoding{
     .stream = [](RawHits&& hits, const TableContext&, const EncodeOptions&, PayloadSink& sink) {
         Hash14Table::write(std::move(hits), sink);
     },
+    .stream_points = [](PointHits&& hits, const TableContext&, const EncodeOptions&,
+                        PayloadSink& sink) { Hash14Table::write(std::move(hits), sink); },
     .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                const TableContext&) -> std::unique_ptr<LatticeTable> {
         return std::make_unique<Hash14Table>(payload, size, entries);

@@ -37,6 +37,8 @@ public:
     static ByteBuffer build(const RawHits& hits);
     // The same payload into a sink, freeing the hits (where nothing else holds them) once read.
     static void write(RawHits&& hits, PayloadSink& sink);
+    // The same from hits rasterized as PointHits.
+    static void write(PointHits&& hits, PayloadSink& sink);
     // Over a payload made by build (owned or memory-mapped; it must outlive the table).
     Hash14Table(const std::uint8_t* payload, std::size_t size, std::uint64_t entries);
 
