@@ -188,7 +188,7 @@ struct EmbreeAccel::Impl {
         assert(objects[d.object].cull);
         const CullParts& cull = *objects[d.object].cull;
         if (d.cull == kEveryPart) {
-            if (!meets_any_cull_part(cull, local)) return false;
+            if (!cull.cull_meets_any(local)) return false;
         } else if (!cull.cull_meets(d.cull, local)) {
             return false;
         }
@@ -196,13 +196,8 @@ struct EmbreeAccel::Impl {
         return true;
     }
     // An object entered whole (place_whole): its cull parts tested in its own space, the
-    // shape's, so that they cost the instance nothing.
+    // shape's (CullParts::cull_meets_any), so that they cost the instance nothing.
     static constexpr std::uint32_t kEveryPart = 0x7FFFFFFFu;
-    static bool meets_any_cull_part(const CullParts& cull, const Ray& local) {
-        for (std::size_t c = 0; c < cull.cull_count(); ++c)
-            if (cull.cull_meets(c, local)) return true;
-        return false;
-    }
 
     void record(QueryContext* ctx, RTCRayHit* rh, std::uint32_t obj, const Crossing& c,
                 unsigned geom, unsigned prim, unsigned inst) const {

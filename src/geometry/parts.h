@@ -48,6 +48,13 @@ public:
     // Whether the line of r (shape coordinates) can meet cull part i, for a line that meets its
     // bounds: a cheap test that saves the shape's own.
     virtual bool cull_meets(std::size_t i, const Ray& r) const = 0;
+    // Whether cull_meets(i, r) holds for some i: for an object entered whole, whose box is
+    // that of all its parts.
+    virtual bool cull_meets_any(const Ray& r) const {
+        for (std::size_t i = 0; i < cull_count(); ++i)
+            if (cull_meets(i, r)) return true;
+        return false;
+    }
     // A capsule that every line cull_meets(i, .) accepts meets, placed by xf (world space), if
     // the cull part has one: the accelerator rejects rays by it before mapping them into the
     // shape's space. widest as for cull_bounds.

@@ -44,6 +44,7 @@ public:
         return frame_.cull_bounds(i, xf);
     }
     bool cull_meets(std::size_t i, const Ray& r) const override { return frame_.cull_meets(i, r); }
+    bool cull_meets_any(const Ray& r) const override { return frame_.cull_meets_any(r); }
     bool cull_capsule(std::size_t i, const Transform& xf, double, Capsule& out) const override {
         return frame_.cull_capsule(i, xf, out);
     }

@@ -92,6 +92,7 @@ public:
     bool cull_meets(std::size_t i, const Ray& r) const override {
         return cull_frame().cull_meets(i, r);
     }
+    bool cull_meets_any(const Ray& r) const override { return cull_frame().cull_meets_any(r); }
     bool cull_capsule(std::size_t i, const Transform& xf, double, Capsule& out) const override {
         return cull_frame().cull_capsule(i, xf, out);
     }

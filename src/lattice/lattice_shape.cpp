@@ -1,6 +1,7 @@
 #include "lattice/lattice_shape.h"
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <cmath>
 
@@ -18,6 +19,8 @@ LatticeFrame::LatticeFrame(const TableContext& ctx, double reach, double beyond_
       box_{{0, 0, 0},
            Vec3{double(ctx.cells[0]), double(ctx.cells[1]), double(ctx.cells[2])} * ctx.cell} {
     make_cull_parts(ctx.primitive, reach, expand(box_, beyond_box));
+    if (std::all_of(cull_.begin(), cull_.end(), [](const CullPart& p) { return p.count > 0; }))
+        screen_ = CapsuleScreen(capsules_);
     if (std::isfinite(reach) && beyond_box >= reach) max_narrower_ = reach;
 }
 
@@ -149,6 +152,21 @@ bool LatticeFrame::cull_meets(std::size_t i, const Ray& r, double narrower) cons
     if (p.count == 0) return true;
     for (std::uint32_t k = p.first; k < p.first + p.count; ++k)
         if (capsules_[k].meets_line(r.o, r.d, capsules_[k].r - narrower)) return true;
+    return false;
+}
+
+bool LatticeFrame::cull_meets_any(const Ray& r, double narrower) const {
+    if (screen_.empty()) {
+        for (std::size_t i = 0; i < cull_.size(); ++i)
+            if (cull_meets(i, r, narrower)) return true;
+        return false;
+    }
+    // Every part's capsules are among capsules_, and the screen names each one its test
+    // (cull_meets') may accept.
+    for (std::uint32_t m = screen_.may_meet(r.o, r.d, narrower); m != 0; m &= m - 1) {
+        const Capsule& c = capsules_[static_cast<std::size_t>(std::countr_zero(m))];
+        if (c.meets_line(r.o, r.d, c.r - narrower)) return true;
+    }
     return false;
 }
 

@@ -10,6 +10,7 @@
 #include <optional>
 #include <vector>
 
+#include "geometry/capsule_screen.h"
 #include "geometry/parts.h"
 #include "geometry/shape.h"
 #include "lattice/boundary_grid.h"
@@ -37,6 +38,8 @@ public:
     std::size_t cull_count() const { return cull_.size(); }
     Bounds3 cull_bounds(std::size_t i, const Transform& xf, double narrower = 0) const;
     bool cull_meets(std::size_t i, const Ray& r, double narrower = 0) const;
+    // Whether cull_meets(i, r, narrower) holds for some i (the same answer, sooner).
+    bool cull_meets_any(const Ray& r, double narrower = 0) const;
     // See CullParts::cull_capsule: a cull part of one capsule has it.
     bool cull_capsule(std::size_t i, const Transform& xf, Capsule& out, double narrower = 0) const;
 
@@ -85,6 +88,9 @@ private:
     };
     std::vector<CullPart> cull_;
     std::vector<Capsule> capsules_;
+    // All capsules_, when every cull part has some (cull_meets_any): most lines that meet an
+    // instance's box miss its capsules, and the screen rejects them in float, four at once.
+    CapsuleScreen screen_;
     std::vector<std::uint32_t> parts_;
     std::optional<ShapeParts> primitive_;  // its parts, when placed_parts bounds by them
     double reach_ = 0;

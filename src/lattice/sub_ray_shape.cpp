@@ -159,6 +159,10 @@ bool SubRayShape::cull_meets(std::size_t i, const Ray& r) const {
     return frame_.cull_meets(i, r, unspanned_reach(footprint_width(r)));
 }
 
+bool SubRayShape::cull_meets_any(const Ray& r) const {
+    return frame_.cull_meets_any(r, unspanned_reach(footprint_width(r)));
+}
+
 // The crossings of kExactSubRays^2 sub-rays parallel to r, on a grid across its footprint (for
 // camera rays the pixel's box filter, as exact mode at that many samples would, but on this
 // primitive only and shaded once a sheet: sheets). A camera ray's are those of the sub-rays'

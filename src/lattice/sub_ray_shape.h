@@ -77,6 +77,7 @@ public:
     }
     // By the reach of the ray's own sub-rays.
     bool cull_meets(std::size_t i, const Ray& r) const override;
+    bool cull_meets_any(const Ray& r) const override;
     bool cull_capsule(std::size_t i, const Transform& xf, double widest,
                       Capsule& out) const override {
         return frame_.cull_capsule(i, xf, out, unspanned_reach(widest));

@@ -31,6 +31,14 @@ Transform Scene::transform(std::size_t i) const {
     return objects[object].xf;
 }
 
+void Scene::prefetch_transform(std::size_t i) const {
+    if (const ScatterGroup* g = group_of(i)) {
+        const char* p = reinterpret_cast<const char*>(&g->placements[i]);
+        __builtin_prefetch(p);
+        __builtin_prefetch(p + sizeof(Affine) - 1);
+    }
+}
+
 const std::shared_ptr<const Shape>& Scene::shape_of(std::size_t i) const {
     const std::size_t object = i;
     if (const ScatterGroup* g = group_of(i)) return g->shape;

@@ -73,6 +73,9 @@ struct Scene {
     // Object i whole (for instances, made from its group: a copy, for uses off the hot path).
     SceneObject object(std::size_t i) const;
     Transform transform(std::size_t i) const;  // object -> world
+    // Starts reading what transform(i) reads into the cache: a ray's layers are met all over
+    // a million instances' placements, and their misses overlap when started together.
+    void prefetch_transform(std::size_t i) const;
     const std::shared_ptr<const Shape>& shape_of(std::size_t i) const;
     std::uint32_t material_of(std::size_t i) const;
     int primitive_of(std::size_t i) const;  // -1: not an instance

@@ -81,6 +81,8 @@ bool TracedScene::intersect_layers(const Ray& r, double tmin, double tmax, std::
     AccelHit h;
     thread_local std::vector<AccelHit> layers;
     const bool found = accel_->intersect_layers(r, tmin, tmax, self, h, layers, stop);
+    if (found) scene_.prefetch_transform(h.object);
+    for (const AccelHit& l : layers) scene_.prefetch_transform(l.object);
     if (found) surface_hit(r, h, hit);
     partial.resize(layers.size());
     for (std::size_t i = 0; i < layers.size(); ++i) surface_hit(r, layers[i], partial[i]);
