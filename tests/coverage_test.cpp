@@ -473,6 +473,103 @@ TEST(Coverage, AThinPrimitiveHasTheRightBrightness) {
     EXPECT_NEAR(ratio[1], 1.0, 0.02) << "smooth filter";
 }
 
+// A bead in a 2 x 2 x 2 lattice over a floor, once, or with copies turned about its centre
+// (the same solid), which a ray meets in the same place: with sub-rays along the world's
+// directions, the copies' partial crossings block the same sub-rays, and the image is the
+// single bead's, silhouettes and the floor's soft shadow included. (Offsets along each copy's
+// own axes, or coverages composed as independent, made the edges and the shadow darker.) The
+// bead is lit by the ambient term alone: the copies, other objects in the same place, would
+// shadow each other as coincident objects do in exact mode.
+constexpr const char* kTurnedCopies = R"({
+  "camera": {"eye": [4, -6, 3.5], "look_at": [1, 1, 1], "up": [0, 0, 1], "fov_y_deg": 22,
+             "width": 40, "height": 40},
+  "background": [0, 0, 0], "ambient": [1, 1, 1], "shadows": true,
+  "lights": [{"position": [2, -1, 9], "intensity": [1, 1, 1]}],
+  "materials": {"w": {"color": [1, 1, 1], "ka": 0.5, "kd": 0, "ks": 0, "shininess": 1},
+                "floor": {"color": [0.8, 0.8, 0.8], "ka": 0.2, "kd": 0.8, "ks": 0, "shininess": 1}},
+  "primitives": {"bead": {"spheres": [[1, 1, 1, 0.45]], "cylinders": [],
+                          "lattice": {"sigma": 1, "cells": [2, 2, 2]}}},
+  "objects": [{"type": "halfspace", "point": [0, 0, 0.3], "normal": [0, 0, 1], "material": "floor"},
+              {"type": "instance", "primitive": "bead", "material": "w"}COPIES]
+})";
+
+// The scene `text` in lattice mode, the default filter, answered by sub-rays.
+Image8 render_filtered(const std::string& text) {
+    test::TempDir dir;
+    const std::string path = (dir.path() / "copies.json").string();
+    std::ofstream(path) << text;
+    const Scene s = load_scene(path);
+    const TableCache cache(dir.path().string());
+    TableSpec spec;
+    spec.encoding = "coverage";
+    const double spread = 2 * std::tan(22 * M_PI / 360.0) / 40;
+    const SceneLattices l = scene_lattices(s, cache, spec, false, {LatticeFilter::kSmooth, true, spread});
+    const TracedScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
+    const RenderOptions opt;
+    const Image8 image = render_layered(rs, opt).display;
+    // The same bytes on one thread (the directions across are per ray, not per thread).
+    Image8 one;
+    tbb::task_arena(1).execute([&] { one = render_layered(rs, opt).display; });
+    EXPECT_EQ(one.rgb, image.rgb);
+    return image;
+}
+
+Image8 render_turned_copies(const std::string& copies) {
+    std::string text = kTurnedCopies;
+    text.replace(text.find("COPIES"), 6, copies);
+    return render_filtered(text);
+}
+
+// A bead turned about its centre is the same solid, and shades the same in Phong light with
+// shadows: its sheets' sub-rays' own normals are turned into the world with it (SubRayNormals).
+TEST(Coverage, ATurnedBeadShadesAsTheBead) {
+    std::string text = kTurnedCopies;
+    text.replace(text.find("COPIES"), 6, "");
+    const std::string matte = R"("ka": 0.5, "kd": 0, "ks": 0, "shininess": 1)";
+    text.replace(text.find(matte), matte.size(),
+                 R"("ka": 0.1, "kd": 0.6, "ks": 0.5, "shininess": 12)");
+    const Image8 plain = render_filtered(text);
+    const std::string instance = R"("primitive": "bead", "material": "w")";
+    text.replace(
+        text.find(instance), instance.size(),
+        instance +
+            R"(, "transform": [{"translate": [-1, -1, -1]},)"
+            R"( {"rotate": {"axis": [1, 2, 3], "angle_deg": 70}}, {"translate": [1, 1, 1]}])");
+    const Image8 turned = render_filtered(text);
+    ASSERT_EQ(plain.rgb.size(), turned.rgb.size());
+    int off = 0, lit = 0;
+    for (std::size_t i = 0; i < plain.rgb.size(); ++i) {
+        off += std::abs(int(plain.rgb[i]) - int(turned.rgb[i])) > 1;
+        lit += plain.rgb[i] > 60;
+    }
+    EXPECT_EQ(off, 0);
+    EXPECT_GT(lit, 100);
+}
+
+TEST(Coverage, TurnedCopiesOfABeadRenderAsOne) {
+    const Image8 one = render_turned_copies("");
+    const std::string turned =
+        R"(, {"type": "instance", "primitive": "bead", "material": "w", "transform": [)"
+        R"({"translate": [-1, -1, -1]}, {"rotate": {"axis": [AXIS], "angle_deg": ANGLE}},)"
+        R"( {"translate": [1, 1, 1]}]})";
+    std::string copies;
+    for (const auto& [axis, angle] : {std::pair{"0, 0, 1", "90"}, {"1, 2, 3", "70"}, {"3, -1, 1", "200"}}) {
+        std::string c = turned;
+        c.replace(c.find("AXIS"), 4, axis);
+        c.replace(c.find("ANGLE"), 5, angle);
+        copies += c;
+    }
+    const Image8 many = render_turned_copies(copies);
+    ASSERT_EQ(one.rgb.size(), many.rgb.size());
+    int partial = 0, off = 0;
+    for (std::size_t i = 0; i < one.rgb.size(); ++i) {
+        off += std::abs(int(one.rgb[i]) - int(many.rgb[i])) > 1;
+        partial += one.rgb[i] > 5 && one.rgb[i] < 100;  // a bead's edge against the black sky
+    }
+    EXPECT_EQ(off, 0);
+    EXPECT_GT(partial, 10);
+}
+
 // Hairs of radius 0.15 in cells of 1 seen from afar, a pixel about as wide as a cell (what
 // the levels of detail choose), lit from the eye: a hair's pairs cover its whole width, whose
 // normals' mean is about pi/4 long. Shaded as a unit normal, the diffuse light was a fifth
