@@ -80,8 +80,8 @@ AtomicFile::AtomicFile(std::string target, std::string what)
     temp_ = name.data();
     register_temp(temp_);
     // Held until the descriptor closes (commit, destruction or the process's death), so that
-    // remove_abandoned_temp leaves a live writer's temporary alone. A filesystem without flock
-    // support gets none, and only the cache's age rule protects its temporaries.
+    // remove_abandoned_temp leaves a live writer's temporary alone. On a filesystem without
+    // flock its own lock fails too, and old temporaries stay rather than risk a live one.
     (void)::flock(fd, LOCK_EX | LOCK_NB);
     // mkstemp creates 0600; the target should get the usual permissions.
     static const mode_t mask = current_umask();

@@ -22,8 +22,9 @@ const Encoding kCoverageEncoding{
     .bytes_per_hit = 78.0,
     .needs_hits = true,
     .coverage = true,
-    .layout = 4,  // 4: 4-byte records with the normals' spread; 3: 4-byte coverage records without it; 2: 8-byte ones, pairs filed by face pair in
-                 // tiles (pair_index.h); 1: a * N + b
+    // 4: 4-byte coverage records with the normals' spread; 3: without it; 2: 8-byte ones,
+    // pairs filed by face pair in tiles (pair_index.h); 1: a * N + b
+    .layout = 4,
     .build = &CoverageTable::build,
     .open = [](const std::uint8_t* payload, std::size_t size, std::uint64_t entries,
                const TableContext& ctx) -> std::unique_ptr<LatticeTable> {
