@@ -61,6 +61,7 @@ struct QueryContext {
         object_footprint.width0 = r.footprint->width0;
         object_footprint.spread = r.footprint->spread;
         object_footprint.coverage_only = r.footprint->coverage_only;
+        object_footprint.seen_until = r.footprint->seen_until;
         local_footprint = &object_footprint;
     }
     QueryContext(const QueryContext&) = delete;

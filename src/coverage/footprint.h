@@ -16,6 +16,17 @@ inline const RayFootprint& footprint_of(const Ray& r) {
     return r.footprint ? *r.footprint : kNoFootprint;
 }
 
+// The share of a footprint-wide answer's coverage at parameter t of a shadow ray to count
+// (RayFootprint::seen_until): none at the start, rising linearly to all of it where the ray's
+// line leaves the camera footprint of the surface it leaves. The camera's lines reached that
+// surface through whatever lies in their footprint, so the coverage a filter finds there, near
+// the start, lies mostly beside those lines and their shadow rays, not on them. (With the
+// light at the eye every shadow ray retraces its camera line: nothing casts a shadow that can
+// be seen.) A line's own answer needs no share: it is exact.
+inline double unseen_share(const RayFootprint& f, double t) {
+    return f.seen_until > 0 ? std::clamp(t / f.seen_until, 0.0, 1.0) : 1.0;
+}
+
 // The width of r's footprint (in r's space) where r passes nearest `p`, and at r's origin for a
 // point behind it: a shape takes its centre, one width for the whole shape.
 inline double footprint_width_at(const Ray& r, Vec3 p) {

@@ -16,6 +16,15 @@ double shadow_width(Vec3 n, Vec3 camera_d, Vec3 shadow_d, double width) {
     return width * std::clamp(std::sqrt(cl / cv), 1 / kMaxShadowWidening, kMaxShadowWidening);
 }
 
+double seen_until(Vec3 camera_d, Vec3 shadow_d, double width, double distance) {
+    const double c = -dot(camera_d, shadow_d) / (length(camera_d) * length(shadow_d));
+    if (!(c > 0) || !(width > 0) || !(distance > 0)) return 0;
+    const double s = std::sqrt(std::max(0.0, 1 - c * c));
+    // Offset s * x from the line at x along the shadow ray; half-width (width / 2) (1 - c x /
+    // distance) there.
+    return 0.5 * width / (s + 0.5 * width * c / distance);
+}
+
 // A sheet of sub-rays covers the share of the footprint its coverage says, and its shadow rays'
 // footprint is as wide as that share's area.
 double sheet_width(double alpha, std::uint8_t sub_rays, double width) {

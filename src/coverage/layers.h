@@ -36,6 +36,12 @@ inline LayerStop shadow_stop() { return {.blocked_below = kMinTransmittance}; }
 // camera_d with a footprint `width` wide, towards shadow_d.
 double shadow_width(Vec3 n, Vec3 camera_d, Vec3 shadow_d, double width);
 
+// How far a shadow ray towards shadow_d stays within the camera footprint, `width` wide, of
+// the surface it leaves, seen along camera_d from `distance` away (RayFootprint::seen_until):
+// until its offset from the camera's line reaches the footprint's half-width, which narrows
+// towards the eye. 0 when it leaves on the far side, away from the eye.
+double seen_until(Vec3 camera_d, Vec3 shadow_d, double width, double distance);
+
 // The footprint's width at a layer of this coverage and these sub-rays, `width` the ray's
 // there.
 double sheet_width(double alpha, std::uint8_t sub_rays, double width);

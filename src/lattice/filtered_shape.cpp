@@ -136,13 +136,16 @@ void FilteredLatticeShape::add_blend(const Level& l, const Blend& b, bool normal
     // for its share ahead of it (crossing_share_ahead).
     const double dd = dot(r.d, r.d);
     const double spread = kCrossingSpreadCells * l.frame.cell() / std::sqrt(dd);  // in t
-    // Adds pair i of `bl` (looked up as h) for the share of its crossings r meets after tmin;
-    // false when that share is 0.
+    const RayFootprint& f = footprint_of(r);
+    // Adds pair i of `bl` (looked up as h) for the share of its crossings r meets after tmin,
+    // and of that, a shadow ray's share unseen by the camera (unseen_share); false when the
+    // share ahead is 0.
     auto add_if_ahead = [&](const Blend& bl, int i, const CoverageHit& hi) {
         const Vec3 p = lerp(to_vec(bl.ca[i]), to_vec(bl.cb[i]), hi.t) * l.frame.cell();
-        const double ahead = crossing_share_ahead(dot(p - r.o, r.d) / dd - tmin, spread);
+        const double t = dot(p - r.o, r.d) / dd;
+        const double ahead = crossing_share_ahead(t - tmin, spread);
         if (ahead <= 0) return false;
-        s.add(bl.w[i] * ahead, hi, p);
+        s.add(bl.w[i] * ahead * unseen_share(f, t), hi, p);
         return true;
     };
     Blend back;

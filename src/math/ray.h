@@ -26,6 +26,12 @@ struct RayFootprint {
     // The ray wants only each sheet's coverage and where it lies (a shadow ray's
     // transmittance): the normals are not decoded, and the crossing's normal faces the ray.
     bool coverage_only = false;
+    // A shadow ray's: how far (parameter t of the world ray, unit direction) its line stays
+    // within the camera footprint of the surface it leaves (0: not at all). Along that stretch
+    // the camera footprint saw through to the surface, so what a footprint-wide answer finds
+    // there mostly lies beside the lines that reached the surface, not on their shadow rays
+    // (coverage/footprint.h: unseen_share).
+    double seen_until = 0;
 };
 
 // A footprint for a world ray of unit direction `unit_direction`, with its directions across.

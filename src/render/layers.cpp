@@ -16,7 +16,8 @@ Vec3 shade_layer(const TracedScene& rs, const InstanceShadows* maps, const Ray& 
         // Narrowing to the light; sub-rays along the same world directions in every lattice
         // (coverage/sub_rays.h).
         const double leaving = shadow_width(hit.n, ray.d, r.d, width);
-        const TraceRay shadow = TraceRay::shadow(r, leaving, dist);
+        const TraceRay shadow = TraceRay::shadow(
+            r, leaving, dist, seen_until(ray.d, r.d, width, hit.t * length(ray.d)));
         if (maps && maps->mapped(light))
             return maps->visible(light, shadow.ray(), tmin, tmax, hit.object, leaving,
                                  state.kept_blocker(light));

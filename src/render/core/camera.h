@@ -27,8 +27,11 @@ struct TraceRay {
 
     // A shadow ray along r (unit direction) leaving a surface where its footprint is `width`
     // wide, narrowing to the point light `dist` away.
-    static TraceRay shadow(const Ray& r, double width, double dist) {
-        return {r.o, r.d, footprint_across(normalize(r.d), width, -width / dist, true)};
+    // seen_until: RayFootprint's.
+    static TraceRay shadow(const Ray& r, double width, double dist, double seen_until) {
+        TraceRay t{r.o, r.d, footprint_across(normalize(r.d), width, -width / dist, true)};
+        t.footprint.seen_until = seen_until;
+        return t;
     }
 };
 
