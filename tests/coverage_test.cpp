@@ -25,6 +25,7 @@
 #include "lattice/filtered_shape.h"
 #include "lattice/lattice_shape.h"
 #include "lattice/rasterizer.h"
+#include "render/core/camera.h"
 #include "render/modes/integrators.h"
 #include "render/modes/scene_lattices.h"
 #include "scene/scene_loader.h"
@@ -618,6 +619,26 @@ TEST(Coverage, NoShadowIsSeenFromTheLight) {
         EXPECT_NEAR(shadowed[f] / lit[f], 1.0, 0.01) << (f == 0 ? "box filter" : "smooth filter");
         EXPECT_NEAR(shadowed[f], 1.0, 0.06) << (f == 0 ? "box filter" : "smooth filter");
     }
+}
+
+// The same rows answered by their own crossings of sub-rays (footprint filtering), whose shadow
+// rays' sub-rays count only past the middle of that stretch: without it, shadows darkened the
+// image by 1.7 %.
+TEST(Coverage, NoShadowIsSeenFromTheLightBySubRays) {
+    auto brightness = [](bool shadows) {
+        const Scene s = load_scene_text(thin_hairs_lit_from_the_eye(4, shadows), "rows.json");
+        LatticeFiltering f;
+        f.filter = LatticeFilter::kSmooth;
+        f.lod = true;
+        f.policy = LatticePolicy::kFootprint;
+        f.spread = PinholeCamera(s.camera).spread();
+        const SceneLattices l = scene_lattices(s, nullptr, TableSpec{}, false, f);
+        const TracedScene rs(s, [&](int p) { return l.shapes[static_cast<std::size_t>(p)]; });
+        return mean_brightness(render_layered(rs, RenderOptions{}).display);
+    };
+    const double lit = brightness(false);
+    EXPECT_GT(lit, 2.0);
+    EXPECT_NEAR(brightness(true) / lit, 1.0, 0.01);
 }
 
 }  // namespace
