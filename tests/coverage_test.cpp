@@ -622,8 +622,7 @@ TEST(Coverage, NoShadowIsSeenFromTheLight) {
 }
 
 // The same rows answered by their own crossings of sub-rays (footprint filtering), whose shadow
-// rays' sub-rays count only past the middle of that stretch: without it, shadows darkened the
-// image by 1.7 %.
+// rays' sub-rays count only past that stretch: without it, shadows darkened the image by 1.7 %.
 TEST(Coverage, NoShadowIsSeenFromTheLightBySubRays) {
     auto brightness = [](bool shadows) {
         const Scene s = load_scene_text(thin_hairs_lit_from_the_eye(4, shadows), "rows.json");

@@ -69,13 +69,15 @@ bool SubRayShape::sheet(const Ray& r, double tmin, double tmax, bool normal, Cro
     Sheet s;
     SubRayHits h;
     sub_ray_hits(sub_ray_width(r), normal, r, tmin, tmax, h);
-    // A shadow ray's sub-rays count where most of their crossing's coverage is unseen by the
-    // camera (unseen_share: a sub-ray counts whole or not at all, so the ramp is cut at its
-    // middle). Camera rays have no such share (seen_until is 0).
+    // A shadow ray's sub-rays count only crossings the camera did not see at all
+    // (unseen_share 1): a sub-ray counts whole or not at all, and spread across a shadow
+    // footprint wider than the camera's, its lines reach more of what the camera saw. (Cut at
+    // the share's middle instead, a million hairs' shadows stayed 1 % too dark: 34.65 dB
+    // against 35.25.) Camera rays have no such share (seen_until is 0).
     unsigned met = h.met;
     if (!normal)
         for (unsigned m = met; m != 0; m &= m - 1)
-            if (const int k = std::countr_zero(m); unseen_share(footprint_of(r), h.t[k]) < 0.5)
+            if (const int k = std::countr_zero(m); unseen_share(footprint_of(r), h.t[k]) < 1)
                 met &= ~(1u << k);
     add_sub_rays(h, met, s);
     return to_crossing(s, r, tmin, tmax, normal, hit);
