@@ -72,13 +72,13 @@ bool SubRayShape::sheet(const Ray& r, double tmin, double tmax, bool normal, Cro
     // A shadow ray's sub-rays count only crossings the camera did not see at all
     // (unseen_share 1): a sub-ray counts whole or not at all, and spread across a shadow
     // footprint wider than the camera's, its lines reach more of what the camera saw. (Cut at
-    // the share's middle instead, a million hairs' shadows stayed 1 % too dark: 34.65 dB
-    // against 35.25.) Camera rays have no such share (seen_until is 0).
+    // the share's middle instead, a million hairs' shadows stayed too dark:
+    // bench/notes/scale-log.md.)
+    const RayFootprint& f = footprint_of(r);
     unsigned met = h.met;
-    if (!normal)
+    if (f.seen_until > 0)
         for (unsigned m = met; m != 0; m &= m - 1)
-            if (const int k = std::countr_zero(m); unseen_share(footprint_of(r), h.t[k]) < 1)
-                met &= ~(1u << k);
+            if (const int k = std::countr_zero(m); unseen_share(f, h.t[k]) < 1) met &= ~(1u << k);
     add_sub_rays(h, met, s);
     return to_crossing(s, r, tmin, tmax, normal, hit);
 }
