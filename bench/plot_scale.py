@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plots bench/results/scale.json (bench/scale.py): total time and peak memory against the number
-of hairs, log-log, exact mode at its best setting and lattice mode (default filter, deep
-shadow maps, and point-sampled tables); with a second file (an earlier binary's run), its lines dashed.
+of hairs, log-log, exact mode at its best setting, lattice mode (default filter, deep
+shadow maps, and point-sampled tables) and auto mode; with a second file (an earlier binary's run), its lines dashed.
 Usage: plot_scale.py scale.json out.png [earlier.json]   (python3-matplotlib, from Debian)"""
 import json
 import os
@@ -15,7 +15,8 @@ from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 SERIES = [("exact (best --instancing)", None, "black"), ("lattice", "lattice", "tab:orange"),
           ("lattice, deep shadow maps", "lattice deep-map", "tab:green"),
-          ("lattice --filter none", "lattice none", "tab:blue")]
+          ("lattice --filter none", "lattice none", "tab:blue"),
+          ("auto (sub-rays, no table)", "auto", "tab:purple")]
 
 
 def points(res, label, key):

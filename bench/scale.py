@@ -12,6 +12,8 @@ scatters (seeds 1, 2, ...), so that every binary reads the same scene. For each 
 - lattice mode at 1 spp, with its default filter (shadow rays through the tables), with the
   instances' shadows from deep shadow maps (`--instance-shadows deep-map`), and point-sampled
   (`--filter none`);
+- auto mode at 1 spp (a hair, cheap to intersect, answered by its own crossings of 2 x 2
+  sub-rays across each footprint: no table);
 
 each once (at these sizes a run takes seconds: one run, interleaved with nothing; the load
 average is recorded beside). Load, build, render and total times and peak memory come from
@@ -20,10 +22,10 @@ read as the stats are written, after the image). PSNR is against exact mode at T
 (stratified jitter) where that truth can be rendered in reasonable time (up to TRUTH_UP_TO
 hairs), cached in the work directory under the scene's bytes.
 
-Time: the full run (20 k to 4 M) takes about 15 minutes on 2 idle cores with its truths cached
-(30 under a load average of 10), and the first time some 15 more for the truths (the 1 M one
-the most); --quick (20 k and 200 k) a few minutes. Lattice mode's default filter at 1 M and 4 M
-is the bulk of it.
+Time: the full run (20 k to 10 M) takes about 35 minutes on 2 idle cores with its truths cached
+(twice that under a load average of 10), and the first time some 15 more for the truths (the
+1 M one the most); --quick (20 k and 200 k) a few minutes. Lattice mode's default filter at 4 M
+and 10 M is the bulk of it. 10 M hairs peak at about 5 GB in lattice mode and 7 in exact mode.
 Writes RESULTS/scale.json (or --name) and prints a Markdown table.
 
 usage: scale.py LATTICE RESULTS [--work DIR] [--quick] [--sizes 20000,...] [--name scale]"""
@@ -36,7 +38,7 @@ import subprocess
 from modes import ground_truth, psnr
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-SIZES = [20_000, 200_000, 1_000_000, 4_000_000]
+SIZES = [20_000, 200_000, 1_000_000, 4_000_000, 10_000_000]
 QUICK_SIZES = [20_000, 200_000]
 MAX_PER_SCATTER = 2_000_000  # the scatter count limit of older binaries
 NEVER_UP_TO = 1_000_000
@@ -110,6 +112,7 @@ def measure(lattice, hairs, work, truth_up_to):
     run("lattice", ["--mode", "lattice"])
     run("lattice deep-map", ["--mode", "lattice", "--instance-shadows", "deep-map"])
     run("lattice none", ["--mode", "lattice", "--filter", "none"])
+    run("auto", ["--mode", "auto"])
     truth = truth_for(lattice, scene, work) if hairs <= truth_up_to else None
     for r in runs.values():
         if truth and "total_ms" in r:
