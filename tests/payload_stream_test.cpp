@@ -173,6 +173,23 @@ TEST(PayloadStream, PointHitsGiveTheSameBytes) {
         }
 }
 
+// PointHits that something else holds too are sorted in a copy: the same payload, and the
+// holder's hits are left as they were.
+TEST(PayloadStream, SharedPointHitsGiveTheSameBytesAndStayUntouched) {
+    const Rasterized& r = hair(1);
+    RasterizeOptions opt;
+    opt.point_hits = true;
+    const RasterizeResult own = rasterize(r.ctx, opt);
+    const std::vector<PointHit> before = own.points.flatten();
+    PointHits shared = own.points;
+    CountingSink sink;
+    find_encoding("hash14").stream_points(std::move(shared), r.ctx, {}, sink);
+    EXPECT_TRUE(sink.bytes == hash14_reference(r.raster.raw));
+    const std::vector<PointHit> after = own.points.flatten();
+    ASSERT_EQ(after.size(), before.size());
+    EXPECT_EQ(std::memcmp(after.data(), before.data(), before.size() * sizeof(PointHit)), 0);
+}
+
 TEST(PayloadStream, NoHitsMakeTheSamePayload) {
     const Encoding& e = find_encoding("hash14");
     const Rasterized& r = hair(1);
