@@ -43,7 +43,10 @@ struct Counts {
     std::uint64_t enumerated = 0, traced = 0, hits = 0, counted = 0, tests = 0;
 };
 
-// Per-thread output: hits go into large huge-page buffers; a block's hits stay contiguous.
+// Per-thread output: hits go into large buffers; a block's hits stay contiguous. Small pages:
+// the hits are written once in order and read chunk by chunk, so huge pages would save few TLB
+// misses, and on a virtual machine that hands freed memory back to its host (free page
+// reporting) a huge page touched first costs several times its 512 small pages.
 template <class Hit>
 class HitArena {
 public:
@@ -66,7 +69,7 @@ private:
         // Move the unfinished block to the new buffer so that it stays in one piece.
         const std::size_t partial = used_ - block_start_;
         const std::size_t cap = std::max(kHits, 2 * partial);
-        auto buf = std::make_shared<ByteBuffer>(cap * sizeof(Hit));
+        auto buf = std::make_shared<ByteBuffer>(cap * sizeof(Hit), ByteBuffer::Pages::kSmall);
         auto* next = reinterpret_cast<Hit*>(buf->data());
         std::copy(cur_ + block_start_, cur_ + used_, next);
         buffers_.push_back(buf);
