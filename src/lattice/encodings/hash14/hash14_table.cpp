@@ -121,8 +121,8 @@ struct Partitioning {
     std::uint64_t p0(std::uint64_t g) const { return std::min(parts, g * kGroup); }
 };
 
-// Where the entries are once each chunk is sorted by partition in place: chunk c's entries of
-// partition p at [local[c (parts + 1) + p], local[c (parts + 1) + p + 1]) of the chunk. The
+// Where the entries are once each chunk is sorted by group in place: chunk c's entries of
+// group g at [local[c (groups + 1) + g], local[c (groups + 1) + g + 1]) of the chunk. The
 // placement needs too where each partition's entries start in entry order (part_start, parts
 // + 1 values) and its overflow entries in the payload (over_start).
 struct Layout {
@@ -152,59 +152,67 @@ std::vector<std::span<Sorted>> writable_chunks(PointHits& entries) {
     return out;
 }
 
-// A thread's scratch for sorting one chunk: each entry's partition, and the sorted copy.
+// A thread's scratch for sorting one chunk: each entry's bucket, the sorted copy with its
+// buckets, the chunk's count in each partition and the buckets it uses (a bitset).
 struct ChunkScratch {
-    std::vector<std::uint32_t> part;
+    std::vector<std::uint32_t> bucket, sorted_bucket;
     std::vector<Sorted> sorted;
-    std::vector<std::uint64_t> used;  // bitset of used buckets
+    std::vector<std::uint64_t> part_count, used;
 };
 
-// One chunk, while it stays in cache: its count in each partition, the buckets it uses, and
-// its entries sorted stably by partition, in place.
+// One chunk, while it stays in cache: its count in each partition (added to s.part_count), the
+// buckets it uses, and its entries sorted stably by group, in place.
 void sort_chunk(std::span<Sorted> chunk, const Partitioning& pt, std::uint32_t* local,
                 ChunkScratch& s) {
-    s.part.resize(chunk.size());
+    s.bucket.resize(chunk.size());
+    s.sorted_bucket.resize(chunk.size());
     s.sorted.resize(chunk.size());
-    std::fill(local, local + pt.parts + 1, 0u);
+    std::fill(local, local + pt.groups + 1, 0u);
+    constexpr int kGroupShift = kPartBits + 4;
+    static_assert(kGroup == 16);
     for (std::size_t i = 0; i < chunk.size(); ++i) {
         const Sorted& e = chunk[i];
         if (e.a >= Hash14Table::kMaxPoints || e.b >= Hash14Table::kMaxPoints)
             throw std::length_error("hash14: point id over 16 bits");
-        const std::uint64_t b = pt.bucket(e);
-        s.part[i] = static_cast<std::uint32_t>(b >> kPartBits);
-        ++local[s.part[i] + 1];
-        s.used[b / 64] |= std::uint64_t{1} << (b % 64);
+        const auto b = static_cast<std::uint32_t>(pt.bucket(e));  // buckets < 2^32
+        s.bucket[i] = b;
+        ++s.part_count[b >> kPartBits];
+        ++local[(b >> kGroupShift) + 1];
     }
-    for (std::uint64_t p = 0; p < pt.parts; ++p) local[p + 1] += local[p];
-    // local[p] runs to partition p's end as its entries are scattered, then is moved back.
-    for (std::size_t i = 0; i < chunk.size(); ++i) s.sorted[local[s.part[i]]++] = chunk[i];
-    for (std::uint64_t p = pt.parts; p > 0; --p) local[p] = local[p - 1];
+    for (std::uint64_t g = 0; g < pt.groups; ++g) local[g + 1] += local[g];
+    // local[g] runs to group g's end as its entries are scattered, then is moved back.
+    for (std::size_t i = 0; i < chunk.size(); ++i) {
+        const std::uint32_t to = local[s.bucket[i] >> kGroupShift]++;
+        s.sorted[to] = chunk[i];
+        s.sorted_bucket[to] = s.bucket[i];
+    }
+    for (std::uint64_t g = pt.groups; g > 0; --g) local[g] = local[g - 1];
     local[0] = 0;
     std::copy(s.sorted.begin(), s.sorted.end(), chunk.begin());
+    // In group order the bitset is visited a small range at a time.
+    for (const std::uint32_t b : s.sorted_bucket) s.used[b / 64] |= std::uint64_t{1} << (b % 64);
 }
 
-// Every chunk sorted by partition in place (sort_chunk, in parallel), then the partitions'
-// starts in the entries and in the payload's overflow area.
+// Every chunk sorted by group in place (sort_chunk, in parallel), then the partitions' starts
+// in the entries and in the payload's overflow area.
 Layout sort_chunks(const std::vector<std::span<Sorted>>& chunks, const Partitioning& pt) {
     const std::size_t nchunks = chunks.size();
-    const std::uint64_t parts = pt.parts, row = parts + 1;
+    const std::uint64_t parts = pt.parts, row = pt.groups + 1;
     Layout l;
     l.local.resize(nchunks * row);
     const std::size_t words = (pt.buckets + 63) / 64;
     tbb::enumerable_thread_specific<ChunkScratch> scratch;
     tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
         ChunkScratch& s = scratch.local();
-        if (s.used.empty()) s.used.assign(words, 0);
+        if (s.used.empty()) s.used.assign(words, 0), s.part_count.assign(parts, 0);
         sort_chunk(chunks[c], pt, &l.local[c * row], s);
     });
     std::vector<std::uint64_t> used(words, 0);
-    for (const ChunkScratch& s : scratch)
-        for (std::size_t w = 0; w < s.used.size(); ++w) used[w] |= s.used[w];
-
     l.part_start.assign(parts + 1, 0);
-    for (std::size_t c = 0; c < nchunks; ++c)  // row by row: the offsets lie in that order
-        for (std::uint64_t p = 0; p < parts; ++p)
-            l.part_start[p + 1] += l.local[c * row + p + 1] - l.local[c * row + p];
+    for (const ChunkScratch& s : scratch) {
+        for (std::size_t w = 0; w < s.used.size(); ++w) used[w] |= s.used[w];
+        for (std::uint64_t p = 0; p < s.part_count.size(); ++p) l.part_start[p + 1] += s.part_count[p];
+    }
     // Overflow entries: a partition's entries less its used buckets (b0(p) is a multiple of 64).
     l.over_start.assign(parts + 1, pt.buckets);
     for (std::uint64_t p = 0; p < parts; ++p) {
@@ -217,34 +225,46 @@ Layout sort_chunks(const std::vector<std::span<Sorted>>& chunks, const Partition
     return l;
 }
 
-// Group g's buckets, then its overflow entries, into stage, partition by partition; a
-// partition's entries in entry order are its pieces of every chunk in turn. A bucket's first
-// entry is its head; later ones take the next overflow slot and go right after the head in its
-// chain.
+// A thread's buffers for one group at a time: its entries by partition, and its payload.
+struct GroupScratch {
+    ByteBuffer by_part, stage;
+};
+
+// Group g's buckets, then its overflow entries, into stage; its entries (its pieces of every
+// chunk in turn: entry order) by partition first. A bucket's first entry is its head; later
+// ones take the next overflow slot and go right after the head in its chain.
 void place_group(std::uint64_t g, const std::vector<std::span<Sorted>>& chunks,
-                 const Partitioning& pt, const Layout& l, Hash14Entry* stage) {
-    const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1), row = pt.parts + 1;
+                 const Partitioning& pt, const Layout& l, GroupScratch& s) {
+    const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1), row = pt.groups + 1;
+    auto* mine = reinterpret_cast<Sorted*>(s.by_part.data());
+    std::uint64_t next[kGroup];
+    for (std::uint64_t p = q0; p < q1; ++p) next[p - q0] = l.part_start[p] - l.part_start[q0];
+    for (std::size_t c = 0; c < chunks.size(); ++c) {
+        const std::uint32_t* local = &l.local[c * row + g];
+        for (std::uint32_t i = local[0]; i < local[1]; ++i) {
+            const Sorted& h = chunks[c][i];
+            mine[next[(pt.bucket(h) >> kPartBits) - q0]++] = h;
+        }
+    }
+    auto* stage = reinterpret_cast<Hash14Entry*>(s.stage.data());
     Hash14Entry* const over_stage = stage + (pt.b0(q1) - pt.b0(q0));
     for (std::uint64_t p = q0; p < q1; ++p) {
         Hash14Entry* part_out = stage + (pt.b0(p) - pt.b0(q0));
         for (std::uint64_t k = 0; k < pt.b0(p + 1) - pt.b0(p); ++k)
             part_out[k] = {0xFFFF, 0xFFFF, 0, 0, 0, Hash14Table::kEnd};
         std::uint64_t next_over = l.over_start[p];
-        for (std::size_t c = 0; c < chunks.size(); ++c) {
-            const std::uint32_t* local = &l.local[c * row + p];
-            for (std::uint32_t i = local[0]; i < local[1]; ++i) {
-                const Sorted& h = chunks[c][i];
-                const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, Hash14Table::kEnd};
-                Hash14Entry& head = part_out[pt.bucket(h) & kLocal];
-                if (head.a == 0xFFFF) {
-                    head = e;
-                    continue;
-                }
-                Hash14Entry& slot = over_stage[next_over - l.over_start[q0]];
-                slot = e;
-                slot.next = head.next;
-                head.next = static_cast<std::uint32_t>(next_over++);
+        for (std::uint64_t i = l.part_start[p]; i < l.part_start[p + 1]; ++i) {
+            const Sorted& h = mine[i - l.part_start[q0]];
+            const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, Hash14Table::kEnd};
+            Hash14Entry& head = part_out[pt.bucket(h) & kLocal];
+            if (head.a == 0xFFFF) {
+                head = e;
+                continue;
             }
+            Hash14Entry& slot = over_stage[next_over - l.over_start[q0]];
+            slot = e;
+            slot.next = head.next;
+            head.next = static_cast<std::uint32_t>(next_over++);
         }
     }
 }
@@ -258,18 +278,22 @@ void place(PointHits&& entries, PayloadSink& sink) {
     const Layout l = sort_chunks(chunks, pt);
     sink.reserve(kHeader + l.over_start[pt.parts] * sizeof(Hash14Entry));
     sink.write_at(0, &pt.buckets, kHeader);
-    std::uint64_t most_stage = 0;
+    std::uint64_t most_entries = 0, most_stage = 0;
     for (std::uint64_t g = 0; g < pt.groups; ++g) {
         const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1);
+        most_entries = std::max(most_entries, l.part_start[q1] - l.part_start[q0]);
         most_stage = std::max(most_stage, (pt.b0(q1) - pt.b0(q0)) + (l.over_start[q1] - l.over_start[q0]));
     }
-    tbb::enumerable_thread_specific<ByteBuffer> stages;
+    tbb::enumerable_thread_specific<GroupScratch> scratch;
     std::mutex writing;  // the sink takes one piece at a time
     tbb::parallel_for(std::uint64_t{0}, pt.groups, [&](std::uint64_t g) {
-        ByteBuffer& buf = stages.local();
-        if (!buf.data()) buf = ByteBuffer(most_stage * sizeof(Hash14Entry));
-        auto* stage = reinterpret_cast<Hash14Entry*>(buf.data());
-        place_group(g, chunks, pt, l, stage);
+        GroupScratch& s = scratch.local();
+        if (!s.stage.data()) {
+            s.by_part = ByteBuffer(most_entries * sizeof(Sorted), ByteBuffer::Pages::kSmall);
+            s.stage = ByteBuffer(most_stage * sizeof(Hash14Entry), ByteBuffer::Pages::kSmall);
+        }
+        place_group(g, chunks, pt, l, s);
+        const auto* stage = reinterpret_cast<const Hash14Entry*>(s.stage.data());
         const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1), nb = pt.b0(q1) - pt.b0(q0);
         const std::lock_guard<std::mutex> lock(writing);
         sink.write_at(kHeader + pt.b0(q0) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
