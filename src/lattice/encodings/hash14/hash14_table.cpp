@@ -2,8 +2,11 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -286,20 +289,26 @@ void place(PointHits&& entries, PayloadSink& sink) {
     }
     tbb::enumerable_thread_specific<GroupScratch> scratch;
     std::mutex writing;  // the sink takes one piece at a time
-    tbb::parallel_for(std::uint64_t{0}, pt.groups, [&](std::uint64_t g) {
+    // Groups are taken in order, so that their buckets reach the sink nearly in order (a file
+    // sink hashes what comes in order as it goes by).
+    std::atomic<std::uint64_t> next_group{0};
+    const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
+    tbb::parallel_for(0, workers, [&](int) {
         GroupScratch& s = scratch.local();
         if (!s.stage.data()) {
             s.by_part = ByteBuffer(most_entries * sizeof(Sorted), ByteBuffer::Pages::kSmall);
             s.stage = ByteBuffer(most_stage * sizeof(Hash14Entry), ByteBuffer::Pages::kSmall);
         }
-        place_group(g, chunks, pt, l, s);
-        const auto* stage = reinterpret_cast<const Hash14Entry*>(s.stage.data());
-        const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1), nb = pt.b0(q1) - pt.b0(q0);
-        const std::lock_guard<std::mutex> lock(writing);
-        sink.write_at(kHeader + pt.b0(q0) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
-        sink.write_at(kHeader + l.over_start[q0] * sizeof(Hash14Entry), stage + nb,
-                      (l.over_start[q1] - l.over_start[q0]) * sizeof(Hash14Entry));
-    });
+        for (std::uint64_t g; (g = next_group++) < pt.groups;) {
+            place_group(g, chunks, pt, l, s);
+            const auto* stage = reinterpret_cast<const Hash14Entry*>(s.stage.data());
+            const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1), nb = pt.b0(q1) - pt.b0(q0);
+            const std::lock_guard<std::mutex> lock(writing);
+            sink.write_at(kHeader + pt.b0(q0) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
+            sink.write_at(kHeader + l.over_start[q0] * sizeof(Hash14Entry), stage + nb,
+                          (l.over_start[q1] - l.over_start[q0]) * sizeof(Hash14Entry));
+        }
+    }, tbb::simple_partitioner());
     entries = {};
 }
 
