@@ -79,7 +79,10 @@ private:
 
 struct Scratch {
     std::vector<double> best_t;
+    // The closest crossing so far at each point: its t in best_t; for a chain, whose crossings
+    // are t and a part alone, its part in best_part, else the whole crossing in best_c.
     std::vector<Crossing> best_c;
+    std::vector<std::uint32_t> best_part;
     std::vector<std::uint32_t> tested;  // generation of the last part tested at each point
     std::uint32_t generation = 0;
     std::vector<std::size_t> touched;  // face points with a hit, to emit and reset
@@ -141,7 +144,8 @@ public:
             const std::vector<Vec3>& at = points_[static_cast<std::size_t>(f)];
             if (s.best_t.size() < fl.mask.size()) {
                 s.best_t.assign(fl.mask.size(), kInfinity);
-                s.best_c.resize(fl.mask.size());
+                if constexpr (std::is_same_v<S, ChainShape>) s.best_part.resize(fl.mask.size());
+                else s.best_c.resize(fl.mask.size());
                 s.tested.assign(fl.mask.size(), 0);
                 s.batch.fit(fl.mask.size());
             }
@@ -230,7 +234,8 @@ private:
         const auto keep = [&](std::size_t k, const Crossing& c) {
             if (s.best_t[k] == kInfinity) s.touched.push_back(k);
             s.best_t[k] = c.t;
-            s.best_c[k] = c;
+            if constexpr (std::is_same_v<S, ChainShape>) s.best_part[k] = c.part;
+            else s.best_c[k] = c;
         };
         std::size_t i = 0;
         if constexpr (std::is_same_v<S, ChainShape>) {
@@ -275,7 +280,9 @@ private:
     void keep_hit(const S& shape, std::uint32_t a, const Vec3& p, std::uint32_t b, const Vec3& qv,
                   bool start_inside, Scratch& s, std::size_t k) const {
         const Ray r{p * h_, (qv - p) * h_};
-        Crossing c = s.best_c[k];
+        Crossing c;
+        if constexpr (std::is_same_v<S, ChainShape>) c = Crossing(s.best_t[k], s.best_part[k], 0);
+        else c = s.best_c[k];
         float t = static_cast<float>(std::min(1.0, s.best_t[k]));
         if (start_inside) {
             // p lies in the closed solid (on its surface, where a primitive touches the box): the
