@@ -228,9 +228,10 @@ Layout sort_chunks(const std::vector<std::span<Sorted>>& chunks, const Partition
     return l;
 }
 
-// A thread's buffers for one group at a time: its entries by partition, and its payload.
+// A thread's buffers for one group at a time: its entries by partition with their buckets,
+// and its payload.
 struct GroupScratch {
-    ByteBuffer by_part, stage;
+    ByteBuffer by_part, bucket, stage;
 };
 
 // Group g's buckets, then its overflow entries, into stage; its entries (its pieces of every
@@ -240,13 +241,17 @@ void place_group(std::uint64_t g, const std::vector<std::span<Sorted>>& chunks,
                  const Partitioning& pt, const Layout& l, GroupScratch& s) {
     const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1), row = pt.groups + 1;
     auto* mine = reinterpret_cast<Sorted*>(s.by_part.data());
+    auto* mine_bucket = reinterpret_cast<std::uint32_t*>(s.bucket.data());
     std::uint64_t next[kGroup];
     for (std::uint64_t p = q0; p < q1; ++p) next[p - q0] = l.part_start[p] - l.part_start[q0];
     for (std::size_t c = 0; c < chunks.size(); ++c) {
         const std::uint32_t* local = &l.local[c * row + g];
         for (std::uint32_t i = local[0]; i < local[1]; ++i) {
             const Sorted& h = chunks[c][i];
-            mine[next[(pt.bucket(h) >> kPartBits) - q0]++] = h;
+            const auto b = static_cast<std::uint32_t>(pt.bucket(h));  // buckets < 2^32
+            const std::uint64_t to = next[(b >> kPartBits) - q0]++;
+            mine[to] = h;
+            mine_bucket[to] = b;
         }
     }
     auto* stage = reinterpret_cast<Hash14Entry*>(s.stage.data());
@@ -259,7 +264,7 @@ void place_group(std::uint64_t g, const std::vector<std::span<Sorted>>& chunks,
         for (std::uint64_t i = l.part_start[p]; i < l.part_start[p + 1]; ++i) {
             const Sorted& h = mine[i - l.part_start[q0]];
             const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, Hash14Table::kEnd};
-            Hash14Entry& head = part_out[pt.bucket(h) & kLocal];
+            Hash14Entry& head = part_out[mine_bucket[i - l.part_start[q0]] & kLocal];
             if (head.a == 0xFFFF) {
                 head = e;
                 continue;
@@ -297,6 +302,7 @@ void place(PointHits&& entries, PayloadSink& sink) {
         GroupScratch& s = scratch.local();
         if (!s.stage.data()) {
             s.by_part = ByteBuffer(most_entries * sizeof(Sorted), ByteBuffer::Pages::kSmall);
+            s.bucket = ByteBuffer(most_entries * sizeof(std::uint32_t), ByteBuffer::Pages::kSmall);
             s.stage = ByteBuffer(most_stage * sizeof(Hash14Entry), ByteBuffer::Pages::kSmall);
         }
         for (std::uint64_t g; (g = next_group++) < pt.groups;) {
