@@ -207,18 +207,28 @@ private:
     void trace_face(const S& shape, const Vec3& p, const FaceLayout& fl, Scratch& s, Counts& cnt) const {
         std::uint32_t last_part = ~0u;
         s.batch.n = 0;
-        for (const PartSphere& ps : spheres_) {
-            if (ps.part != last_part) {
+        for (std::size_t i = 0; i < spheres_.size(); ++i) {
+            const PartSphere& ps = spheres_[i];
+            const bool first = ps.part != last_part;
+            if (first) {
                 test_batch(shape, p, last_part, s, cnt);
                 last_part = ps.part;
                 ++s.generation;  // marks "gathered for this part" in s.tested
             }
             // An exit's range ends at its best hit so far, which only its own test in this
-            // part's batch can change.
+            // part's batch can change. A part of one sphere visits each exit once: it needs no
+            // marks.
+            const auto gather = [&](std::size_t k, const Vec3& q) {
+                s.batch.push(k, (q - p) * h_, std::min(s.best_t[k], 1.0 + 1e-12));
+            };
+            if (first && (i + 1 == spheres_.size() || spheres_[i + 1].part != ps.part)) {
+                for_each_exit_in_cone(p, ps, fl, gather);
+                continue;
+            }
             for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
                 if (s.tested[k] == s.generation) return;
                 s.tested[k] = s.generation;
-                s.batch.push(k, (q - p) * h_, std::min(s.best_t[k], 1.0 + 1e-12));
+                gather(k, q);
             });
         }
         test_batch(shape, p, last_part, s, cnt);
