@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <vector>
@@ -171,6 +172,83 @@ TEST(PayloadStream, PointHitsGiveTheSameBytes) {
             for (std::size_t i = 0; i < sink.writes.size(); ++i)
                 ASSERT_EQ(sink.writes[i], 1) << "byte " << i;
         }
+}
+
+// PointHits that something else holds too are sorted in a copy: the same payload, and the
+// holder's hits are left as they were.
+TEST(PayloadStream, SharedPointHitsGiveTheSameBytesAndStayUntouched) {
+    const Rasterized& r = hair(1);
+    RasterizeOptions opt;
+    opt.point_hits = true;
+    const RasterizeResult own = rasterize(r.ctx, opt);
+    const std::vector<PointHit> before = own.points.flatten();
+    PointHits shared = own.points;
+    CountingSink sink;
+    find_encoding("hash14").stream_points(std::move(shared), r.ctx, {}, sink);
+    EXPECT_TRUE(sink.bytes == hash14_reference(r.raster.raw));
+    const std::vector<PointHit> after = own.points.flatten();
+    ASSERT_EQ(after.size(), before.size());
+    EXPECT_EQ(std::memcmp(after.data(), before.data(), before.size() * sizeof(PointHit)), 0);
+}
+
+// The file's checksum (hashed as pieces arrive in order, the rest read back) is the whole
+// payload's whatever order and size the pieces come in: in order, backwards, a little ahead of
+// the bytes before them, rewriting bytes already hashed or a piece still waiting.
+TEST(PayloadStream, TableFileChecksumHoldsForPiecesInAnyOrder) {
+    const test::TempDir dir;
+    const Rasterized& r = hair(1);
+    const ByteBuffer payload = find_encoding("hash14").build(r.raster.raw, r.ctx, {});
+    TableHeader h;
+    h.encoding = "hash14";
+    h.cells = r.ctx.cells;
+    h.sigma_inv = 1;
+    h.sigma = r.ctx.sigma;
+    h.cell = r.ctx.cell;
+    h.pairs = r.raster.pairs_eq2;
+    h.entries = r.raster.hits;
+    const std::string whole = dir.file("whole.lht");
+    write_table_file(whole, h, payload);
+    const std::size_t n = payload.size(), piece = 4099;  // not a multiple of 32
+    const auto put = [&](PayloadSink& sink, std::size_t from, std::size_t to) {
+        sink.write_at(from, payload.data() + from, to - from);
+    };
+    using Fill = std::function<void(PayloadSink&)>;
+    const std::vector<std::pair<const char*, Fill>> orders = {
+        {"in order", [&](PayloadSink& s) { for (std::size_t o = 0; o < n; o += piece) put(s, o, std::min(n, o + piece)); }},
+        {"backwards", [&](PayloadSink& s) {
+             for (std::size_t o = (n - 1) / piece * piece;; o -= piece) {
+                 put(s, o, std::min(n, o + piece));
+                 if (o == 0) break;
+             }
+         }},
+        {"pairs swapped", [&](PayloadSink& s) {
+             for (std::size_t o = 0; o < n; o += 2 * piece) {
+                 if (o + piece < n) put(s, o + piece, std::min(n, o + 2 * piece));
+                 put(s, o, std::min(n, o + piece));
+             }
+         }},
+        {"hashed bytes rewritten", [&](PayloadSink& s) {
+             const std::vector<std::uint8_t> junk(5000, 0xAB);
+             s.write_at(0, junk.data(), junk.size());
+             put(s, 0, n);
+         }},
+        {"waiting piece rewritten", [&](PayloadSink& s) {
+             const std::vector<std::uint8_t> junk(300, 0xCD);
+             s.write_at(1000, junk.data(), junk.size());
+             put(s, 1000, 1300);
+             put(s, 0, 1000);
+             put(s, 1300, n);
+         }},
+    };
+    for (const auto& [what, fill] : orders) {
+        const std::string path = dir.file("pieces.lht");
+        write_table_file(path, h, [&](PayloadSink& sink) {
+            sink.reserve(n);
+            fill(sink);
+        });
+        EXPECT_TRUE(test::slurp(path) == test::slurp(whole)) << what;
+        EXPECT_NO_THROW(load_table_file(path)) << what;
+    }
 }
 
 TEST(PayloadStream, NoHitsMakeTheSamePayload) {

@@ -95,10 +95,6 @@ void ChainShape::spans(const Ray& r, SpanList& out) const {
     merge_span_union(out, first);
 }
 
-Vec3 ChainShape::normal(const Ray& r, const Crossing& c) const {
-    return part(c.part >> 2).normal(r, {c.t, c.part & 3u, 0});
-}
-
 bool ChainShape::part_capsule(std::size_t i, Capsule& out) const {
     if (i < spheres_.size()) {
         out = {spheres_[i].center, spheres_[i].center, spheres_[i].radius};

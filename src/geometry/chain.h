@@ -36,7 +36,12 @@ public:
     bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override;
     bool occluded(const Ray& r, double tmin, double tmax) const override;
     void spans(const Ray& r, SpanList& out) const override;
-    Vec3 normal(const Ray& r, const Crossing& c) const override;
+    // Inline and through the parts' concrete types: the rasterizer's call for every hit.
+    Vec3 normal(const Ray& r, const Crossing& c) const override {
+        const std::size_t i = c.part >> 2, spheres = sphere_parts_.size();
+        const Crossing own{c.t, c.part & 3u, 0};
+        return i < spheres ? sphere_parts_[i].normal(r, own) : cyl_parts_[i - spheres].normal(r, own);
+    }
     // A part's index in the high bits, its own part number in the low two.
     bool names_surface(const Crossing& c) const override {
         const std::size_t i = c.part >> 2, spheres = sphere_parts_.size();

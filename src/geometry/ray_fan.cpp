@@ -26,6 +26,10 @@ unsigned SphereShape::intersect_fan(const RayFan& f, FanHits& out) const {
     const V3 perp{splat(w.x) + f.d.x * b, splat(w.y) + f.d.y * b, splat(w.z) + f.d.z * b};
     const V disc = splat(r_ * r_) - dot(perp, perp);
     V met = _mm_and_pd(_mm_cmpneq_pd(dd, zero), _mm_cmpnlt_pd(disc, splat(-kTouchTolerance * r_ * r_)));
+    if (!bits(met)) {  // both lanes' lines pass the sphere by
+        out.t = out.part = zero;
+        return 0;
+    }
     const V h = _mm_sqrt_pd(max0(disc) / dd);
     const V c = splat(length_squared(w) - r_ * r_) / dd;
     const V q = b + copysign(h, b);
@@ -49,6 +53,20 @@ unsigned CappedCylinderShape::intersect_fan(const RayFan& f, FanHits& out) const
     const V3 dp{f.d.x - splat(axis_.x) * da, f.d.y - splat(axis_.y) * da, f.d.z - splat(axis_.z) * da};
     V met = _mm_castsi128_pd(_mm_set1_epi64x(-1));
 
+    // Infinite cylinder, in the stable closest-point form; a lane along the axis lies within
+    // the radius or misses. Where both lanes' lines pass it by, nothing else need be worked out.
+    const V A = dot(dp, dp);
+    const V slanted = _mm_cmpgt_pd(A, zero);
+    const V b = -dot(dp, wp) / A;
+    const V3 pp{splat(wp.x) + dp.x * b, splat(wp.y) + dp.y * b, splat(wp.z) + dp.z * b};
+    const V disc = splat(r_ * r_) - dot(pp, pp);
+    const V side_met = _mm_cmpnlt_pd(disc, splat(-kTouchTolerance * r_ * r_));
+    const V axial_met = length_squared(wp) > r_ * r_ ? zero : met;
+    if (!bits(pick(slanted, side_met, axial_met))) {
+        out.t = out.part = zero;
+        return 0;
+    }
+
     // Slab between the two end planes; a lane parallel to them lies between them or misses.
     const V flat = _mm_cmpeq_pd(da, zero);
     const V n0 = splat(-wa) / da, n1 = splat(len_ - wa) / da;
@@ -59,14 +77,6 @@ unsigned CappedCylinderShape::intersect_fan(const RayFan& f, FanHits& out) const
     const V s1part = pick(flat, splat(2), pick(swap, splat(1), splat(2)));
     if (wa < 0.0 || wa > len_) met = _mm_andnot_pd(flat, met);
 
-    // Infinite cylinder, in the stable closest-point form; a lane along the axis lies within
-    // the radius or misses.
-    const V A = dot(dp, dp);
-    const V slanted = _mm_cmpgt_pd(A, zero);
-    const V b = -dot(dp, wp) / A;
-    const V3 pp{splat(wp.x) + dp.x * b, splat(wp.y) + dp.y * b, splat(wp.z) + dp.z * b};
-    const V disc = splat(r_ * r_) - dot(pp, pp);
-    const V side_met = _mm_cmpnlt_pd(disc, splat(-kTouchTolerance * r_ * r_));
     const V h = _mm_sqrt_pd(max0(disc) / A);
     const V c = splat(length_squared(wp) - r_ * r_) / A;
     const V q = b + copysign(h, b);
@@ -74,7 +84,6 @@ unsigned CappedCylinderShape::intersect_fan(const RayFan& f, FanHits& out) const
     const V rswap = _mm_cmpgt_pd(q, other), qzero = _mm_cmpeq_pd(q, zero);
     const V c0 = pick(slanted, _mm_andnot_pd(qzero, pick(rswap, other, q)), splat(-kInfinity));
     const V c1 = pick(slanted, _mm_andnot_pd(qzero, pick(rswap, q, other)), splat(kInfinity));
-    const V axial_met = length_squared(wp) > r_ * r_ ? zero : met;
     met = _mm_and_pd(met, pick(slanted, side_met, axial_met));
 
     const V side_in = _mm_cmpgt_pd(c0, s0), side_out = _mm_cmplt_pd(c1, s1);

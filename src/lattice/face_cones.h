@@ -67,13 +67,15 @@ bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0,
 // (Inline: the rasterizer's hottest culling step.)
 class ConeRows {
 public:
-    ConeRows(const Vec3& p, const PartSphere& s, const FaceLayout& f)
-        : ua_(static_cast<std::size_t>(f.ua)), va_(static_cast<std::size_t>(f.va)), p_(p), w_(s.c - p) {
-        const auto ax = static_cast<std::size_t>(f.axis);
-        k_ = length_squared(w_) - s.r * s.r;
+    ConeRows(const Vec3& p, const PartSphere& s, const FaceLayout& f) {
+        const auto ax = static_cast<std::size_t>(f.axis), ua = static_cast<std::size_t>(f.ua),
+                   va = static_cast<std::size_t>(f.va);
+        const Vec3 w = s.c - p;
+        pu_ = p[ua], pv_ = p[va], wv_ = w[va];
+        k_ = length_squared(w) - s.r * s.r;
         da_ = f.level - p[ax];
-        alpha0_ = da_ * w_[ax];
-        beta_ = w_[ua_];
+        alpha0_ = da_ * w[ax];
+        beta_ = w[ua];
         da2_ = da_ * da_;
         A_ = beta_ * beta_ - k_;
         whole_ = k_ <= 0 || A_ >= 0;  // p inside the sphere, or the cone opens along u
@@ -83,8 +85,8 @@ public:
             ulo = -kInfinity, uhi = kInfinity;
             return true;
         }
-        const double dv = v - p_[va_];
-        const double alpha = alpha0_ + dv * w_[va_];
+        const double dv = v - pv_;
+        const double alpha = alpha0_ + dv * wv_;
         const double gamma = da2_ + dv * dv;
         // g(u') = (alpha + beta u')^2 - k (gamma + u'^2) >= 0 with alpha + beta u' >= 0, u' = u - p_u.
         const double B = alpha * beta_, C = alpha * alpha - k_ * gamma;
@@ -94,14 +96,13 @@ public:
         const double r0 = (-B + sq) / A_, r1 = (-B - sq) / A_;  // r0 <= r1 since A < 0
         if (alpha + beta_ * 0.5 * (r0 + r1) < 0) return false;  // the cone's far nappe
         const double pad = 1e-7 * (1 + std::abs(r0) + std::abs(r1));
-        ulo = p_[ua_] + r0 - pad;
-        uhi = p_[ua_] + r1 + pad;
+        ulo = pu_ + r0 - pad;
+        uhi = pu_ + r1 + pad;
         return true;
     }
 
 private:
-    std::size_t ua_, va_;
-    Vec3 p_, w_;
+    double pu_, pv_, wv_;  // p's coordinates along the face's u and v, and w = c - p's along v
     double k_, da_, alpha0_, beta_, da2_, A_;
     bool whole_;
 };

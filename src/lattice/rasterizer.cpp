@@ -43,7 +43,10 @@ struct Counts {
     std::uint64_t enumerated = 0, traced = 0, hits = 0, counted = 0, tests = 0;
 };
 
-// Per-thread output: hits go into large huge-page buffers; a block's hits stay contiguous.
+// Per-thread output: hits go into large buffers; a block's hits stay contiguous. Small pages:
+// the hits are written once in order and read chunk by chunk, so huge pages would save few TLB
+// misses, and on a virtual machine that hands freed memory back to its host (free page
+// reporting) a huge page touched first costs several times its 512 small pages.
 template <class Hit>
 class HitArena {
 public:
@@ -66,7 +69,7 @@ private:
         // Move the unfinished block to the new buffer so that it stays in one piece.
         const std::size_t partial = used_ - block_start_;
         const std::size_t cap = std::max(kHits, 2 * partial);
-        auto buf = std::make_shared<ByteBuffer>(cap * sizeof(Hit));
+        auto buf = std::make_shared<ByteBuffer>(cap * sizeof(Hit), ByteBuffer::Pages::kSmall);
         auto* next = reinterpret_cast<Hit*>(buf->data());
         std::copy(cur_ + block_start_, cur_ + used_, next);
         buffers_.push_back(buf);
@@ -76,30 +79,33 @@ private:
 
 struct Scratch {
     std::vector<double> best_t;
+    // The closest crossing so far at each point: its t in best_t; for a chain, whose crossings
+    // are t and a part alone, its part in best_part, else the whole crossing in best_c.
     std::vector<Crossing> best_c;
+    std::vector<std::uint32_t> best_part;
     std::vector<std::uint32_t> tested;  // generation of the last part tested at each point
     std::uint32_t generation = 0;
     std::vector<std::size_t> touched;  // face points with a hit, to emit and reset
-    struct Exit {
-        std::size_t k;
-        Vec3 q;
-    };
-    std::vector<Exit> batch;  // exits in the cones of one part, to test against it
+    // The exits in the cones of one part, to test against it: each one's index in the face, its
+    // segment's direction (primitive units) and the end of its range, in arrays of their own
+    // (two lanes load as one register). Each exit is gathered once, so a face's size holds them.
+    struct Batch {
+        std::vector<std::uint32_t> k;
+        std::vector<double> dx, dy, dz, tmax;
+        std::size_t n = 0;
+        void fit(std::size_t size) {
+            k.resize(size), dx.resize(size), dy.resize(size), dz.resize(size), tmax.resize(size);
+        }
+        void push(std::size_t face_index, const Vec3& d, double range_end) {
+            assert(n < k.size());
+            k[n] = static_cast<std::uint32_t>(face_index);
+            dx[n] = d.x, dy[n] = d.y, dz[n] = d.z, tmax[n] = range_end;
+            ++n;
+        }
+    } batch;
     bool point_hits = false;  // hits kept in `points`, else in `raw`
     HitArena<RawHit> raw;
     HitArena<PointHit> points;
-
-    void keep(const RawHit& h) {
-        if (!point_hits) {
-            raw.push(h);
-            return;
-        }
-        // The table's build checked every id against the encoding's limit before tracing.
-        if (h.a >= 0xFFFF || h.b >= 0xFFFF)
-            throw std::length_error("point hits: point id over 16 bits");
-        points.push({static_cast<std::uint16_t>(h.a), static_cast<std::uint16_t>(h.b),
-                     quantise_t16(h.t), h.nu, h.nv});
-    }
 };
 
 // The primitive as a Shape, for the tracer's loops over its parts (a chain's concrete type, or
@@ -138,8 +144,10 @@ public:
             const std::vector<Vec3>& at = points_[static_cast<std::size_t>(f)];
             if (s.best_t.size() < fl.mask.size()) {
                 s.best_t.assign(fl.mask.size(), kInfinity);
-                s.best_c.resize(fl.mask.size());
+                if constexpr (std::is_same_v<S, ChainShape>) s.best_part.resize(fl.mask.size());
+                else s.best_c.resize(fl.mask.size());
                 s.tested.assign(fl.mask.size(), 0);
+                s.batch.fit(fl.mask.size());
             }
             if (start_inside) {  // every segment starts in the solid: all hit at t = 0
                 for (std::size_t k = 0; k < fl.mask.size(); ++k)
@@ -156,7 +164,7 @@ public:
                 if (fl.ids[k] == a || !BoundaryGrid::valid_pair(fa, fl.mask[k])) continue;
                 ++cnt.hits;
                 cnt.counted += static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fl.mask[k]));
-                if (keep) s.keep(make_hit(shape, a, p, fl.ids[k], at[k], start_inside, s, k));
+                if (keep) keep_hit(shape, a, p, fl.ids[k], at[k], start_inside, s, k);
             }
             if (!start_inside)
                 for (const std::size_t k : s.touched) s.best_t[k] = kInfinity;
@@ -198,17 +206,29 @@ private:
     template <class S>
     void trace_face(const S& shape, const Vec3& p, const FaceLayout& fl, Scratch& s, Counts& cnt) const {
         std::uint32_t last_part = ~0u;
-        s.batch.clear();
-        for (const PartSphere& ps : spheres_) {
-            if (ps.part != last_part) {
+        s.batch.n = 0;
+        for (std::size_t i = 0; i < spheres_.size(); ++i) {
+            const PartSphere& ps = spheres_[i];
+            const bool first = ps.part != last_part;
+            if (first) {
                 test_batch(shape, p, last_part, s, cnt);
                 last_part = ps.part;
                 ++s.generation;  // marks "gathered for this part" in s.tested
             }
+            // An exit's range ends at its best hit so far, which only its own test in this
+            // part's batch can change. A part of one sphere visits each exit once: it needs no
+            // marks.
+            const auto gather = [&](std::size_t k, const Vec3& q) {
+                s.batch.push(k, (q - p) * h_, std::min(s.best_t[k], 1.0 + 1e-12));
+            };
+            if (first && (i + 1 == spheres_.size() || spheres_[i + 1].part != ps.part)) {
+                for_each_exit_in_cone(p, ps, fl, gather);
+                continue;
+            }
             for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
                 if (s.tested[k] == s.generation) return;
                 s.tested[k] = s.generation;
-                s.batch.push_back({k, q});
+                gather(k, q);
             });
         }
         test_batch(shape, p, last_part, s, cnt);
@@ -219,11 +239,13 @@ private:
     // once, so the order of the tests does not matter.
     template <class S>
     void test_batch(const S& shape, const Vec3& p, std::uint32_t part, Scratch& s, Counts& cnt) const {
-        cnt.tests += s.batch.size();
+        Scratch::Batch& b = s.batch;
+        cnt.tests += b.n;
         const auto keep = [&](std::size_t k, const Crossing& c) {
             if (s.best_t[k] == kInfinity) s.touched.push_back(k);
             s.best_t[k] = c.t;
-            s.best_c[k] = c;
+            if constexpr (std::is_same_v<S, ChainShape>) s.best_part[k] = c.part;
+            else s.best_c[k] = c;
         };
         std::size_t i = 0;
         if constexpr (std::is_same_v<S, ChainShape>) {
@@ -237,15 +259,12 @@ private:
             f.tmin = _mm_setzero_pd();
             unsigned m[kRun];
             alignas(16) double t[2 * kRun], sub[2 * kRun];
-            while (i + 1 < s.batch.size()) {
-                const std::size_t run = std::min(kRun, (s.batch.size() - i) / 2);
+            while (i + 1 < b.n) {
+                const std::size_t run = std::min(kRun, (b.n - i) / 2);
                 for (std::size_t r = 0; r < run; ++r) {
-                    const Scratch::Exit& e0 = s.batch[i + 2 * r];
-                    const Scratch::Exit& e1 = s.batch[i + 2 * r + 1];
-                    const Vec3 d0 = (e0.q - p) * h_, d1 = (e1.q - p) * h_;
-                    f.d = {_mm_set_pd(d1.x, d0.x), _mm_set_pd(d1.y, d0.y), _mm_set_pd(d1.z, d0.z)};
-                    f.tmax = _mm_set_pd(std::min(s.best_t[e1.k], 1.0 + 1e-12),
-                                        std::min(s.best_t[e0.k], 1.0 + 1e-12));
+                    const std::size_t e = i + 2 * r;  // even: the arrays' 16-byte alignment
+                    f.d = {_mm_load_pd(&b.dx[e]), _mm_load_pd(&b.dy[e]), _mm_load_pd(&b.dz[e])};
+                    f.tmax = _mm_load_pd(&b.tmax[e]);
                     FanHits out;
                     m[r] = shape.intersect_fan(part, f, out);
                     _mm_store_pd(t + 2 * r, out.t);
@@ -253,25 +272,27 @@ private:
                 }
                 for (std::size_t j = 0; j < 2 * run; ++j)
                     if (m[j / 2] >> (j % 2) & 1)
-                        keep(s.batch[i + j].k, Crossing(t[j], part << 2 | static_cast<std::uint32_t>(sub[j]), 0));
+                        keep(b.k[i + j], Crossing(t[j], part << 2 | static_cast<std::uint32_t>(sub[j]), 0));
                 i += 2 * run;
             }
         }
-        for (; i < s.batch.size(); ++i) {
-            const Scratch::Exit& e = s.batch[i];
-            const Ray r{p * h_, (e.q - p) * h_};
+        for (; i < b.n; ++i) {
+            const Ray r{p * h_, {b.dx[i], b.dy[i], b.dz[i]}};
             Crossing c;
-            const double tmax = std::min(s.best_t[e.k], 1.0 + 1e-12);
-            if (shape.intersect_part(part, r, 0.0, tmax, c)) keep(e.k, c);
+            if (shape.intersect_part(part, r, 0.0, b.tmax[i], c)) keep(b.k[i], c);
         }
-        s.batch.clear();
+        b.n = 0;
     }
 
+    // The hit of segment a -> b (exit k of the face) into the thread's arena: raw, or as a
+    // PointHit (made straight from its parts: the rasterizer's every hit passes here).
     template <class S>
-    RawHit make_hit(const S& shape, std::uint32_t a, const Vec3& p, std::uint32_t b, const Vec3& qv,
-                    bool start_inside, const Scratch& s, std::size_t k) const {
+    void keep_hit(const S& shape, std::uint32_t a, const Vec3& p, std::uint32_t b, const Vec3& qv,
+                  bool start_inside, Scratch& s, std::size_t k) const {
         const Ray r{p * h_, (qv - p) * h_};
-        Crossing c = s.best_c[k];
+        Crossing c;
+        if constexpr (std::is_same_v<S, ChainShape>) c = Crossing(s.best_t[k], s.best_part[k], 0);
+        else c = s.best_c[k];
         float t = static_cast<float>(std::min(1.0, s.best_t[k]));
         if (start_inside) {
             // p lies in the closed solid (on its surface, where a primitive touches the box): the
@@ -281,8 +302,14 @@ private:
         }
         const Oct o = oct_encode(shape.normal(r, c), kRawNormalBits);
         if (c.part > RawHit::kMaxPart || c.leaf_index() > RawHit::kMaxLeaf) refuse_part(c);
-        return {a, b, t, static_cast<std::uint16_t>(o.u), static_cast<std::uint16_t>(o.v),
-                static_cast<std::uint16_t>(c.part), RawHit::pack_leaf(c.leaf)};
+        const auto nu = static_cast<std::uint16_t>(o.u), nv = static_cast<std::uint16_t>(o.v);
+        if (!s.point_hits) {
+            s.raw.push({a, b, t, nu, nv, static_cast<std::uint16_t>(c.part), RawHit::pack_leaf(c.leaf)});
+            return;
+        }
+        // The table's build checked every id against the encoding's limit before tracing.
+        if (a >= 0xFFFF || b >= 0xFFFF) throw std::length_error("point hits: point id over 16 bits");
+        s.points.push({static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(b), quantise_t16(t), nu, nv});
     }
 };
 

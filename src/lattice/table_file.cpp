@@ -11,7 +11,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
+#include <map>
 #include <stdexcept>
+#include <vector>
 
 #include "lattice/boundary_grid.h"
 #include "lattice/encoding.h"
@@ -167,7 +170,25 @@ bool read_whole(int fd, Mapping& m) {
     return true;
 }
 
-// Puts a payload's pieces into a table file, after its header.
+// Adds to h the n bytes `out` holds at `offset` (bytes never written read as zeros), mapped
+// from the page cache, where they were just written.
+void hash_written(const AtomicFile& out, std::size_t offset, std::size_t n, HashStream& h) {
+    if (n == 0) return;
+    const int fd = ::fileno(out.file());
+    if (::ftruncate(fd, static_cast<off_t>(offset + n)) != 0)
+        throw_write_errno(out.target(), errno, "lattice table");
+    const auto page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+    const std::size_t start = offset / page * page;
+    void* p = ::mmap(nullptr, offset + n - start, PROT_READ, MAP_SHARED, fd, static_cast<off_t>(start));
+    if (p == MAP_FAILED) throw_write_errno(out.target(), errno, "lattice table");
+    h.add(static_cast<const std::uint8_t*>(p) + (offset - start), n);
+    ::munmap(p, offset + n - start);
+}
+
+// Puts a payload's pieces into a table file, after its header, and hashes the pieces that come
+// in order as they go by (from memory the encoder has just filled, still in cache); a piece a
+// little ahead waits, copied, for the ones before it. What is not hashed so is read back from
+// the file at the end (all of it if a piece rewrites bytes already hashed).
 class FileSink final : public PayloadSink {
 public:
     explicit FileSink(AtomicFile& out) : out_(out) {}
@@ -175,27 +196,48 @@ public:
     void write_at(std::size_t offset, const void* data, std::size_t n) override {
         assert(offset <= size_ && n <= size_ - offset);
         out_.write_at(kTableHeaderBytes + offset, data, n);
+        if (!in_order_ || n == 0) return;
+        if (offset < hashed_) {
+            in_order_ = false, waiting_.clear();
+            return;
+        }
+        // A waiting copy this piece overlaps is stale.
+        const auto after = waiting_.lower_bound(offset + n);
+        if (after != waiting_.begin() && std::prev(after)->first + std::prev(after)->second.size() > offset)
+            waiting_.clear(), waiting_bytes_ = 0;
+        const auto* bytes = static_cast<const std::uint8_t*>(data);
+        if (offset == hashed_) {
+            hash_.add(bytes, n);
+            hashed_ += n;
+            for (auto it = waiting_.begin(); it != waiting_.end() && it->first == hashed_; it = waiting_.erase(it)) {
+                hash_.add(it->second.data(), it->second.size());
+                hashed_ += it->second.size(), waiting_bytes_ -= it->second.size();
+            }
+        } else if (offset + n - hashed_ <= kAhead && waiting_bytes_ + n <= kAhead) {
+            waiting_.emplace(offset, std::vector<std::uint8_t>(bytes, bytes + n));
+            waiting_bytes_ += n;
+        }
     }
     std::size_t size() const { return size_; }
+    // hash_bytes of the whole payload.
+    std::uint64_t checksum() {
+        if (!in_order_) hash_ = HashStream(), hashed_ = 0;
+        waiting_.clear(), waiting_bytes_ = 0;
+        hash_written(out_, kTableHeaderBytes + hashed_, size_ - hashed_, hash_);
+        hashed_ = size_;
+        return hash_.value();
+    }
 
 private:
+    static constexpr std::size_t kAhead = std::size_t{16} << 20;
     AtomicFile& out_;
     std::size_t size_ = 0;
+    HashStream hash_;
+    std::size_t hashed_ = 0;  // the payload's bytes [0, hashed_) are in hash_
+    bool in_order_ = true;
+    std::map<std::size_t, std::vector<std::uint8_t>> waiting_;  // by offset
+    std::size_t waiting_bytes_ = 0;
 };
-
-// hash_bytes of n bytes of what `out` holds at `offset`.
-std::uint64_t hash_written(const AtomicFile& out, std::size_t offset, std::size_t n) {
-    if (n == 0) return hash_bytes(nullptr, 0);
-    const int fd = ::fileno(out.file());
-    // Bytes never written read as zeros (and mapping past the end would fault).
-    if (::ftruncate(fd, static_cast<off_t>(offset + n)) != 0)
-        throw_write_errno(out.target(), errno, "lattice table");
-    void* p = ::mmap(nullptr, offset + n, PROT_READ, MAP_SHARED, fd, 0);
-    if (p == MAP_FAILED) throw_write_errno(out.target(), errno, "lattice table");
-    const std::uint64_t h = hash_bytes(static_cast<const std::uint8_t*>(p) + offset, n);
-    ::munmap(p, offset + n);
-    return h;
-}
 
 }  // namespace
 
@@ -220,9 +262,7 @@ std::uint64_t write_table_file(const std::string& path, const TableHeader& h0,
     fill(sink);
     TableHeader h = h0;
     h.payload_bytes = sink.size();
-    // The checksum is read back from the file (its pages are still cached).
-    const std::uint64_t checksum = hash_bytes(h.metadata.data(), h.metadata.size(),
-                                              hash_written(out, kTableHeaderBytes, sink.size()));
+    const std::uint64_t checksum = hash_bytes(h.metadata.data(), h.metadata.size(), sink.checksum());
     const auto header = encode_header(h, checksum);
     out.write_at(kTableHeaderBytes + sink.size(), h.metadata.data(), h.metadata.size());
     out.write_at(0, header.data(), header.size());

@@ -15,31 +15,73 @@ inline std::uint64_t mix64(std::uint64_t x) {  // splitmix64's finaliser
     return x ^ (x >> 31);
 }
 
+// hash_bytes of bytes given in pieces, in order: the same value however they are split (a
+// file's checksum taken as its pieces are written).
+class HashStream {
+public:
+    explicit HashStream(std::uint64_t seed = 0)
+        : h_{seed ^ 0x9E3779B97F4A7C15ull, seed + 0x632BE59BD9B4E019ull, ~seed,
+             seed * 0xD6E8FEB86659FD93ull + 1} {}
+
+    void add(const void* data, std::size_t n) {
+        if (n == 0) return;
+        const auto* p = static_cast<const unsigned char*>(data);
+        n_ += n;
+        if (fill_) {
+            const std::size_t take = n < 32 - fill_ ? n : 32 - fill_;
+            std::memcpy(buf_ + fill_, p, take);
+            fill_ += take, p += take, n -= take;
+            if (fill_ < 32) return;
+            blocks(buf_, 1);
+            fill_ = 0;
+        }
+        blocks(p, n / 32);
+        p += n / 32 * 32, n %= 32;
+        if (n) std::memcpy(buf_, p, n);
+        fill_ = n;
+    }
+
+    std::uint64_t value() const {
+        std::uint64_t acc = n_;
+        std::size_t i = 0;
+        for (; i + 8 <= fill_; i += 8) {
+            std::uint64_t w;
+            std::memcpy(&w, buf_ + i, 8);
+            acc = mix64(acc ^ w);
+        }
+        std::uint64_t tail = 0;
+        if (i < fill_) std::memcpy(&tail, buf_ + i, fill_ - i);
+        acc = mix64(acc ^ tail);
+        for (const std::uint64_t v : h_) acc = mix64(acc ^ v);
+        return acc;
+    }
+
+private:
+    std::uint64_t h_[4];
+    std::uint64_t n_ = 0;
+    unsigned char buf_[32] = {};  // the last bytes, short of a block of 32
+    std::size_t fill_ = 0;
+
+    // Four chains over blocks of 32 bytes, in a local copy of the state (the bytes read may
+    // alias the members).
+    void blocks(const unsigned char* p, std::size_t count) {
+        std::uint64_t h[4] = {h_[0], h_[1], h_[2], h_[3]};
+        for (std::size_t b = 0; b < count; ++b, p += 32)
+            for (int k = 0; k < 4; ++k) {
+                std::uint64_t w;
+                std::memcpy(&w, p + 8 * k, 8);
+                h[k] = (h[k] ^ w) * 0x9FB21C651E98DF25ull;
+                h[k] ^= h[k] >> 29;
+            }
+        for (int k = 0; k < 4; ++k) h_[k] = h[k];
+    }
+};
+
 // Hash of a byte range; about 8 bytes per cycle, strong enough to detect corruption.
 inline std::uint64_t hash_bytes(const void* data, std::size_t n, std::uint64_t seed = 0) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    std::uint64_t h[4] = {seed ^ 0x9E3779B97F4A7C15ull, seed + 0x632BE59BD9B4E019ull,
-                          ~seed, seed * 0xD6E8FEB86659FD93ull + 1};
-    std::size_t i = 0;
-    for (; i + 32 <= n; i += 32) {
-        for (int k = 0; k < 4; ++k) {
-            std::uint64_t w;
-            std::memcpy(&w, p + i + 8 * k, 8);
-            h[k] = (h[k] ^ w) * 0x9FB21C651E98DF25ull;
-            h[k] ^= h[k] >> 29;
-        }
-    }
-    std::uint64_t acc = n;
-    for (; i + 8 <= n; i += 8) {
-        std::uint64_t w;
-        std::memcpy(&w, p + i, 8);
-        acc = mix64(acc ^ w);
-    }
-    std::uint64_t tail = 0;
-    if (i < n) std::memcpy(&tail, p + i, n - i);
-    acc = mix64(acc ^ tail);
-    for (const std::uint64_t v : h) acc = mix64(acc ^ v);
-    return acc;
+    HashStream h(seed);
+    h.add(data, n);
+    return h.value();
 }
 
 // Incremental fingerprint of typed values (doubles by bit pattern).

@@ -2,8 +2,11 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -27,8 +30,8 @@ std::uint64_t bucket_of(std::uint32_t a, std::uint32_t b, std::uint64_t buckets)
 }
 
 // A hit as its finished entry, without its link (the form the rasterizer can keep hits in). Its
-// bucket is hashed again where it is needed rather than kept: at 10 bytes, the half of a raw
-// hit that compaction frees holds the whole sorted copy.
+// bucket is hashed again where it is needed rather than kept: at 10 bytes, entries are sorted
+// in the place the hits were, and a raw hit's compaction frees the other half.
 using Sorted = PointHit;
 
 // The indices of hits.chunks that lie in each buffer of hits.storage, in address order.
@@ -99,10 +102,9 @@ PointHits compact_hits(RawHits&& hits, ToEntry&& to_entry) {
 }
 
 // Buckets are split into partitions small enough (4k buckets, 57 kB) to stay in cache while
-// their entries are placed, and partitions into groups (16: about 1.3 MB of entries and 2 MB of
-// payload, near what a core's cache holds). Entries are sorted stably by group (one pass over
-// memory, to few places), then each group by partition in a buffer of its own thread's, which
-// the placement reads while it is still in cache.
+// their entries are placed; partitions are placed in groups (16: about 1.3 MB of entries and
+// 2 MB of payload, near what a core's cache holds), each group's payload written as one piece of
+// buckets and one of overflow entries.
 constexpr int kPartBits = 12;
 constexpr std::uint64_t kLocal = (1u << kPartBits) - 1;
 constexpr std::uint64_t kGroup = 16;  // partitions
@@ -117,46 +119,103 @@ struct Partitioning {
             throw std::length_error("hash14: too many entries for 32-bit links");
     }
     std::uint64_t bucket(const Sorted& e) const { return bucket_of(e.a, e.b, buckets); }
-    std::uint64_t part(const Sorted& e) const { return bucket(e) >> kPartBits; }
     // Partition p owns buckets [b0(p), b0(p + 1)); group g partitions [p0(g), p0(g + 1)).
     std::uint64_t b0(std::uint64_t p) const { return std::min(buckets, p << kPartBits); }
     std::uint64_t p0(std::uint64_t g) const { return std::min(parts, g * kGroup); }
 };
 
-// What the placement needs to know before it starts: where each partition's entries start in
-// the sorted order (part_start, parts + 1 values) and its overflow entries in the payload
-// (over_start), and where each chunk's entries of each group go (group_pos[c * groups + g]).
+// Where the entries are once each chunk is sorted by group in place: chunk c's entries of
+// group g at [local[c (groups + 1) + g], local[c (groups + 1) + g + 1]) of the chunk. The
+// placement needs too where each partition's entries start in entry order (part_start, parts
+// + 1 values) and its overflow entries in the payload (over_start).
 struct Layout {
-    std::vector<std::uint64_t> part_start, over_start, group_pos;
+    std::vector<std::uint32_t> local;  // a chunk holds fewer than 2^32 entries (32-bit links)
+    std::vector<std::uint64_t> part_start, over_start;
 };
 
-// One pass over the entries: each chunk's count in each partition, and which buckets are used
-// (bitsets per thread, or'ed).
-Layout count_entries(const PointHits& entries, const Partitioning& pt) {
-    const std::size_t nchunks = entries.chunks.size();
-    const std::uint64_t parts = pt.parts, groups = pt.groups;
-    std::vector<std::uint32_t> count(nchunks * parts, 0);  // n < 2^32 (32-bit links)
-    const std::size_t words = (pt.buckets + 63) / 64;
-    tbb::enumerable_thread_specific<std::vector<std::uint64_t>> used_by_thread(words, 0);
-    tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
-        std::vector<std::uint64_t>& used = used_by_thread.local();
-        std::uint32_t* row = &count[c * parts];
-        for (const Sorted& e : entries.chunks[c]) {
-            if (e.a >= Hash14Table::kMaxPoints || e.b >= Hash14Table::kMaxPoints)
-                throw std::length_error("hash14: point id over 16 bits");
-            const std::uint64_t b = pt.bucket(e);
-            ++row[b >> kPartBits];
-            used[b / 64] |= std::uint64_t{1} << (b % 64);
+// Chunks as writable spans: the encoder's own where it holds the only reference to their
+// buffers, else a copy of them.
+std::vector<std::span<Sorted>> writable_chunks(PointHits& entries) {
+    bool ours = true;
+    for (const auto& b : entries.storage) ours = ours && b.use_count() == 1;
+    if (!ours) {
+        auto copy = std::make_shared<ByteBuffer>(std::max<std::uint64_t>(1, entries.size()) * sizeof(Sorted));
+        auto* w = reinterpret_cast<Sorted*>(copy->data());
+        for (std::span<const Sorted>& c : entries.chunks) {
+            std::copy(c.begin(), c.end(), w);
+            c = {w, c.size()};
+            w += c.size();
         }
+        entries.storage = {std::move(copy)};
+    }
+    // The buffers are never const objects (table.h).
+    std::vector<std::span<Sorted>> out;
+    for (const std::span<const Sorted>& c : entries.chunks)
+        out.emplace_back(const_cast<Sorted*>(c.data()), c.size());
+    return out;
+}
+
+// A thread's scratch for sorting one chunk: each entry's bucket, the sorted copy with its
+// buckets, the chunk's count in each partition and the buckets it uses (a bitset).
+struct ChunkScratch {
+    std::vector<std::uint32_t> bucket, sorted_bucket;
+    std::vector<Sorted> sorted;
+    std::vector<std::uint64_t> part_count, used;
+};
+
+// One chunk, while it stays in cache: its count in each partition (added to s.part_count), the
+// buckets it uses, and its entries sorted stably by group, in place.
+void sort_chunk(std::span<Sorted> chunk, const Partitioning& pt, std::uint32_t* local,
+                ChunkScratch& s) {
+    s.bucket.resize(chunk.size());
+    s.sorted_bucket.resize(chunk.size());
+    s.sorted.resize(chunk.size());
+    std::fill(local, local + pt.groups + 1, 0u);
+    constexpr int kGroupShift = kPartBits + 4;
+    static_assert(kGroup == 16);
+    for (std::size_t i = 0; i < chunk.size(); ++i) {
+        const Sorted& e = chunk[i];
+        if (e.a >= Hash14Table::kMaxPoints || e.b >= Hash14Table::kMaxPoints)
+            throw std::length_error("hash14: point id over 16 bits");
+        const auto b = static_cast<std::uint32_t>(pt.bucket(e));  // buckets < 2^32
+        s.bucket[i] = b;
+        ++s.part_count[b >> kPartBits];
+        ++local[(b >> kGroupShift) + 1];
+    }
+    for (std::uint64_t g = 0; g < pt.groups; ++g) local[g + 1] += local[g];
+    // local[g] runs to group g's end as its entries are scattered, then is moved back.
+    for (std::size_t i = 0; i < chunk.size(); ++i) {
+        const std::uint32_t to = local[s.bucket[i] >> kGroupShift]++;
+        s.sorted[to] = chunk[i];
+        s.sorted_bucket[to] = s.bucket[i];
+    }
+    for (std::uint64_t g = pt.groups; g > 0; --g) local[g] = local[g - 1];
+    local[0] = 0;
+    std::copy(s.sorted.begin(), s.sorted.end(), chunk.begin());
+    // In group order the bitset is visited a small range at a time.
+    for (const std::uint32_t b : s.sorted_bucket) s.used[b / 64] |= std::uint64_t{1} << (b % 64);
+}
+
+// Every chunk sorted by group in place (sort_chunk, in parallel), then the partitions' starts
+// in the entries and in the payload's overflow area.
+Layout sort_chunks(const std::vector<std::span<Sorted>>& chunks, const Partitioning& pt) {
+    const std::size_t nchunks = chunks.size();
+    const std::uint64_t parts = pt.parts, row = pt.groups + 1;
+    Layout l;
+    l.local.resize(nchunks * row);
+    const std::size_t words = (pt.buckets + 63) / 64;
+    tbb::enumerable_thread_specific<ChunkScratch> scratch;
+    tbb::parallel_for(std::size_t{0}, nchunks, [&](std::size_t c) {
+        ChunkScratch& s = scratch.local();
+        if (s.used.empty()) s.used.assign(words, 0), s.part_count.assign(parts, 0);
+        sort_chunk(chunks[c], pt, &l.local[c * row], s);
     });
     std::vector<std::uint64_t> used(words, 0);
-    for (const std::vector<std::uint64_t>& u : used_by_thread)
-        for (std::size_t w = 0; w < words; ++w) used[w] |= u[w];
-
-    Layout l;
     l.part_start.assign(parts + 1, 0);
-    for (std::size_t c = 0; c < nchunks; ++c)  // row by row: the counts lie in that order
-        for (std::uint64_t p = 0; p < parts; ++p) l.part_start[p + 1] += count[c * parts + p];
+    for (const ChunkScratch& s : scratch) {
+        for (std::size_t w = 0; w < s.used.size(); ++w) used[w] |= s.used[w];
+        for (std::uint64_t p = 0; p < s.part_count.size(); ++p) l.part_start[p + 1] += s.part_count[p];
+    }
     // Overflow entries: a partition's entries less its used buckets (b0(p) is a multiple of 64).
     l.over_start.assign(parts + 1, pt.buckets);
     for (std::uint64_t p = 0; p < parts; ++p) {
@@ -166,56 +225,35 @@ Layout count_entries(const PointHits& entries, const Partitioning& pt) {
         l.over_start[p + 1] = l.over_start[p] + l.part_start[p + 1] - distinct;
     }
     for (std::uint64_t p = 0; p < parts; ++p) l.part_start[p + 1] += l.part_start[p];
-    // Stable by group: group by group, chunk by chunk.
-    l.group_pos.resize(nchunks * groups);
-    std::vector<std::uint64_t> pos(groups);
-    for (std::uint64_t g = 0; g < groups; ++g) pos[g] = l.part_start[pt.p0(g)];
-    for (std::size_t c = 0; c < nchunks; ++c)
-        for (std::uint64_t g = 0; g < groups; ++g) {
-            l.group_pos[c * groups + g] = pos[g];
-            for (std::uint64_t p = pt.p0(g); p < pt.p0(g + 1); ++p) pos[g] += count[c * parts + p];
-        }
     return l;
 }
 
-// The entries sorted stably by group, a buffer of entries at a time, each buffer freed once
-// read (where nothing else holds it), into small pages: every group's range fills from its
-// start, so the pages a buffer's entries first touch are about as many as the buffer before
-// gave back (a first touch of memory the process has just freed is cheap; of memory new to it,
-// dear).
-ByteBuffer sort_by_group(PointHits&& entries, const Partitioning& pt, Layout& l) {
-    ByteBuffer out(entries.size() * sizeof(Sorted), ByteBuffer::Pages::kSmall);
-    auto* sorted = reinterpret_cast<Sorted*>(out.data());
-    const std::vector<std::vector<std::size_t>> in_buffer = chunks_by_buffer(entries);
-    for (std::size_t j = 0; j < in_buffer.size(); ++j) {
-        const std::vector<std::size_t>& cs = in_buffer[j];
-        tbb::parallel_for(std::size_t{0}, cs.size(), [&](std::size_t i) {
-            const std::size_t c = cs[i];
-            std::uint64_t* pos = &l.group_pos[c * pt.groups];
-            for (const Sorted& e : entries.chunks[c]) sorted[pos[pt.part(e) / kGroup]++] = e;
-        });
-        entries.storage[j].reset();
-    }
-    entries = {};
-    return out;
-}
-
-// A thread's buffers for one group at a time: its entries by partition, and its payload.
+// A thread's buffers for one group at a time: its entries by partition with their buckets,
+// and its payload.
 struct GroupScratch {
-    ByteBuffer by_part, stage;
+    ByteBuffer by_part, bucket, stage;
 };
 
-// Group g's buckets, then its overflow entries, into stage; its entries (sorted by group) by
-// partition first. A bucket's first entry is its head; later ones take the next overflow slot
-// and go right after the head in its chain.
-void place_group(std::uint64_t g, const Sorted* sorted, const Partitioning& pt, const Layout& l,
-                 GroupScratch& s) {
-    const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1);
+// Group g's buckets, then its overflow entries, into stage; its entries (its pieces of every
+// chunk in turn: entry order) by partition first. A bucket's first entry is its head; later
+// ones take the next overflow slot and go right after the head in its chain.
+void place_group(std::uint64_t g, const std::vector<std::span<Sorted>>& chunks,
+                 const Partitioning& pt, const Layout& l, GroupScratch& s) {
+    const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1), row = pt.groups + 1;
     auto* mine = reinterpret_cast<Sorted*>(s.by_part.data());
+    auto* mine_bucket = reinterpret_cast<std::uint32_t*>(s.bucket.data());
     std::uint64_t next[kGroup];
     for (std::uint64_t p = q0; p < q1; ++p) next[p - q0] = l.part_start[p] - l.part_start[q0];
-    for (std::uint64_t i = l.part_start[q0]; i < l.part_start[q1]; ++i)
-        mine[next[pt.part(sorted[i]) - q0]++] = sorted[i];
+    for (std::size_t c = 0; c < chunks.size(); ++c) {
+        const std::uint32_t* local = &l.local[c * row + g];
+        for (std::uint32_t i = local[0]; i < local[1]; ++i) {
+            const Sorted& h = chunks[c][i];
+            const auto b = static_cast<std::uint32_t>(pt.bucket(h));  // buckets < 2^32
+            const std::uint64_t to = next[(b >> kPartBits) - q0]++;
+            mine[to] = h;
+            mine_bucket[to] = b;
+        }
+    }
     auto* stage = reinterpret_cast<Hash14Entry*>(s.stage.data());
     Hash14Entry* const over_stage = stage + (pt.b0(q1) - pt.b0(q0));
     for (std::uint64_t p = q0; p < q1; ++p) {
@@ -226,7 +264,7 @@ void place_group(std::uint64_t g, const Sorted* sorted, const Partitioning& pt, 
         for (std::uint64_t i = l.part_start[p]; i < l.part_start[p + 1]; ++i) {
             const Sorted& h = mine[i - l.part_start[q0]];
             const Hash14Entry e{h.a, h.b, h.t, h.nu, h.nv, Hash14Table::kEnd};
-            Hash14Entry& head = part_out[pt.bucket(h) & kLocal];
+            Hash14Entry& head = part_out[mine_bucket[i - l.part_start[q0]] & kLocal];
             if (head.a == 0xFFFF) {
                 head = e;
                 continue;
@@ -239,14 +277,13 @@ void place_group(std::uint64_t g, const Sorted* sorted, const Partitioning& pt, 
     }
 }
 
-// The payload from the entries (chunks in entry order), freeing the entries' buffers (where
-// nothing else holds them) once read. Groups are placed in parallel, each written as two
-// contiguous ranges of the payload (its buckets, its overflow entries).
+// The payload from the entries (chunks in entry order), freeing them at the end. Groups are
+// placed in parallel, each written as two contiguous ranges of the payload (its buckets, its
+// overflow entries).
 void place(PointHits&& entries, PayloadSink& sink) {
     const Partitioning pt(entries.size());
-    Layout l = count_entries(entries, pt);
-    const ByteBuffer sorted_buf = sort_by_group(std::move(entries), pt, l);
-    const auto* sorted = reinterpret_cast<const Sorted*>(sorted_buf.data());
+    const std::vector<std::span<Sorted>> chunks = writable_chunks(entries);
+    const Layout l = sort_chunks(chunks, pt);
     sink.reserve(kHeader + l.over_start[pt.parts] * sizeof(Hash14Entry));
     sink.write_at(0, &pt.buckets, kHeader);
     std::uint64_t most_entries = 0, most_stage = 0;
@@ -257,20 +294,28 @@ void place(PointHits&& entries, PayloadSink& sink) {
     }
     tbb::enumerable_thread_specific<GroupScratch> scratch;
     std::mutex writing;  // the sink takes one piece at a time
-    tbb::parallel_for(std::uint64_t{0}, pt.groups, [&](std::uint64_t g) {
+    // Groups are taken in order, so that their buckets reach the sink nearly in order (a file
+    // sink hashes what comes in order as it goes by).
+    std::atomic<std::uint64_t> next_group{0};
+    const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
+    tbb::parallel_for(0, workers, [&](int) {
         GroupScratch& s = scratch.local();
         if (!s.stage.data()) {
-            s.by_part = ByteBuffer(most_entries * sizeof(Sorted));
-            s.stage = ByteBuffer(most_stage * sizeof(Hash14Entry));
+            s.by_part = ByteBuffer(most_entries * sizeof(Sorted), ByteBuffer::Pages::kSmall);
+            s.bucket = ByteBuffer(most_entries * sizeof(std::uint32_t), ByteBuffer::Pages::kSmall);
+            s.stage = ByteBuffer(most_stage * sizeof(Hash14Entry), ByteBuffer::Pages::kSmall);
         }
-        place_group(g, sorted, pt, l, s);
-        const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1), nb = pt.b0(q1) - pt.b0(q0);
-        const auto* stage = reinterpret_cast<const Hash14Entry*>(s.stage.data());
-        const std::lock_guard<std::mutex> lock(writing);
-        sink.write_at(kHeader + pt.b0(q0) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
-        sink.write_at(kHeader + l.over_start[q0] * sizeof(Hash14Entry), stage + nb,
-                      (l.over_start[q1] - l.over_start[q0]) * sizeof(Hash14Entry));
-    });
+        for (std::uint64_t g; (g = next_group++) < pt.groups;) {
+            place_group(g, chunks, pt, l, s);
+            const auto* stage = reinterpret_cast<const Hash14Entry*>(s.stage.data());
+            const std::uint64_t q0 = pt.p0(g), q1 = pt.p0(g + 1), nb = pt.b0(q1) - pt.b0(q0);
+            const std::lock_guard<std::mutex> lock(writing);
+            sink.write_at(kHeader + pt.b0(q0) * sizeof(Hash14Entry), stage, nb * sizeof(Hash14Entry));
+            sink.write_at(kHeader + l.over_start[q0] * sizeof(Hash14Entry), stage + nb,
+                          (l.over_start[q1] - l.over_start[q0]) * sizeof(Hash14Entry));
+        }
+    }, tbb::simple_partitioner());
+    entries = {};
 }
 
 }  // namespace
