@@ -191,6 +191,19 @@ TEST(PayloadStream, SharedPointHitsGiveTheSameBytesAndStayUntouched) {
     EXPECT_EQ(std::memcmp(after.data(), before.data(), before.size() * sizeof(PointHit)), 0);
 }
 
+// A hash14 table's header for the hair rasterized at sigma^-1 = k.
+TableHeader hash14_header(const Rasterized& r, int k) {
+    TableHeader h;
+    h.encoding = "hash14";
+    h.cells = r.ctx.cells;
+    h.sigma_inv = k;
+    h.sigma = r.ctx.sigma;
+    h.cell = r.ctx.cell;
+    h.pairs = r.raster.pairs_eq2;
+    h.entries = r.raster.hits;
+    return h;
+}
+
 // The file's checksum (hashed as pieces arrive in order, the rest read back) is the whole
 // payload's whatever order and size the pieces come in: in order, backwards, a little ahead of
 // the bytes before them, rewriting bytes already hashed or a piece still waiting.
@@ -198,14 +211,7 @@ TEST(PayloadStream, TableFileChecksumHoldsForPiecesInAnyOrder) {
     const test::TempDir dir;
     const Rasterized& r = hair(1);
     const ByteBuffer payload = find_encoding("hash14").build(r.raster.raw, r.ctx, {});
-    TableHeader h;
-    h.encoding = "hash14";
-    h.cells = r.ctx.cells;
-    h.sigma_inv = 1;
-    h.sigma = r.ctx.sigma;
-    h.cell = r.ctx.cell;
-    h.pairs = r.raster.pairs_eq2;
-    h.entries = r.raster.hits;
+    TableHeader h = hash14_header(r, 1);
     const std::string whole = dir.file("whole.lht");
     write_table_file(whole, h, payload);
     const std::size_t n = payload.size(), piece = 4099;  // not a multiple of 32
@@ -266,14 +272,7 @@ TEST(PayloadStream, StreamedTableFileEqualsTheWholeOne) {
     const test::TempDir dir;
     const Rasterized& r = hair(2);
     const Encoding& e = find_encoding("hash14");
-    TableHeader h;
-    h.encoding = "hash14";
-    h.cells = r.ctx.cells;
-    h.sigma_inv = 2;
-    h.sigma = r.ctx.sigma;
-    h.cell = r.ctx.cell;
-    h.pairs = r.raster.pairs_eq2;
-    h.entries = r.raster.hits;
+    TableHeader h = hash14_header(r, 2);
     h.metadata = R"({"primitive": "hair"})";
     const std::string whole = dir.file("whole.lht"), streamed = dir.file("streamed.lht");
     write_table_file(whole, h, e.build(r.raster.raw, r.ctx, {}));
