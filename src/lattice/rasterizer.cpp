@@ -77,6 +77,11 @@ private:
     }
 };
 
+// A chain's crossings are a t and a part alone, kept as its part (Scratch::best_part); other
+// shapes keep the whole crossing (best_c).
+template <class S>
+inline constexpr bool kKeepsPartOnly = std::is_same_v<S, ChainShape>;
+
 struct Scratch {
     std::vector<double> best_t;
     // The closest crossing so far at each point: its t in best_t; for a chain, whose crossings
@@ -144,7 +149,7 @@ public:
             const std::vector<Vec3>& at = points_[static_cast<std::size_t>(f)];
             if (s.best_t.size() < fl.mask.size()) {
                 s.best_t.assign(fl.mask.size(), kInfinity);
-                if constexpr (std::is_same_v<S, ChainShape>) s.best_part.resize(fl.mask.size());
+                if constexpr (kKeepsPartOnly<S>) s.best_part.resize(fl.mask.size());
                 else s.best_c.resize(fl.mask.size());
                 s.tested.assign(fl.mask.size(), 0);
                 s.batch.fit(fl.mask.size());
@@ -244,7 +249,7 @@ private:
         const auto keep = [&](std::size_t k, const Crossing& c) {
             if (s.best_t[k] == kInfinity) s.touched.push_back(k);
             s.best_t[k] = c.t;
-            if constexpr (std::is_same_v<S, ChainShape>) s.best_part[k] = c.part;
+            if constexpr (kKeepsPartOnly<S>) s.best_part[k] = c.part;
             else s.best_c[k] = c;
         };
         std::size_t i = 0;
@@ -291,7 +296,7 @@ private:
                   bool start_inside, Scratch& s, std::size_t k) const {
         const Ray r{p * h_, (qv - p) * h_};
         Crossing c;
-        if constexpr (std::is_same_v<S, ChainShape>) c = Crossing(s.best_t[k], s.best_part[k], 0);
+        if constexpr (kKeepsPartOnly<S>) c = Crossing(s.best_t[k], s.best_part[k], 0);
         else c = s.best_c[k];
         float t = static_cast<float>(std::min(1.0, s.best_t[k]));
         if (start_inside) {
