@@ -58,7 +58,8 @@ inline std::uint16_t quantise_t16(float t) {
     const double x = std::clamp(double(t), 0.0, 1.0) * 65535.0;
     if (!(x >= 0)) return 0;
     const double whole = std::trunc(x);  // x - whole is exact
-    return static_cast<std::uint16_t>(x - whole >= 0.5 ? whole + 1 : whole);
+    // The round-up as a 0 or 1 added, not a branch: it is a coin toss for a table's hits.
+    return static_cast<std::uint16_t>(static_cast<int>(whole) + (x - whole >= 0.5 ? 1 : 0));
 }
 
 // Rasterized hits in chunks (one per block of entry points, in a fixed order) that point into
