@@ -1,6 +1,7 @@
 #include "lattice/face_cones.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include "geometry/lattice_source.h"
@@ -26,6 +27,16 @@ FaceLayout layout_face(const BoundaryGrid& grid, int f) {
             fl.canonical[k] = (__builtin_ctz(fl.mask[k]) == f) ? 1 : 0;
             fl.ids[k] = grid.id(q);
         }
+    fl.canon_u0.assign(static_cast<std::size_t>(fl.nv), 0);
+    fl.canon_u1.assign(static_cast<std::size_t>(fl.nv), -1);
+    for (int v = 0; v < fl.nv; ++v) {
+        const std::uint8_t* row = &fl.canonical[static_cast<std::size_t>(v * fl.nu)];
+        int u0 = 0, u1 = fl.nu - 1;
+        while (u0 < fl.nu && !row[u0]) ++u0;
+        while (u1 >= u0 && !row[u1]) --u1;
+        for (int u = u0; u <= u1; ++u) assert(row[u] && "a face row's canonical points are one run");
+        if (u0 <= u1) fl.canon_u0[static_cast<std::size_t>(v)] = u0, fl.canon_u1[static_cast<std::size_t>(v)] = u1;
+    }
     return fl;
 }
 

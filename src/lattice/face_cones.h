@@ -19,6 +19,9 @@ struct FaceLayout {
     std::vector<std::uint8_t> mask;       // faces of each point
     std::vector<std::uint8_t> canonical;  // 1 where this face is the point's lowest face
     std::vector<std::uint32_t> ids;
+    // Row v's canonical points are u in [canon_u0[v], canon_u1[v]] (none when u0 > u1): only the
+    // box's edges are shared with other faces, so they are one run.
+    std::vector<int> canon_u0, canon_u1;
 };
 
 FaceLayout layout_face(const BoundaryGrid& grid, int face);
@@ -107,35 +110,44 @@ private:
     bool whole_;
 };
 
-// Every canonical exit point of face fl inside the cone from p around the sphere ps: calls
-// visit(k, q) with k the point's index in the face and q its lattice coordinates.
-template <class Visit>
-void for_each_exit_in_cone(const Vec3& p, const PartSphere& ps, const FaceLayout& fl, Visit&& visit) {
+// Every row of face fl that the cone from p around the sphere ps reaches, with the u-range of
+// its canonical exits there (clamped to them and to the sphere's projection):
+// visit_row(v, ub, ue) with ub <= ue, rows in ascending order.
+template <class VisitRow>
+void for_each_cone_row(const Vec3& p, const PartSphere& ps, const FaceLayout& fl, VisitRow&& visit_row) {
     int u0, u1, v0, v1, c0, c1;
     if (!cone_rows(p, ps, fl, c0, c1)) return;
     const Vec3 rr{ps.r, ps.r, ps.r};
     projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
     v0 = std::max(v0, c0), v1 = std::min(v1, c1);
     const ConeRows cone(p, ps, fl);
+    for (int v = v0; v <= v1; ++v) {
+        double ulo, uhi;
+        if (!cone.row(v, ulo, uhi)) continue;
+        // Clamp in double first: the interval may be unbounded or huge.
+        const int ub = std::max(static_cast<int>(std::ceil(std::max(ulo, double(u0)))),
+                                fl.canon_u0[static_cast<std::size_t>(v)]);
+        const int ue = std::min(static_cast<int>(std::floor(std::min(uhi, double(u1)))),
+                                fl.canon_u1[static_cast<std::size_t>(v)]);
+        if (ub <= ue) visit_row(v, ub, ue);
+    }
+}
+
+// Every canonical exit point of face fl inside the cone from p around the sphere ps: calls
+// visit(k, q) with k the point's index in the face and q its lattice coordinates.
+template <class Visit>
+void for_each_exit_in_cone(const Vec3& p, const PartSphere& ps, const FaceLayout& fl, Visit&& visit) {
     // q = base + u eu + v ev, exactly (small integers and zeros): writing q's coordinates by
     // runtime axis index instead stalls the load of q that follows on store forwarding.
     Vec3 base{0, 0, 0}, eu{0, 0, 0}, ev{0, 0, 0};
     base[static_cast<std::size_t>(fl.axis)] = fl.level;
     eu[static_cast<std::size_t>(fl.ua)] = 1;
     ev[static_cast<std::size_t>(fl.va)] = 1;
-    for (int v = v0; v <= v1; ++v) {
-        double ulo, uhi;
-        if (!cone.row(v, ulo, uhi)) continue;
-        // Clamp in double first: the interval may be unbounded or huge.
-        const int ub = static_cast<int>(std::ceil(std::max(ulo, double(u0))));
-        const int ue = static_cast<int>(std::floor(std::min(uhi, double(u1))));
+    for_each_cone_row(p, ps, fl, [&](int v, int ub, int ue) {
         const Vec3 row = base + ev * double(v);
-        for (int u = ub; u <= ue; ++u) {
-            const std::size_t k = static_cast<std::size_t>(v * fl.nu + u);
-            if (!fl.canonical[k]) continue;
-            visit(k, row + eu * double(u));
-        }
-    }
+        for (int u = ub; u <= ue; ++u)
+            visit(static_cast<std::size_t>(v * fl.nu + u), row + eu * double(u));
+    });
 }
 
 }  // namespace lat

@@ -91,21 +91,24 @@ struct Scratch {
     std::vector<std::uint32_t> tested;  // generation of the last part tested at each point
     std::uint32_t generation = 0;
     std::vector<std::size_t> touched;  // face points with a hit, to emit and reset
+    // The u-range of exits that the last sphere visited in each row of a face, stamped with
+    // that sphere's visit (the next sphere of the same part skips them: they are gathered).
+    struct RowRange {
+        std::uint64_t visit = 0;
+        int ub = 0, ue = -1;
+    };
+    std::vector<RowRange> rows;
+    std::uint64_t visit = 0;
     // The exits in the cones of one part, to test against it: each one's index in the face, its
     // segment's direction (primitive units) and the end of its range, in arrays of their own
-    // (two lanes load as one register). Each exit is gathered once, so a face's size holds them.
+    // (two lanes load as one register). Each exit is gathered once, so a face's size holds them
+    // (trace_face fills them).
     struct Batch {
         std::vector<std::uint32_t> k;
         std::vector<double> dx, dy, dz, tmax;
         std::size_t n = 0;
         void fit(std::size_t size) {
             k.resize(size), dx.resize(size), dy.resize(size), dz.resize(size), tmax.resize(size);
-        }
-        void push(std::size_t face_index, const Vec3& d, double range_end) {
-            assert(n < k.size());
-            k[n] = static_cast<std::uint32_t>(face_index);
-            dx[n] = d.x, dy[n] = d.y, dz[n] = d.z, tmax[n] = range_end;
-            ++n;
         }
     } batch;
     bool point_hits = false;  // hits kept in `points`, else in `raw`
@@ -207,11 +210,39 @@ private:
     }
 
     // The closest hit of every segment from p to face fl, culled per part by its cones: the
-    // exits in any cone of a part are gathered (each once), then tested against it.
+    // exits in any cone of a part are gathered (each once), then tested against it. Exits are
+    // gathered in the order of the part's spheres, rows and u, which fixes the order of the hits.
     template <class S>
     void trace_face(const S& shape, const Vec3& p, const FaceLayout& fl, Scratch& s, Counts& cnt) const {
+        if (s.rows.size() < static_cast<std::size_t>(fl.nv)) s.rows.resize(static_cast<std::size_t>(fl.nv));
+        Scratch::Batch& b = s.batch;
+        // An exit's segment is q - p in primitive units, q's coordinates small integers: along
+        // the face's axis and v it is the same for a whole face and row, along u one subtraction.
+        double* const along[3] = {b.dx.data(), b.dy.data(), b.dz.data()};
+        double* const du = along[static_cast<std::size_t>(fl.ua)];
+        double* const dv = along[static_cast<std::size_t>(fl.va)];
+        double* const dax = along[static_cast<std::size_t>(fl.axis)];
+        const double pu = p[static_cast<std::size_t>(fl.ua)], pv = p[static_cast<std::size_t>(fl.va)];
+        const double dax_face = (fl.level - p[static_cast<std::size_t>(fl.axis)]) * h_;
+        // The (canonical) exits [ub, ue] of row v (from index k0 = v nu) into the batch; with
+        // marks, those not yet gathered for this part. An exit's range ends at its best hit so far, which
+        // only its own test in this part's batch can change.
+        const auto gather = [&](std::size_t k0, double dv_row, int ub, int ue, bool marks) {
+            for (int u = ub; u <= ue; ++u) {
+                const std::size_t k = k0 + static_cast<std::size_t>(u);
+                if (marks) {
+                    if (s.tested[k] == s.generation) continue;
+                    s.tested[k] = s.generation;
+                }
+                assert(b.n < b.k.size());
+                b.k[b.n] = static_cast<std::uint32_t>(k);
+                du[b.n] = (u - pu) * h_, dv[b.n] = dv_row, dax[b.n] = dax_face;
+                b.tmax[b.n] = std::min(s.best_t[k], 1.0 + 1e-12);
+                ++b.n;
+            }
+        };
         std::uint32_t last_part = ~0u;
-        s.batch.n = 0;
+        b.n = 0;
         for (std::size_t i = 0; i < spheres_.size(); ++i) {
             const PartSphere& ps = spheres_[i];
             const bool first = ps.part != last_part;
@@ -220,20 +251,21 @@ private:
                 last_part = ps.part;
                 ++s.generation;  // marks "gathered for this part" in s.tested
             }
-            // An exit's range ends at its best hit so far, which only its own test in this
-            // part's batch can change. A part of one sphere visits each exit once: it needs no
-            // marks.
-            const auto gather = [&](std::size_t k, const Vec3& q) {
-                s.batch.push(k, (q - p) * h_, std::min(s.best_t[k], 1.0 + 1e-12));
-            };
-            if (first && (i + 1 == spheres_.size() || spheres_[i + 1].part != ps.part)) {
-                for_each_exit_in_cone(p, ps, fl, gather);
-                continue;
-            }
-            for_each_exit_in_cone(p, ps, fl, [&](std::size_t k, const Vec3& q) {
-                if (s.tested[k] == s.generation) return;
-                s.tested[k] = s.generation;
-                gather(k, q);
+            // A part of one sphere visits each exit once: it needs no marks.
+            const bool alone = first && (i + 1 == spheres_.size() || spheres_[i + 1].part != ps.part);
+            const std::uint64_t visit = ++s.visit;
+            for_each_cone_row(p, ps, fl, [&](int v, int ub, int ue) {
+                const std::size_t k0 = static_cast<std::size_t>(v) * static_cast<std::size_t>(fl.nu);
+                const double dv_row = (v - pv) * h_;
+                if (alone) return gather(k0, dv_row, ub, ue, false);
+                // What the part's previous sphere visited in this row is gathered already.
+                Scratch::RowRange& row = s.rows[static_cast<std::size_t>(v)];
+                const Scratch::RowRange before = row;
+                row = {visit, ub, ue};
+                if (first || before.visit + 1 != visit || before.ue < ub || before.ub > ue)
+                    return gather(k0, dv_row, ub, ue, true);
+                gather(k0, dv_row, ub, before.ub - 1, true);
+                gather(k0, dv_row, before.ue + 1, ue, true);
             });
         }
         test_batch(shape, p, last_part, s, cnt);
@@ -262,22 +294,25 @@ private:
             RayFan f;
             f.o = p * h_;
             f.tmin = _mm_setzero_pd();
-            unsigned m[kRun];
+            static_assert(2 * kRun <= 32);
             alignas(16) double t[2 * kRun], sub[2 * kRun];
             while (i + 1 < b.n) {
                 const std::size_t run = std::min(kRun, (b.n - i) / 2);
+                std::uint32_t met = 0;  // bit j: lane j of the run has a hit
                 for (std::size_t r = 0; r < run; ++r) {
                     const std::size_t e = i + 2 * r;  // even: the arrays' 16-byte alignment
                     f.d = {_mm_load_pd(&b.dx[e]), _mm_load_pd(&b.dy[e]), _mm_load_pd(&b.dz[e])};
                     f.tmax = _mm_load_pd(&b.tmax[e]);
                     FanHits out;
-                    m[r] = shape.intersect_fan(part, f, out);
+                    met |= shape.intersect_fan(part, f, out) << (2 * r);
                     _mm_store_pd(t + 2 * r, out.t);
                     _mm_store_pd(sub + 2 * r, out.part);
                 }
-                for (std::size_t j = 0; j < 2 * run; ++j)
-                    if (m[j / 2] >> (j % 2) & 1)
-                        keep(b.k[i + j], Crossing(t[j], part << 2 | static_cast<std::uint32_t>(sub[j]), 0));
+                // The hits in lane order, one branch each (a branch per lane mispredicts).
+                for (; met; met &= met - 1) {
+                    const auto j = static_cast<std::size_t>(__builtin_ctz(met));
+                    keep(b.k[i + j], Crossing(t[j], part << 2 | static_cast<std::uint32_t>(sub[j]), 0));
+                }
                 i += 2 * run;
             }
         }
