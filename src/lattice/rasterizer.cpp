@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <span>
 #include <stdexcept>
 #include <type_traits>
 
@@ -90,7 +91,10 @@ struct Scratch {
     std::vector<std::uint32_t> best_part;
     std::vector<std::uint32_t> tested;  // generation of the last part tested at each point
     std::uint32_t generation = 0;
-    std::vector<std::size_t> touched;  // face points with a hit, to emit and reset
+    // The face points with a hit, to emit and reset: the first n_touched of touched, which has
+    // room for every point of a face and one more (a point is written, then counted if new).
+    std::vector<std::uint32_t> touched;
+    std::size_t n_touched = 0;
     // The u-range of exits that the last sphere visited in each row of a face, stamped with
     // that sphere's visit (the next sphere of the same part skips them: they are gathered).
     struct RowRange {
@@ -155,11 +159,12 @@ public:
                 if constexpr (kKeepsPartOnly<S>) s.best_part.resize(fl.mask.size());
                 else s.best_c.resize(fl.mask.size());
                 s.tested.assign(fl.mask.size(), 0);
+                s.touched.resize(fl.mask.size() + 1);
                 s.batch.fit(fl.mask.size());
             }
             if (start_inside) {  // every segment starts in the solid: all hit at t = 0
                 for (std::size_t k = 0; k < fl.mask.size(); ++k)
-                    if (fl.canonical[k]) s.touched.push_back(k);
+                    if (fl.canonical[k]) s.touched[s.n_touched++] = static_cast<std::uint32_t>(k);
             } else {
                 trace_face(shape, p, fl, s, cnt);
             }
@@ -168,15 +173,16 @@ public:
             cnt.enumerated += sums_[fa][static_cast<std::size_t>(f)].multiplicity -
                               (own ? static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fa)) : 0);
             cnt.traced += sums_[fa][static_cast<std::size_t>(f)].valid - (own ? 1 : 0);
-            for (const std::size_t k : s.touched) {
+            const std::span<const std::uint32_t> touched(s.touched.data(), s.n_touched);
+            for (const std::size_t k : touched) {
                 if (fl.ids[k] == a || !BoundaryGrid::valid_pair(fa, fl.mask[k])) continue;
                 ++cnt.hits;
                 cnt.counted += static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fl.mask[k]));
                 if (keep) keep_hit(shape, a, p, fl.ids[k], at[k], start_inside, s, k);
             }
             if (!start_inside)
-                for (const std::size_t k : s.touched) s.best_t[k] = kInfinity;
-            s.touched.clear();
+                for (const std::size_t k : touched) s.best_t[k] = kInfinity;
+            s.n_touched = 0;
         }
     }
 
@@ -279,7 +285,10 @@ private:
         Scratch::Batch& b = s.batch;
         cnt.tests += b.n;
         const auto keep = [&](std::size_t k, const Crossing& c) {
-            if (s.best_t[k] == kInfinity) s.touched.push_back(k);
+            // Counted without a branch: whether an exit is hit for the first time is hard to
+            // predict.
+            s.touched[s.n_touched] = static_cast<std::uint32_t>(k);
+            s.n_touched += s.best_t[k] == kInfinity;
             s.best_t[k] = c.t;
             if constexpr (kKeepsPartOnly<S>) s.best_part[k] = c.part;
             else s.best_c[k] = c;
