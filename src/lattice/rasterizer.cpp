@@ -115,6 +115,15 @@ struct Scratch {
             k.resize(size), dx.resize(size), dy.resize(size), dz.resize(size), tmax.resize(size);
         }
     } batch;
+    // A face's hits on their way to the arena (Tracer::keep_hits): their exits, then their
+    // normals, t, parts and leaves.
+    struct Emit {
+        std::vector<std::uint32_t> k;
+        std::vector<Vec3> n;
+        std::vector<float> t;
+        std::vector<std::uint16_t> part, leaf;
+        void fit(std::size_t size) { k.resize(size), n.resize(size), t.resize(size), part.resize(size), leaf.resize(size); }
+    } emit;
     bool point_hits = false;  // hits kept in `points`, else in `raw`
     HitArena<RawHit> raw;
     HitArena<PointHit> points;
@@ -160,6 +169,7 @@ public:
                 else s.best_c.resize(fl.mask.size());
                 s.tested.assign(fl.mask.size(), 0);
                 s.touched.resize(fl.mask.size() + 1);
+                s.emit.fit(fl.mask.size());
                 s.batch.fit(fl.mask.size());
             }
             if (start_inside) {  // every segment starts in the solid: all hit at t = 0
@@ -174,12 +184,14 @@ public:
                               (own ? static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fa)) : 0);
             cnt.traced += sums_[fa][static_cast<std::size_t>(f)].valid - (own ? 1 : 0);
             const std::span<const std::uint32_t> touched(s.touched.data(), s.n_touched);
+            std::size_t n_keep = 0;
             for (const std::size_t k : touched) {
                 if (fl.ids[k] == a || !BoundaryGrid::valid_pair(fa, fl.mask[k])) continue;
                 ++cnt.hits;
                 cnt.counted += static_cast<std::uint64_t>(BoundaryGrid::multiplicity(fa, fl.mask[k]));
-                if (keep) keep_hit(shape, a, p, fl.ids[k], at[k], start_inside, s, k);
+                s.emit.k[n_keep++] = static_cast<std::uint32_t>(k);
             }
+            if (keep) keep_hits(shape, a, p, fl, at, start_inside, s, n_keep);
             if (!start_inside)
                 for (const std::size_t k : touched) s.best_t[k] = kInfinity;
             s.n_touched = 0;
@@ -333,32 +345,45 @@ private:
         b.n = 0;
     }
 
-    // The hit of segment a -> b (exit k of the face) into the thread's arena: raw, or as a
-    // PointHit (made straight from its parts: the rasterizer's every hit passes here).
+    // The hits of segments from a to the face's exits e.k[0, n) into the thread's arena: raw,
+    // or as PointHits (made straight from their parts: the rasterizer's every hit passes here).
+    // First every hit's crossing and normal, then their codes: a normal is a long chain of
+    // divisions, and short loops let the chains of several hits overlap.
     template <class S>
-    void keep_hit(const S& shape, std::uint32_t a, const Vec3& p, std::uint32_t b, const Vec3& qv,
-                  bool start_inside, Scratch& s, std::size_t k) const {
-        const Ray r{p * h_, (qv - p) * h_};
-        Crossing c;
-        if constexpr (kKeepsPartOnly<S>) c = Crossing(s.best_t[k], s.best_part[k], 0);
-        else c = s.best_c[k];
-        float t = static_cast<float>(std::min(1.0, s.best_t[k]));
-        if (start_inside) {
-            // p lies in the closed solid (on its surface, where a primitive touches the box): the
-            // hit is p itself, with the surface there the crossing nearest to it.
-            t = 0.0f;
-            c = nearest_crossing(whole_shape(shape), r);
+    void keep_hits(const S& shape, std::uint32_t a, const Vec3& p, const FaceLayout& fl,
+                   const std::vector<Vec3>& at, bool start_inside, Scratch& s, std::size_t n) const {
+        Scratch::Emit& e = s.emit;
+        for (std::size_t j = 0; j < n; ++j) {
+            const std::size_t k = e.k[j];
+            const Ray r{p * h_, (at[k] - p) * h_};
+            Crossing c;
+            if constexpr (kKeepsPartOnly<S>) c = Crossing(s.best_t[k], s.best_part[k], 0);
+            else c = s.best_c[k];
+            float t = static_cast<float>(std::min(1.0, s.best_t[k]));
+            if (start_inside) {
+                // p lies in the closed solid (on its surface, where a primitive touches the box):
+                // the hit is p itself, with the surface there the crossing nearest to it.
+                t = 0.0f;
+                c = nearest_crossing(whole_shape(shape), r);
+            }
+            if (c.part > RawHit::kMaxPart || c.leaf_index() > RawHit::kMaxLeaf) refuse_part(c);
+            e.n[j] = shape.normal(r, c);
+            e.t[j] = t;
+            e.part[j] = static_cast<std::uint16_t>(c.part);
+            e.leaf[j] = RawHit::pack_leaf(c.leaf);
         }
-        const Oct o = oct_encode(shape.normal(r, c), kRawNormalBits);
-        if (c.part > RawHit::kMaxPart || c.leaf_index() > RawHit::kMaxLeaf) refuse_part(c);
-        const auto nu = static_cast<std::uint16_t>(o.u), nv = static_cast<std::uint16_t>(o.v);
-        if (!s.point_hits) {
-            s.raw.push({a, b, t, nu, nv, static_cast<std::uint16_t>(c.part), RawHit::pack_leaf(c.leaf)});
-            return;
+        for (std::size_t j = 0; j < n; ++j) {
+            const Oct o = oct_encode(e.n[j], kRawNormalBits);
+            const auto nu = static_cast<std::uint16_t>(o.u), nv = static_cast<std::uint16_t>(o.v);
+            const std::uint32_t b = fl.ids[e.k[j]];
+            if (!s.point_hits) {
+                s.raw.push({a, b, e.t[j], nu, nv, e.part[j], e.leaf[j]});
+                continue;
+            }
+            // The table's build checked every id against the encoding's limit before tracing.
+            if (a >= 0xFFFF || b >= 0xFFFF) throw std::length_error("point hits: point id over 16 bits");
+            s.points.push({static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(b), quantise_t16(e.t[j]), nu, nv});
         }
-        // The table's build checked every id against the encoding's limit before tracing.
-        if (a >= 0xFFFF || b >= 0xFFFF) throw std::length_error("point hits: point id over 16 bits");
-        s.points.push({static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(b), quantise_t16(t), nu, nv});
     }
 };
 
