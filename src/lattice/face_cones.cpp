@@ -70,8 +70,10 @@ void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& 
     v1 = static_cast<int>(std::floor(std::min(vmax + eps, double(v1))));
 }
 
-bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0, int& v1) {
+bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0, int& v1, int& g0,
+               int& g1) {
     v0 = 0, v1 = f.nv - 1;
+    g0 = 0, g1 = -1;
     const auto ax = static_cast<std::size_t>(f.axis), va = static_cast<std::size_t>(f.va);
     const double da = f.level - p[ax];
     const double wax = s.c[ax] - p[ax], wva = s.c[va] - p[va];
@@ -81,11 +83,26 @@ bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0,
     if (da == 0) return std::abs(wax) <= s.r + margin;
     const double ahead = da > 0 ? wax : -wax;  // how far the centre lies towards the face
     if (ahead + s.r < -margin) return false;    // wholly behind
-    if (ahead - s.r <= margin) return true;     // straddles: the whole face
     // Exits at row offset dv = v - p_v meet the cone where
     // (r^2 - wax^2) dv^2 + 2 da wax wva dv + (r^2 - wva^2) da^2 >= 0 (the row's discriminant
     // in ConeRows::row over |w|^2 - r^2); with |wax| > r the leading coefficient is negative.
     const double a2 = s.r * s.r - wax * wax;
+    if (ahead - s.r <= margin) {
+        // Straddles: every row but those strictly between the roots (a2 > 0 clearly), where
+        // the quadratic is negative (most rows of such a sphere).
+        const double q = wax * wax + wva * wva - s.r * s.r;
+        if (!(a2 > 0.01 * s.r * s.r) || !(q > 0)) return true;
+        const double h = std::abs(da) * s.r * std::sqrt(q);
+        const double b = -da * wax * wva;
+        const double r0 = (b - h) / a2, r1 = (b + h) / a2;  // r0 <= r1 since a2 > 0
+        const double pad = 1e-6 * (1 + std::abs(r0) + std::abs(r1) + std::abs(da));
+        const double lo = p[va] + r0 + pad, hi = p[va] + r1 - pad;
+        // Clamp in double first: the roots may lie far off the face.
+        if (!(lo < hi) || !(hi > v0) || !(lo < v1)) return true;
+        g0 = static_cast<int>(std::floor(std::max(lo, double(v0) - 1))) + 1;
+        g1 = static_cast<int>(std::ceil(std::min(hi, double(v1) + 1))) - 1;
+        return true;
+    }
     const double h = std::abs(da) * s.r * std::sqrt(wax * wax + wva * wva - s.r * s.r);
     const double b = -da * wax * wva;
     const double r0 = (b + h) / a2, r1 = (b - h) / a2;  // r0 <= r1 since a2 < 0

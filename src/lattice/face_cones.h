@@ -57,13 +57,16 @@ std::vector<PartSphere> piece_spheres(const Shape& shape, double cell, const Vec
 void projected_range(const Vec3& p, const Bounds3& b, const FaceLayout& f, int& u0, int& u1,
                      int& v0, int& v1);
 
-// The rows of face f that can hold exits of segments from p that meet the sphere s: [v0, v1],
-// false when none. A superset of the rows where ConeRows::row finds an interval (padded far beyond
-// its rounding), found without visiting them: a sphere wholly behind p's plane parallel to the
-// face is never met on the way to it, and a sphere wholly in front of it casts an ellipse,
-// whose rows are the roots of a quadratic. A sphere that straddles that plane gets every row.
-// The one exit it may drop is p itself (p on the face, the sphere off its plane).
-bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0, int& v1);
+// The rows of face f that can hold exits of segments from p that meet the sphere s: [v0, v1]
+// less [g0, g1] (no rows when g0 > g1), false when none. A superset of the rows where
+// ConeRows::row finds an interval (padded far beyond its rounding), found without visiting them:
+// a sphere wholly behind p's plane parallel to the face is never met on the way to it, and a
+// sphere wholly in front of it casts an ellipse, whose rows lie between the roots of a quadratic.
+// A sphere that straddles that plane gets every row but those between the same quadratic's
+// roots (g0 to g1), where it is negative. The one exit it may drop is p itself (p on the face,
+// the sphere off its plane).
+bool cone_rows(const Vec3& p, const PartSphere& s, const FaceLayout& f, int& v0, int& v1, int& g0,
+               int& g1);
 
 // The cone from p around the sphere s, cut by the rows of face f: row(v) is the u-interval of
 // exits q whose segment from p can meet the sphere, i.e. q inside the cone. Conservative
@@ -119,13 +122,20 @@ private:
 // visit_row(v, ub, ue) with ub <= ue, rows in ascending order.
 template <class VisitRow>
 void for_each_cone_row(const Vec3& p, const PartSphere& ps, const FaceLayout& fl, VisitRow&& visit_row) {
-    int u0, u1, v0, v1, c0, c1;
-    if (!cone_rows(p, ps, fl, c0, c1)) return;
+    int u0, u1, v0, v1, c0, c1, g0, g1;
+    if (!cone_rows(p, ps, fl, c0, c1, g0, g1)) return;
     const Vec3 rr{ps.r, ps.r, ps.r};
     projected_range(p, {ps.c - rr, ps.c + rr}, fl, u0, u1, v0, v1);
     v0 = std::max(v0, c0), v1 = std::min(v1, c1);
     const ConeRows cone(p, ps, fl);
+    // One loop that jumps the gap (two would not be inlined).
+    if (g0 > g1) g0 = v1 + 1;
+    if (g0 <= v0) v0 = std::max(v0, g1 + 1);
     for (int v = v0; v <= v1; ++v) {
+        if (v == g0) {
+            v = g1;
+            continue;
+        }
         double ulo, uhi;
         if (!cone.row(v, ulo, uhi)) continue;
         // Clamp in double first: the interval may be unbounded or huge.
