@@ -246,6 +246,14 @@ void place_group(std::uint64_t g, const std::vector<std::span<Sorted>>& chunks,
     for (std::uint64_t p = q0; p < q1; ++p) next[p - q0] = l.part_start[p] - l.part_start[q0];
     for (std::size_t c = 0; c < chunks.size(); ++c) {
         const std::uint32_t* local = &l.local[c * row + g];
+        // The next chunk's piece is fetched while this one is read: pieces are a few kB, far
+        // apart, and each would start with misses that the hardware prefetcher cannot foresee.
+        if (c + 1 < chunks.size()) {
+            const std::uint32_t* next_local = local + row;
+            const auto* from = reinterpret_cast<const char*>(chunks[c + 1].data() + next_local[0]);
+            const auto* to = reinterpret_cast<const char*>(chunks[c + 1].data() + next_local[1]);
+            for (const char* at = from; at < to; at += 64) __builtin_prefetch(at);
+        }
         for (std::uint32_t i = local[0]; i < local[1]; ++i) {
             const Sorted& h = chunks[c][i];
             const auto b = static_cast<std::uint32_t>(pt.bucket(h));  // buckets < 2^32
