@@ -165,17 +165,95 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
     return sheet(r, tmin, tmax, !footprint_of(r).coverage_only, hit);
 }
 
-bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
-                                 Crossing& hit) const {
-    Sheet s;
+FilteredLatticeShape::Lod FilteredLatticeShape::lod_of(const Ray& r) const {
     // Rays without a footprint read the finest table.
     const double width = footprint_width(r);
     const double top = double(levels_.size() - 1);
     const double wanted = width > 0 ? lod_level(levels_.front().frame.cell(), width) : top;
     const double level = std::clamp(wanted, 0.0, top);
-    const double finer = std::max(0.0, wanted - level);  // levels finer than the finest table
-    add_tables(level, normal, r, tmin, s);
-    return to_crossing(s, finer, r, tmin, tmax, normal, hit);
+    return {width, level, std::max(0.0, wanted - level)};
+}
+
+bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
+                                 Crossing& hit) const {
+    Sheet s;
+    const Lod lod = lod_of(r);
+    add_tables(lod.level, normal, r, tmin, s);
+    return to_crossing(s, lod.finer, r, tmin, tmax, normal, hit);
+}
+
+int FilteredLatticeShape::sheets(const Ray& r, double tmin, double tmax,
+                                 std::span<SheetCrossing, kMaxSheets> out) const {
+    out[0].normals.count = 0;
+    if (footprint_of(r).coverage_only) return sheet(r, tmin, tmax, false, out[0].crossing) ? 1 : 0;
+    Sheet s;
+    s.keep_pairs = true;
+    const Lod lod = lod_of(r);
+    add_tables(lod.level, true, r, tmin, s);
+    return split(s, lod, r, tmin, tmax, out);
+}
+
+int FilteredLatticeShape::depth_clusters(const Sheet& s, const Ray& r, double depth,
+                                         Cluster* out) {
+    const double dd = dot(r.d, r.d);
+    // The pairs in ray order (an insertion sort: at most kMaxPairParts).
+    double t[kMaxPairParts];
+    int order[kMaxPairParts];
+    for (int i = 0; i < s.pairs; ++i) {
+        const PairPart& q = s.part[i];
+        t[i] = dot(Vec3{q.p[0], q.p[1], q.p[2]} - r.o, r.d) / dd;
+        order[i] = i;
+        for (int j = i; j > 0 && t[order[j]] < t[order[j - 1]]; --j) std::swap(order[j], order[j - 1]);
+    }
+    int m = 0;
+    for (int i = 0; i < s.pairs; ++m) {
+        Cluster& c = out[m];
+        c = Cluster{};
+        for (const double t0 = t[order[i]]; i < s.pairs && t[order[i]] <= t0 + depth; ++i) {
+            const PairPart& q = s.part[order[i]];
+            c.alpha += q.a;
+            c.p += Vec3{q.p[0], q.p[1], q.p[2]} * q.a;
+            c.n += Vec3{q.n[0], q.n[1], q.n[2]} * q.a;
+        }
+    }
+    return m;
+}
+
+int FilteredLatticeShape::split(const Sheet& s, const Lod& lod, const Ray& r, double tmin,
+                                double tmax, std::span<SheetCrossing, kMaxSheets> out) const {
+    const double depth = kSheetDepthFootprints *
+                         std::max(lod.width, levels_.back().frame.cell()) / length(r.d);
+    Cluster c[kMaxPairParts];
+    const int m = depth_clusters(s, r, depth, c);
+    int n = 0;
+    double drawn = 0, left = s.alpha;  // coverage in sheets so far; in clusters not yet in one
+    for (int i = 0; i < m;) {
+        // A sheet: clusters until it covers kMinSheetShare and so does the rest (the last
+        // takes all that is left), placed at its largest cluster (see kSheetDepthFootprints).
+        Cluster g;
+        int largest = i;
+        for (; i < m; ++i) {
+            if (g.alpha >= kMinSheetShare && left - g.alpha >= kMinSheetShare && n < kMaxSheets - 1)
+                break;
+            g.alpha += c[i].alpha, g.p += c[i].p, g.n += c[i].n;
+            if (c[i].alpha > c[largest].alpha) largest = i;
+        }
+        left -= g.alpha;
+        Sheet sheet;
+        sheet.alpha = g.alpha, sheet.n = g.n;
+        sheet.p = c[largest].p * (g.alpha / c[largest].alpha);
+        SheetCrossing& sc = out[static_cast<std::size_t>(n)];
+        sc.normals.count = 0;
+        if (!to_crossing(sheet, lod.finer, r, tmin, tmax, true, sc.crossing)) continue;
+        // Composited behind the sheets before it, a sheet covers its own share of the footprint.
+        const double uncovered = 1 - drawn;
+        const double alpha = uncovered > 1e-6 ? std::min(1.0, g.alpha / uncovered) : 1.0;
+        sc.crossing.coverage = alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(alpha);
+        drawn += g.alpha;
+        ++n;
+        if (sc.crossing.coverage >= 1.0f) break;  // opaque: nothing behind it is seen
+    }
+    return n;
 }
 
 bool FilteredLatticeShape::to_crossing(const Sheet& s, double finer, const Ray& r, double tmin,
