@@ -117,14 +117,19 @@ void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bo
         if (frac[order[j]] > frac[order[i]]) std::swap(order[i], order[j]);
     };
     sort2(0, 1), sort2(2, 3), sort2(0, 2), sort2(1, 3), sort2(1, 2);
-    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn).
+    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn): each step
+    // moves one end, whose id alone is found anew.
+    GridPoint p[2] = {{c[0][0], c[0][1], c[0][2]}, {c[1][0], c[1][1], c[1][2]}};
+    std::uint32_t id[2] = {l.grid.id(p[0]), l.grid.id(p[1])};
     double prev = 1;
     for (int step = 0; step <= 4; ++step) {
         const double f = step < 4 ? frac[order[step]] : 0;
-        if (prev - f > 0)
-            out.add(l.grid, {c[0][0], c[0][1], c[0][2]}, {c[1][0], c[1][1], c[1][2]}, weight * (prev - f));
+        if (prev - f > 0) out.add(id[0], id[1], p[0], p[1], weight * (prev - f));
         prev = f;
-        if (step < 4) ++c[order[step] / 2][axis_of[order[step]]];
+        if (step == 4) break;
+        const int e = order[step] / 2;
+        ++p[e][axis_of[order[step]]];
+        id[e] = l.grid.id(p[e]);
     }
 }
 
