@@ -76,25 +76,29 @@ bool FilteredLatticeShape::inside(Vec3 p) const { return point_->inside(p); }
 
 void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bool smooth,
                                  Blend& out) const {
-    LatticeFrame::Snap sn;
-    if (!l.frame.snap(r, sn)) return;
     if (!smooth) {
-        out.add(l.grid, sn.pa, sn.pb, weight);
+        LatticeFrame::Snap sn;
+        if (l.frame.snap(r, sn)) out.add(l.grid, sn.pa, sn.pb, weight);
         return;
     }
-    // The real entry and exit points, on the faces snap chose (the axes that clip first and
-    // last), in face coordinates u, v (the next two axes).
+    // The real entry and exit points, on the faces the chord enters and leaves by (snap's), in
+    // face coordinates u, v (the next two axes); the chord alone, in double, not snap's float
+    // pass first: the pair it snaps to is not wanted.
     const auto& n = l.grid.cells();
+    Vec3 o, d;
     LatticeFrame::Chord ch;
-    if (!l.frame.chord(sn.o, sn.d, ch)) return;  // (not reached: snap met the box)
+    if (!l.frame.visit_chord(r, o, d, ch)) return;
     const int ax[2] = {ch.ax0, ch.ax1};
-    const Vec3 x[2] = {sn.o + sn.d * ch.t0, sn.o + sn.d * ch.t1};
+    const bool high[2] = {ch.high0, ch.high1};
+    const Vec3 x[2] = {o + d * ch.t0, o + d * ch.t1};
     // The 4-D coordinates (u, v of the entry, u, v of the exit): the corners' coordinates
-    // start at their cell's (c), each with its fraction in the cell and the axis it moves.
-    int c[2][3] = {{sn.pa.x, sn.pa.y, sn.pa.z}, {sn.pb.x, sn.pb.y, sn.pb.z}};
+    // start at their cell's (c), each with its fraction in the cell and the axis it moves; the
+    // face's own coordinate is its level.
+    int c[2][3];
     double frac[4];
     int axis_of[4];
-    for (int e = 0; e < 2; ++e)
+    for (int e = 0; e < 2; ++e) {
+        c[e][ax[e]] = high[e] ? n[static_cast<std::size_t>(ax[e])] : 0;
         for (int j = 0; j < 2; ++j) {
             const int a = kFaceAxes[ax[e]][j];
             const int na = n[static_cast<std::size_t>(a)];
@@ -105,6 +109,7 @@ void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bo
             frac[2 * e + j] = std::clamp(v - b, 0.0, 1.0);
             axis_of[2 * e + j] = a;
         }
+    }
     // The coordinates by decreasing fraction (a sorting network; ties in either order give the
     // same pairs, the step between tied coordinates having weight 0).
     int order[4] = {0, 1, 2, 3};
@@ -112,14 +117,19 @@ void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bo
         if (frac[order[j]] > frac[order[i]]) std::swap(order[i], order[j]);
     };
     sort2(0, 1), sort2(2, 3), sort2(0, 2), sort2(1, 3), sort2(1, 2);
-    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn).
+    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn): each step
+    // moves one end, whose id alone is found anew.
+    GridPoint p[2] = {{c[0][0], c[0][1], c[0][2]}, {c[1][0], c[1][1], c[1][2]}};
+    std::uint32_t id[2] = {l.grid.id(p[0]), l.grid.id(p[1])};
     double prev = 1;
     for (int step = 0; step <= 4; ++step) {
         const double f = step < 4 ? frac[order[step]] : 0;
-        if (prev - f > 0)
-            out.add(l.grid, {c[0][0], c[0][1], c[0][2]}, {c[1][0], c[1][1], c[1][2]}, weight * (prev - f));
+        if (prev - f > 0) out.add(id[0], id[1], p[0], p[1], weight * (prev - f));
         prev = f;
-        if (step < 4) ++c[order[step] / 2][axis_of[order[step]]];
+        if (step == 4) break;
+        const int e = order[step] / 2;
+        ++p[e][axis_of[order[step]]];
+        id[e] = l.grid.id(p[e]);
     }
 }
 

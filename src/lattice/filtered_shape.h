@@ -177,8 +177,12 @@ private:
         GridPoint ca[kMaxPairs], cb[kMaxPairs];
         double w[kMaxPairs];
         void add(const BoundaryGrid& g, const GridPoint& a, const GridPoint& b, double weight) {
-            ia[n] = g.id(a), ib[n] = g.id(b);
-            if (ia[n] != ib[n]) ca[n] = a, cb[n] = b, w[n] = weight, ++n;
+            add(g.id(a), g.id(b), a, b, weight);
+        }
+        // The same for points whose ids are known.
+        void add(std::uint32_t id_a, std::uint32_t id_b, const GridPoint& a, const GridPoint& b,
+                 double weight) {
+            if (id_a != id_b) ia[n] = id_a, ib[n] = id_b, ca[n] = a, cb[n] = b, w[n] = weight, ++n;
         }
     };
     std::vector<Level> levels_;
