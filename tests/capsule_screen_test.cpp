@@ -3,6 +3,7 @@
 // origin lies; and it must reject most lines that pass well clear.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -90,6 +91,18 @@ TEST(CapsuleScreen, TooManyOrNoneNameEveryCapsule) {
     const CapsuleScreen screen(many);
     EXPECT_TRUE(screen.empty());
     EXPECT_EQ(screen.may_meet({0, 50, 0}, {0, 0, 1}), ~std::uint32_t{0});
+}
+
+// Lines the float screen cannot measure (no direction, a non-finite one, an origin too far
+// for its margin) get every capsule the screen holds, and no bit past them: callers index
+// their capsules by the bits.
+TEST(CapsuleScreen, UnmeasurableLinesNameTheCapsulesHeldAndNoMore) {
+    const std::vector<Capsule> three(3, Capsule{{0, 0, 0}, {1, 0, 0}, 0.1});
+    const CapsuleScreen screen(three);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_EQ(screen.may_meet({0, 5, 0}, {0, 0, 0}), 0b111u);
+    EXPECT_EQ(screen.may_meet({0, 5, 0}, {nan, 0, 1}), 0b111u);
+    EXPECT_EQ(screen.may_meet({0, 1e36, 0}, {0, 0, 1}), 0b111u);
 }
 
 // A hair's lattice frame answers cull_meets_any as the loop over its cull parts does, on lines

@@ -14,6 +14,7 @@
 
 #include "accel/embree_accel.h"
 #include "coverage/layer_composite.h"
+#include "coverage/layers.h"
 #include "coverage/sheets.h"
 #include "geometry/parts.h"
 #include "render/core/shading.h"
@@ -133,6 +134,38 @@ TEST(Layers, ShadowRaysSumTransmittanceAndStopWhenBlocked) {
     // Let through less than asked: blocked.
     EXPECT_TRUE(clear.accel->intersect_layers(kUp, 0, kInfinity, EmbreeAccel::kNoObject, hit, partial,
                                               {.blocked_below = expected * 1.01}));
+}
+
+// A shadow ray worth little to its pixel (a layer deep behind partial sheets, a faint light)
+// is traced only until what it could still add is under kMinShadowContribution: it stops at
+// the first sheet that takes it there, sooner the less it is worth, so what blocking it drops
+// is always under that; worth 1 keeps a front layer's precision.
+TEST(Layers, AShadowRayIsTracedOnlyAsFarAsItsPixelCanTell) {
+    EXPECT_EQ(shadow_stop(1).blocked_below, kMinTransmittance);
+    EXPECT_EQ(shadow_stop(1e-9).blocked_below, 1.0);
+    const Stack s(12);
+    AccelHit hit;
+    std::vector<AccelHit> all;
+    s.accel->intersect_layers(kUp, 0, kInfinity, EmbreeAccel::kNoObject, hit, all);
+    std::size_t read_before = all.size() + 1;
+    for (const double worth : {1.0, 0.1, 0.01, 1e-3}) {
+        std::vector<AccelHit> cut;
+        const bool blocked = s.accel->intersect_layers(kUp, 0, kInfinity, EmbreeAccel::kNoObject,
+                                                       hit, cut, shadow_stop(worth));
+        // What got through, sheet by sheet: the ray reads up to the first sheet that takes it
+        // under the stop, and no farther.
+        double left = 1;
+        std::size_t used = 0;
+        while (used < all.size() && left >= shadow_stop(worth).blocked_below)
+            left *= 1 - double(all[used++].crossing.coverage);
+        ASSERT_EQ(blocked, left < shadow_stop(worth).blocked_below) << "worth " << worth;
+        if (blocked) {
+            EXPECT_LT(left * worth, kMinShadowContribution) << "worth " << worth;
+        }
+        EXPECT_LE(cut.size(), used) << "worth " << worth;
+        EXPECT_LT(used, read_before) << "worth " << worth;
+        read_before = used;
+    }
 }
 
 // Shadow rays in a run that keeps what blocked the last of them (EmbreeAccel::LastBlocker):

@@ -7,6 +7,7 @@
 // tables' sheets are independent draws (the product of 1 - alpha). Exact shapes have alpha = 1,
 // so a scene without lattices shades as it would without layers. The renderer shades
 // (render/layers.h); the accelerator collects (coverage/layer_sink.h); this file decides.
+#include <algorithm>
 #include <span>
 
 #include "coverage/layer_composite.h"
@@ -28,9 +29,18 @@ inline constexpr double kMinTransmittance = 1.0 / 1024;
 // (and at least its inverse): the pixel's footprint on the surface seen from the light.
 inline constexpr double kMaxShadowWidening = 4;
 
-// How far a camera ray's traversal looks, and when a shadow ray counts as blocked.
+// How far a camera ray's traversal looks.
 inline LayerStop camera_stop() { return {.max_layers = kMaxLayers, .min_left = kMinTransmittance}; }
-inline LayerStop shadow_stop() { return {.blocked_below = kMinTransmittance}; }
+// A shadow ray's worth: the most it can add to its pixel, its layer's share of the pixel times
+// the light's unshadowed term (its largest channel, in display units: images are linear, an
+// 8-bit step is 1/255). It counts as blocked once what it would still add falls under this,
+// a quarter of a step: a layer deep behind partial sheets, or lit faintly, needs its shadow
+// ray traced only as far as a front layer's needs it traced to kMinTransmittance.
+inline constexpr double kMinShadowContribution = 1.0 / 1024;
+inline LayerStop shadow_stop(double worth) {
+    const double below = kMinShadowContribution / std::max(worth, kMinShadowContribution);
+    return {.blocked_below = std::max(kMinTransmittance, below)};
+}
 
 // The width of a shadow ray's footprint as it leaves a surface of unit normal n, seen along
 // camera_d with a footprint `width` wide, towards shadow_d.
@@ -51,8 +61,8 @@ double sheet_width(double alpha, std::uint8_t sub_rays, double width);
 double transmitted(std::span<const ObjectHit> partial);
 
 // A camera ray's colour from its partial layers in ray order (each with `alpha` and `sub_rays`,
-// shaded by shade(h)) and what lies behind them (behind(), asked only if the layers let
-// something through to it).
+// shaded by shade(h, weight), weight its share of the colour) and what lies behind them
+// (behind(weight), asked only if the layers let something through to it).
 template <class Hit, class Shade, class Behind>
 Vec3 composite_layers(std::span<const Hit> partial, Shade&& shade, Behind&& behind) {
     Vec3 c;
@@ -64,10 +74,10 @@ Vec3 composite_layers(std::span<const Hit> partial, Shade&& shade, Behind&& behi
         double alpha = seen.add(h.alpha, h.sub_rays);
         const bool last = h.sub_rays == 0 && seen.draws() == kMaxLayers;
         if (last) alpha = 1;
-        if (alpha > 0) c += shade(h) * (left * alpha);
+        if (alpha > 0) c += shade(h, left * alpha) * (left * alpha);
         if (last || seen.left() <= kMinTransmittance) return c;
     }
-    return c + behind() * seen.left();
+    return c + behind(seen.left()) * seen.left();
 }
 
 }  // namespace lat

@@ -57,14 +57,16 @@ CapsuleScreen::CapsuleScreen(std::span<const Capsule> capsules) {
 // both under 1e-15 of |o - centre| (plus M). A capsule is left out only when its distance,
 // less all that, exceeds its radius: the double test rejects the line too.
 std::uint32_t CapsuleScreen::may_meet(Vec3 o, Vec3 d, double narrower) const {
-    constexpr std::uint32_t kAll = ~std::uint32_t{0};
-    if (count_ == 0) return kAll;
+    if (count_ == 0) return ~std::uint32_t{0};
+    // Where the float screen cannot be trusted, it names all the capsules it holds (and no bit
+    // past them: callers index their capsules by the bits).
+    const auto held = static_cast<std::uint32_t>((std::uint64_t{1} << count_) - 1);
     const double dd = dot(d, d);
-    if (!(dd > 0) || !std::isfinite(dd)) return kAll;
+    if (!(dd > 0) || !std::isfinite(dd)) return held;
     const Vec3 n = d * (1.0 / std::sqrt(dd)), oc = o - centre_;
     const Vec3 q = oc - n * dot(oc, n);
     const double margin = 1e-4 * (l1(q) + extent_) + 1e-12 * l1(oc) + 1e-6 * std::abs(narrower);
-    if (!std::isfinite(margin) || margin > 1e30) return kAll;
+    if (!std::isfinite(margin) || margin > 1e30) return held;
     const __m128 qx = _mm_set1_ps(float(q.x)), qy = _mm_set1_ps(float(q.y)),
                  qz = _mm_set1_ps(float(q.z));
     const __m128 nx = _mm_set1_ps(float(n.x)), ny = _mm_set1_ps(float(n.y)),
@@ -88,7 +90,7 @@ std::uint32_t CapsuleScreen::may_meet(Vec3 o, Vec3 d, double narrower) const {
         const __m128 r = _mm_andnot_ps(sign, c.r - shrink) + grow;
         bits |= std::uint64_t(_mm_movemask_ps(_mm_cmple_ps(vv, r * r))) << (4 * g);
     }
-    return static_cast<std::uint32_t>(bits & ((std::uint64_t{1} << count_) - 1));
+    return static_cast<std::uint32_t>(bits) & held;
 }
 
 }  // namespace lat

@@ -76,25 +76,29 @@ bool FilteredLatticeShape::inside(Vec3 p) const { return point_->inside(p); }
 
 void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bool smooth,
                                  Blend& out) const {
-    LatticeFrame::Snap sn;
-    if (!l.frame.snap(r, sn)) return;
     if (!smooth) {
-        out.add(l.grid, sn.pa, sn.pb, weight);
+        LatticeFrame::Snap sn;
+        if (l.frame.snap(r, sn)) out.add(l.grid, sn.pa, sn.pb, weight);
         return;
     }
-    // The real entry and exit points, on the faces snap chose (the axes that clip first and
-    // last), in face coordinates u, v (the next two axes).
+    // The real entry and exit points, on the faces the chord enters and leaves by (snap's), in
+    // face coordinates u, v (the next two axes); the chord alone, in double, not snap's float
+    // pass first: the pair it snaps to is not wanted.
     const auto& n = l.grid.cells();
+    Vec3 o, d;
     LatticeFrame::Chord ch;
-    if (!l.frame.chord(sn.o, sn.d, ch)) return;  // (not reached: snap met the box)
+    if (!l.frame.visit_chord(r, o, d, ch)) return;
     const int ax[2] = {ch.ax0, ch.ax1};
-    const Vec3 x[2] = {sn.o + sn.d * ch.t0, sn.o + sn.d * ch.t1};
+    const bool high[2] = {ch.high0, ch.high1};
+    const Vec3 x[2] = {o + d * ch.t0, o + d * ch.t1};
     // The 4-D coordinates (u, v of the entry, u, v of the exit): the corners' coordinates
-    // start at their cell's (c), each with its fraction in the cell and the axis it moves.
-    int c[2][3] = {{sn.pa.x, sn.pa.y, sn.pa.z}, {sn.pb.x, sn.pb.y, sn.pb.z}};
+    // start at their cell's (c), each with its fraction in the cell and the axis it moves; the
+    // face's own coordinate is its level.
+    int c[2][3];
     double frac[4];
     int axis_of[4];
-    for (int e = 0; e < 2; ++e)
+    for (int e = 0; e < 2; ++e) {
+        c[e][ax[e]] = high[e] ? n[static_cast<std::size_t>(ax[e])] : 0;
         for (int j = 0; j < 2; ++j) {
             const int a = kFaceAxes[ax[e]][j];
             const int na = n[static_cast<std::size_t>(a)];
@@ -105,6 +109,7 @@ void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bo
             frac[2 * e + j] = std::clamp(v - b, 0.0, 1.0);
             axis_of[2 * e + j] = a;
         }
+    }
     // The coordinates by decreasing fraction (a sorting network; ties in either order give the
     // same pairs, the step between tied coordinates having weight 0).
     int order[4] = {0, 1, 2, 3};
@@ -112,14 +117,19 @@ void FilteredLatticeShape::blend(const Level& l, const Ray& r, double weight, bo
         if (frac[order[j]] > frac[order[i]]) std::swap(order[i], order[j]);
     };
     sort2(0, 1), sort2(2, 3), sort2(0, 2), sort2(1, 3), sort2(1, 2);
-    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn).
+    // Walk the simplex from the base corner, adding one coordinate at a time (Kuhn): each step
+    // moves one end, whose id alone is found anew.
+    GridPoint p[2] = {{c[0][0], c[0][1], c[0][2]}, {c[1][0], c[1][1], c[1][2]}};
+    std::uint32_t id[2] = {l.grid.id(p[0]), l.grid.id(p[1])};
     double prev = 1;
     for (int step = 0; step <= 4; ++step) {
         const double f = step < 4 ? frac[order[step]] : 0;
-        if (prev - f > 0)
-            out.add(l.grid, {c[0][0], c[0][1], c[0][2]}, {c[1][0], c[1][1], c[1][2]}, weight * (prev - f));
+        if (prev - f > 0) out.add(id[0], id[1], p[0], p[1], weight * (prev - f));
         prev = f;
-        if (step < 4) ++c[order[step] / 2][axis_of[order[step]]];
+        if (step == 4) break;
+        const int e = order[step] / 2;
+        ++p[e][axis_of[order[step]]];
+        id[e] = l.grid.id(p[e]);
     }
 }
 
@@ -165,17 +175,95 @@ bool FilteredLatticeShape::intersect(const Ray& r, double tmin, double tmax, Cro
     return sheet(r, tmin, tmax, !footprint_of(r).coverage_only, hit);
 }
 
-bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
-                                 Crossing& hit) const {
-    Sheet s;
+FilteredLatticeShape::Lod FilteredLatticeShape::lod_of(const Ray& r) const {
     // Rays without a footprint read the finest table.
     const double width = footprint_width(r);
     const double top = double(levels_.size() - 1);
     const double wanted = width > 0 ? lod_level(levels_.front().frame.cell(), width) : top;
     const double level = std::clamp(wanted, 0.0, top);
-    const double finer = std::max(0.0, wanted - level);  // levels finer than the finest table
-    add_tables(level, normal, r, tmin, s);
-    return to_crossing(s, finer, r, tmin, tmax, normal, hit);
+    return {width, level, std::max(0.0, wanted - level)};
+}
+
+bool FilteredLatticeShape::sheet(const Ray& r, double tmin, double tmax, bool normal,
+                                 Crossing& hit) const {
+    Sheet s;
+    const Lod lod = lod_of(r);
+    add_tables(lod.level, normal, r, tmin, s);
+    return to_crossing(s, lod.finer, r, tmin, tmax, normal, hit);
+}
+
+int FilteredLatticeShape::sheets(const Ray& r, double tmin, double tmax,
+                                 std::span<SheetCrossing, kMaxSheets> out) const {
+    out[0].normals.count = 0;
+    if (footprint_of(r).coverage_only) return sheet(r, tmin, tmax, false, out[0].crossing) ? 1 : 0;
+    Sheet s;
+    s.keep_pairs = true;
+    const Lod lod = lod_of(r);
+    add_tables(lod.level, true, r, tmin, s);
+    return split(s, lod, r, tmin, tmax, out);
+}
+
+int FilteredLatticeShape::depth_clusters(const Sheet& s, const Ray& r, double depth,
+                                         Cluster* out) {
+    const double dd = dot(r.d, r.d);
+    // The pairs in ray order (an insertion sort: at most kMaxPairParts).
+    double t[kMaxPairParts];
+    int order[kMaxPairParts];
+    for (int i = 0; i < s.pairs; ++i) {
+        const PairPart& q = s.part[i];
+        t[i] = dot(Vec3{q.p[0], q.p[1], q.p[2]} - r.o, r.d) / dd;
+        order[i] = i;
+        for (int j = i; j > 0 && t[order[j]] < t[order[j - 1]]; --j) std::swap(order[j], order[j - 1]);
+    }
+    int m = 0;
+    for (int i = 0; i < s.pairs; ++m) {
+        Cluster& c = out[m];
+        c = Cluster{};
+        for (const double t0 = t[order[i]]; i < s.pairs && t[order[i]] <= t0 + depth; ++i) {
+            const PairPart& q = s.part[order[i]];
+            c.alpha += q.a;
+            c.p += Vec3{q.p[0], q.p[1], q.p[2]} * q.a;
+            c.n += Vec3{q.n[0], q.n[1], q.n[2]} * q.a;
+        }
+    }
+    return m;
+}
+
+int FilteredLatticeShape::split(const Sheet& s, const Lod& lod, const Ray& r, double tmin,
+                                double tmax, std::span<SheetCrossing, kMaxSheets> out) const {
+    const double depth = kSheetDepthFootprints *
+                         std::max(lod.width, levels_.back().frame.cell()) / length(r.d);
+    Cluster c[kMaxPairParts];
+    const int m = depth_clusters(s, r, depth, c);
+    int n = 0;
+    double drawn = 0, left = s.alpha;  // coverage in sheets so far; in clusters not yet in one
+    for (int i = 0; i < m;) {
+        // A sheet: clusters until it covers kMinSheetShare and so does the rest (the last
+        // takes all that is left), placed at its largest cluster (see kSheetDepthFootprints).
+        Cluster g;
+        int largest = i;
+        for (; i < m; ++i) {
+            if (g.alpha >= kMinSheetShare && left - g.alpha >= kMinSheetShare && n < kMaxSheets - 1)
+                break;
+            g.alpha += c[i].alpha, g.p += c[i].p, g.n += c[i].n;
+            if (c[i].alpha > c[largest].alpha) largest = i;
+        }
+        left -= g.alpha;
+        Sheet sheet;
+        sheet.alpha = g.alpha, sheet.n = g.n;
+        sheet.p = c[largest].p * (g.alpha / c[largest].alpha);
+        SheetCrossing& sc = out[static_cast<std::size_t>(n)];
+        sc.normals.count = 0;
+        if (!to_crossing(sheet, lod.finer, r, tmin, tmax, true, sc.crossing)) continue;
+        // Composited behind the sheets before it, a sheet covers its own share of the footprint.
+        const double uncovered = 1 - drawn;
+        const double alpha = uncovered > 1e-6 ? std::min(1.0, g.alpha / uncovered) : 1.0;
+        sc.crossing.coverage = alpha >= 1 - 1e-6 ? 1.0f : static_cast<float>(alpha);
+        drawn += g.alpha;
+        ++n;
+        if (sc.crossing.coverage >= 1.0f) break;  // opaque: nothing behind it is seen
+    }
+    return n;
 }
 
 bool FilteredLatticeShape::to_crossing(const Sheet& s, double finer, const Ray& r, double tmin,

@@ -14,12 +14,14 @@
 // level's own hits, exactly as without filtering.
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
 
+#include "coverage/sheets.h"
 #include "geometry/parts.h"
 #include "lattice/boundary_grid.h"
 #include "lattice/hit_table_shape.h"
@@ -54,6 +56,16 @@ double lod_blend(double f, double band);
 // the bunny (1280 x 720, against 64-spp exact) 31.46 dB, with the share 33.45 dB; on the
 // modes benchmark's scenes within 0.13 dB either way (bench/notes/filtering-constants.md).
 inline constexpr double kCrossingSpreadCells = 2;
+// A camera ray's pairs whose crossings lie within this many footprints (or finest cells, if
+// wider) in depth of the nearest pair of a cluster are of one surface. A sheet blending two
+// clusters is shaded at its largest cluster's point: their mean put a tube seen beside another
+// behind it at a point between the two, inside the object, in shadow from both lights (the
+// burr's dark speckle). 1 and 4 do about as well on the burrs (bench/notes/scale-log.md).
+inline constexpr double kSheetDepthFootprints = 2;
+// Clusters apart in depth make sheets of their own, each shaded with its own shadow rays, when
+// each side covers at least this share of the footprint; less would cost more shadow rays than
+// it brings (burrs: 0.25 costs 8 % more table visits for +0.65 dB, 0.1 +21 % render time).
+inline constexpr double kMinSheetShare = 0.25;
 // The share of crossings spread over `spread` (in t, centred on their mean) that lie ahead of
 // a ray's start, their mean dt past it.
 double crossing_share_ahead(double dt, double spread);
@@ -64,7 +76,7 @@ struct FilterLevel {
     TableContext ctx;
 };
 
-class FilteredLatticeShape final : public Shape, public CullParts {
+class FilteredLatticeShape final : public Shape, public CullParts, public SheetSource {
 public:
     // levels: coarse to fine, the same box, cells doubling; every table has coverage (a null
     // one is refused). table_error: Encoding::error_bound of the finest level. box_shadows:
@@ -79,6 +91,11 @@ public:
     // Shadow rays that need transmittance ask intersect for the coverage; as an any-hit test, a
     // sheet occludes when it covers at least half.
     bool occluded(const Ray& r, double tmin, double tmax) const override;
+    // A camera ray's pairs grouped by depth (kSheetDepthFootprints), a sheet a group, front to
+    // back, each with the coverage that composites (LayerComposite) to its own share; a shadow
+    // ray's one sheet.
+    int sheets(const Ray& r, double tmin, double tmax,
+               std::span<SheetCrossing, kMaxSheets> out) const override;
     // As a CSG leaf: the finest level point-sampled.
     void spans(const Ray& r, SpanList& out) const override;
     // The mean of unit normals: of length 1 or less (see intersect).
@@ -110,16 +127,47 @@ private:
         LatticeFrame frame;
         BoundaryGrid grid;
     };
-    // A sheet: coverage-weighted sums of the pairs' points (primitive units) and normals.
+    // A sheet: coverage-weighted sums of the pairs' points (primitive units) and normals, and,
+    // when asked (keep_pairs), each pair's share of them (for sheets: at most 5 pairs a level,
+    // 2 levels). Plain doubles, left unset until written: a Sheet is made for every ray.
+    struct PairPart {
+        double a, p[3], n[3];
+    };
+    static constexpr int kMaxPairParts = 10;
     struct Sheet {
         double alpha = 0;
         Vec3 p, n;
+        bool keep_pairs = false;
+        int pairs = 0;
+        PairPart part[kMaxPairParts];
         void add(double w, const CoverageHit& h, const Vec3& p_prim) {
-            alpha += w * h.alpha;
-            p += p_prim * (w * h.alpha);
-            n += h.normal * (w * h.alpha);
+            const double a = w * h.alpha;
+            alpha += a;
+            p += p_prim * a;
+            n += h.normal * a;
+            if (!keep_pairs) return;
+            assert(pairs < kMaxPairParts);  // Blend::kMaxPairs a level, two levels
+            part[pairs++] = {a, {p_prim.x, p_prim.y, p_prim.z}, {h.normal.x, h.normal.y, h.normal.z}};
         }
     };
+    // A sheet's pairs whose crossings lie within a depth of each other: the sums of their
+    // shares, points and normals, as in Sheet.
+    struct Cluster {
+        double alpha = 0;
+        Vec3 p, n;
+    };
+    // s's kept pairs in clusters, in ray order: each holds the pairs within `depth` (parameter
+    // t of r) of its nearest. Returns how many (at most s.pairs).
+    static int depth_clusters(const Sheet& s, const Ray& r, double depth, Cluster* out);
+    // The level of detail a ray reads: `level` (0 to the finest, fractional between two) and how
+    // many levels finer than the finest table its footprint is (`finer`).
+    struct Lod {
+        double width, level, finer;
+    };
+    Lod lod_of(const Ray& r) const;
+    // s's pairs grouped by depth into sheets (see sheets and kMinSheetShare).
+    int split(const Sheet& s, const Lod& lod, const Ray& r, double tmin, double tmax,
+              std::span<SheetCrossing, kMaxSheets> out) const;
     // The pairs of one level that a ray's sheet blends, and their weights.
     struct Blend {
         static constexpr int kMaxPairs = 5;
@@ -129,8 +177,12 @@ private:
         GridPoint ca[kMaxPairs], cb[kMaxPairs];
         double w[kMaxPairs];
         void add(const BoundaryGrid& g, const GridPoint& a, const GridPoint& b, double weight) {
-            ia[n] = g.id(a), ib[n] = g.id(b);
-            if (ia[n] != ib[n]) ca[n] = a, cb[n] = b, w[n] = weight, ++n;
+            add(g.id(a), g.id(b), a, b, weight);
+        }
+        // The same for points whose ids are known.
+        void add(std::uint32_t id_a, std::uint32_t id_b, const GridPoint& a, const GridPoint& b,
+                 double weight) {
+            if (id_a != id_b) ia[n] = id_a, ib[n] = id_b, ca[n] = a, cb[n] = b, w[n] = weight, ++n;
         }
     };
     std::vector<Level> levels_;

@@ -244,6 +244,13 @@ bool LatticeFrame::snap_double(const Ray& r, Snap& s) const {
     return true;
 }
 
+bool LatticeFrame::visit_chord(const Ray& r, Vec3& o, Vec3& d, Chord& c) const {
+    stats::bump(stats::Counter::kLatticeVisits);
+    o = r.o * inv_cell_;
+    d = r.d * inv_cell_;
+    return chord(o, d, c);
+}
+
 bool LatticeFrame::chord(const Vec3& o, const Vec3& d, Chord& c) const {
     const auto& n = grid_.cells();
     c = Chord{-kInfinity, kInfinity};

@@ -65,6 +65,11 @@ public:
         bool high0 = false, high1 = false;
     };
     bool chord(const Vec3& o, const Vec3& d, Chord& c) const;
+    // A visit that wants the chord's real end points, not the snapped pair (the smooth filter):
+    // the ray in lattice units (o, d, as snap's Snap has them) and its chord, counted as a
+    // visit as snap counts one. The faces are snap's: snap_double takes them from this chord,
+    // and snap's float path gives snap_double's answer.
+    bool visit_chord(const Ray& r, Vec3& o, Vec3& d, Chord& c) const;
 
 private:
     bool snap_points(Snap& s) const;  // from s.o and s.d, in double

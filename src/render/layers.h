@@ -19,8 +19,10 @@ Vec3 trace_layers(const TracedScene& rs, const TraceRay& ray, ShadeState& state,
 // The share of light that gets through from tmin to tmax along r (a shadow ray's
 // TraceRay::ray()) leaving a surface of object `self`,
 // whose crossings within its surface tolerance are skipped. last: what blocked the last ray of
-// its run, if kept (EmbreeAccel::LastBlocker).
+// its run, if kept (EmbreeAccel::LastBlocker). worth: the most the light can add to the pixel
+// (shadow_stop); 1 traces the ray until under kMinTransmittance gets through.
 double transmittance(const TracedScene& rs, const Ray& r, double tmin, double tmax,
-                     std::uint32_t self, EmbreeAccel::LastBlocker* last = nullptr);
+                     std::uint32_t self, EmbreeAccel::LastBlocker* last = nullptr,
+                     double worth = 1);
 
 }  // namespace lat

@@ -179,7 +179,8 @@ Vec3 shade_particle(const Scene& s, const TracedScene& base, const std::vector<S
         const Vec3 reflected = diffuse * m.color + Vec3{spec, spec, spec};
         return reflected == Vec3{} ? Term{} : Term{light.intensity, reflected};
     };
-    const auto visible = [&](std::size_t i, const Ray& r, double tmin, double tmax, double) {
+    const auto visible = [&](std::size_t i, const Ray& r, double tmin, double tmax, double,
+                             const auto&) {
         return light_visibility(base, maps, i, r, tmin, tmax, EmbreeAccel::kNoObject);
     };
     const auto lit = [&](const Term& k, double seen) { c += seen * k.intensity * k.reflected; };
@@ -190,7 +191,8 @@ Vec3 shade_particle(const Scene& s, const TracedScene& base, const std::vector<S
 // Phong, as exact mode shades; the particles' shadows from their maps.
 Vec3 shade_base(const TracedScene& base, const std::vector<ShadowMap>& maps, const Ray& ray,
                 const SurfaceHit& hit, ShadeState& state) {
-    const auto visible = [&](std::size_t i, const Ray& r, double tmin, double tmax, double) {
+    const auto visible = [&](std::size_t i, const Ray& r, double tmin, double tmax, double,
+                             const auto&) {
         return light_visibility(base, maps, i, r, tmin, tmax, hit.object);
     };
     return shade_with(base, ray, hit, state, visible);

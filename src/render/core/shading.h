@@ -75,12 +75,13 @@ double shadow_epsilon(Vec3 p);
 // The lights that reach p, each with its shadow ray cast (when the scene has shadows):
 // term(light, unit direction to it) is the light's contribution unshadowed, a value that
 // compares equal to its default (zero) when the light adds nothing; visible(light's index,
-// shadow ray, tmin, tmax, distance) gives the share of the light that arrives, and lit(term,
-// share) is called when that is above 0. A light whose term is zero casts no shadow ray:
-// shadowed or not, it adds nothing, and the image is the same. With a unit normal that is a
-// surface turned from the light, N.L and R.V both at most 0 (6 to 9 % of the shadow rays of
-// the ball scenes and grass); a prefiltered lattice's mean normal spreads its diffuse term past
-// the terminator, so its layers rarely skip one. The one home of the light loop: shade(),
+// shadow ray, tmin, tmax, distance, term) gives the share of the light that arrives (the term
+// tells it how precisely that matters), and lit(term, share) is called when that is above 0.
+// A light whose term is zero casts no shadow ray: shadowed or not, it adds nothing, and the
+// image is the same. With a unit normal that is a surface turned from the light, N.L and R.V
+// both at most 0 (6 to 9 % of the shadow rays of the ball scenes and grass); a prefiltered
+// lattice's mean normal spreads its diffuse term past the terminator, so its layers rarely
+// skip one. The one home of the light loop: shade(),
 // layered shading, the texture mode's baked surfaces and particle mode (whose visibility reads
 // a shadow map per light) go through it.
 template <class Term, class Visible, class Lit>
@@ -99,7 +100,7 @@ void for_each_light(const TracedScene& rs, Vec3 p, ShadeState& state, Term&& ter
         double seen = 1;
         if (s.shadows) {
             ++state.shadow_rays;
-            seen = visible(i, Ray{p, l}, eps, dist * (1 - 1e-12), dist);
+            seen = visible(i, Ray{p, l}, eps, dist * (1 - 1e-12), dist, unshadowed);
             if (seen <= 0) continue;
         }
         lit(unshadowed, seen);
@@ -109,13 +110,14 @@ void for_each_light(const TracedScene& rs, Vec3 p, ShadeState& state, Term&& ter
 // visible for for_each_light and shade_with where nothing is partly covered: the light
 // arrives whole (1) unless the shadow ray, leaving object self, meets something (0).
 inline auto hard_shadows(const TracedScene& rs, std::uint32_t self, ShadeState& state) {
-    return [&rs, self, &state](std::size_t light, const Ray& r, double tmin, double tmax, double) {
+    return [&rs, self, &state](std::size_t light, const Ray& r, double tmin, double tmax, double,
+                               const auto&) {
         return rs.occluded(r, tmin, tmax, self, state.kept_blocker(light)) ? 0.0 : 1.0;
     };
 }
 
-// Phong with shadows; visible(light's index, shadow ray, tmin, tmax, distance) is the share of
-// the light that arrives: 0 or 1 for shade(), a transmittance through partial hits for layered
+// Phong with shadows; visible(light's index, shadow ray, tmin, tmax, distance, term) is the
+// share of the light that arrives: 0 or 1 for shade(), a transmittance through partial hits for layered
 // rays (render/layers.h), a shadow map's for particle mode's base.
 template <class Visible>
 Vec3 shade_with(const TracedScene& rs, const Ray& ray, const SurfaceHit& hit, ShadeState& state,

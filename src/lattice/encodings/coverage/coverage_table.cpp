@@ -215,15 +215,22 @@ CoverageTable::CoverageTable(const std::uint8_t* payload, std::size_t size, std:
 
 // Returns the set bits in all.
 std::uint64_t CoverageTable::build_lines(const std::uint64_t* kept, std::uint64_t nwords) {
-    const std::uint64_t nlines = (nwords + RankLine::kWords - 1) / RankLine::kWords;
-    lines_ = std::make_unique<RankLine[]>(nlines);
+    // A word holds 4 tiles' bits (check_records reads them so too).
+    static_assert(64 % kTileGroups == 0);
+    constexpr std::uint64_t kWordTiles = 64 / kTileGroups;
+    const std::uint64_t tiles = nwords * kWordTiles;
+    const std::uint64_t nlines = (tiles + RankLine::kTiles - 1) / RankLine::kTiles;
+    lines_ = std::make_unique<RankLine[]>(nlines);  // zeroed: tiles past the last keep none
     size_ += nlines * sizeof(RankLine);
     std::uint64_t below = 0;
-    for (std::uint64_t w = 0; w < nlines * RankLine::kWords; ++w) {
-        RankLine& l = lines_[w / RankLine::kWords];
-        if (w % RankLine::kWords == 0) l.base = below;
-        l.bits[w % RankLine::kWords] = w < nwords ? kept[w] : 0;
-        below += static_cast<std::uint64_t>(std::popcount(l.bits[w % RankLine::kWords]));
+    for (std::uint64_t t = 0; t < tiles; ++t) {
+        RankLine& l = lines_[t / RankLine::kTiles];
+        const auto i = static_cast<unsigned>(t % RankLine::kTiles);
+        if (i == 0) l.base = below;
+        const auto bits = static_cast<std::uint16_t>(kept[t / kWordTiles] >> (t % kWordTiles * kTileGroups));
+        l.kept[i] = bits;
+        l.before[i] = static_cast<std::uint8_t>(below - l.base);
+        below += static_cast<std::uint64_t>(std::popcount(bits));
     }
     return below;
 }
@@ -319,14 +326,7 @@ bool CoverageTable::coverage(std::uint32_t a, std::uint32_t b, CoverageHit& hit)
 
 void CoverageTable::locate_coverage(const std::uint32_t* a, const std::uint32_t* b, int n,
                                     std::uint64_t* ref) const {
-    // The records are found through the rank lines (often in cache) and prefetched, so that
-    // their cache misses overlap instead of following one another.
-    for (int i = 0; i < n; ++i) {
-        const Place p = place(a[i], b[i]);
-        const std::uint8_t* c = p.kept ? cover_at(p) : nullptr;
-        if (c) __builtin_prefetch(c);
-        ref[i] = reinterpret_cast<std::uintptr_t>(c);
-    }
+    for (int i = 0; i < n; ++i) ref[i] = locate(index_.slot(a[i], b[i]));
 }
 
 void CoverageTable::coverage_at(const std::uint64_t* ref, int n, CoverageHit* out, bool* found,

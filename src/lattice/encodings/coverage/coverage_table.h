@@ -17,10 +17,10 @@
 // and exit points). Records are kept densely for every group of 16 slots that holds a stored
 // pair (an empty slot's records say so), with a bit per group saying whether it is kept; the
 // groups' coverage records (64 bytes a group: one cache line) apart from their hits, which
-// filtered rendering does not read. Read through rank lines built at open (a line: the rank
-// of its first bit and 448 bits; 1 MB at sigma^-1 = 4 for Plate 4's hair, where one bit per
-// pair took 16 MB), a pair's record is found from a line that is often in cache: about one
-// cache miss a pair instead of two.
+// filtered rendering does not read. Read through rank lines built at open (a line: 16 tiles'
+// bits and their ranks; 1.75 MB at sigma^-1 = 4 for Plate 4's hair, where one bit per pair
+// took 16 MB), a pair's record is found from a line that is often in cache: about one cache
+// miss a pair instead of two, and a rank in one read and one popcount.
 #include <bit>
 #include <cstdint>
 #include <memory>
@@ -64,13 +64,18 @@ public:
     static void unpack_cover(std::uint32_t cover, CoverageHit& hit, bool normal);
 
 private:
-    // A line of the kept-group bits: the rank of its first bit and the 448 that follow.
+    // A line of the kept-group bits, by tile (PairIndex::kTileSlots, 16 groups: 16 bits of a
+    // word of them): 16 tiles' bits, and the ranks of the line's first group and of each tile's
+    // first within the line, so that a group's rank is one read and one popcount.
     struct alignas(64) RankLine {
-        static constexpr std::uint64_t kWords = 7, kBits = kWords * 64;
-        std::uint64_t base;  // kept groups before this line's first
-        std::uint64_t bits[kWords];
+        static constexpr unsigned kTiles = 16;
+        std::uint64_t base;            // kept groups before this line's first
+        std::uint16_t kept[kTiles];    // bit j of kept[i]: group j of tile i is kept
+        std::uint8_t before[kTiles];   // kept groups in this line before tile i (at most 240)
     };
     static_assert(sizeof(RankLine) == 64);
+    static constexpr unsigned kTileGroups = PairIndex::kTileSlots / kGroupSlots;
+    static_assert(kTileGroups == 16);
     // Where a slot's records are: its group's rank among the kept ones, and its place in it.
     struct Place {
         std::uint64_t group;
@@ -93,16 +98,24 @@ private:
     void check_records(const std::uint64_t* kept);
     Place place(std::uint32_t a, std::uint32_t b) const;
     Place place_of(std::uint64_t s) const {
-        const std::uint64_t g = s / kGroupSlots;
-        const RankLine& l = lines_[g / RankLine::kBits];
-        const auto off = static_cast<unsigned>(g % RankLine::kBits);
-        const unsigned w = off >> 6, bit = off & 63;
-        const std::uint64_t word = l.bits[w];
-        if (!((word >> bit) & 1)) return {0, 0, false};
-        std::uint64_t r = l.base + static_cast<std::uint64_t>(
-                                       std::popcount(word & ((std::uint64_t{1} << bit) - 1)));
-        for (unsigned k = 0; k < w; ++k) r += static_cast<std::uint64_t>(std::popcount(l.bits[k]));
-        return {r, static_cast<unsigned>(s % kGroupSlots), true};
+        const std::uint64_t g = s / kGroupSlots, tile = g / kTileGroups;
+        const RankLine& l = lines_[tile / RankLine::kTiles];
+        const auto i = static_cast<unsigned>(tile % RankLine::kTiles);
+        const auto bit = static_cast<unsigned>(g % kTileGroups);
+        const unsigned kept = l.kept[i];
+        if (!((kept >> bit) & 1u)) return {0, 0, false};
+        const auto below = static_cast<unsigned>(std::popcount(kept & ((1u << bit) - 1)));
+        return {l.base + l.before[i] + below, static_cast<unsigned>(s % kGroupSlots), true};
+    }
+    // A coverage handle (the record's address, 0 for none) for a slot (or PairIndex::kNone).
+    // The records are found through the rank lines (often in cache) and prefetched, so that
+    // the cache misses of a blend's pairs overlap instead of following one another.
+    std::uint64_t locate(std::uint64_t slot) const {
+        const Place p = slot == PairIndex::kNone ? Place{0, 0, false} : place_of(slot);
+        if (!p.kept) return 0;
+        const std::uint8_t* c = cover_at(p);
+        __builtin_prefetch(c);
+        return reinterpret_cast<std::uintptr_t>(c);
     }
     const std::uint8_t* cover_at(const Place& p) const {
         return covers_ + (p.group * kGroupSlots + p.slot) * kCoverBytes;
