@@ -154,9 +154,9 @@ def markdown_checks(res):
     if not rows:
         return
     c = res["config"]
-    print(f"## Issue 9's check class: {complexity_scenes.BALL_INSTANCES} instances on a ball\n")
-    print("The issue is checked on scenes we do not see (several hundred instances on a sphere); "
-          "these are our stand-ins (bench/complexity_scenes.py), same settings as above: "
+    print(f"## The costly-primitive check class: {complexity_scenes.BALL_INSTANCES} instances on a ball\n")
+    print("The check class is several hundred instances on a sphere; "
+          "these are its stand-ins (bench/complexity_scenes.py), same settings as above: "
           f"{c['size']} x {c['size']}, {c['threads']} threads, median of {c['runs']}, "
           "tables cached. The ratio depends on how much of the image the instances cover: "
           "the ball and floor alone cost the same in both modes.\n")
