@@ -172,7 +172,7 @@ TEST(EncodingCandidates, EveryPartARayMeetsIsACandidate) {
     EXPECT_GT(hits, 3000);
 }
 
-// Issue 9's CSG class: tilted tori minus a sphere, centred in an 8^3 box, placed by `objects`.
+// The costly-primitive check class: tilted tori minus a sphere, centred in an 8^3 box, placed by `objects`.
 Scene tori_scene_with(const std::string& objects) {
     std::string text = R"({
       "camera": {"eye": [15, -12, 9], "look_at": [5, 3, 0], "fov_y_deg": 45, "width": 96, "height": 96},
