@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Plots bench/results/scale.json (bench/scale.py): total time and peak memory against the number
-of hairs, log-log, exact mode at its best setting (and at 4 spp, the time alone: its memory is
-the same), lattice mode (default filter, deep
+of hairs, log-log, exact mode at its best setting (and at 4 spp, point-sampled and
+footprint-filtered, the time alone: their memory is the same), lattice mode (default filter, deep
 shadow maps, and point-sampled tables) and auto mode; with a second file (an earlier binary's run), its lines dashed.
 Usage: plot_scale.py scale.json out.png [earlier.json]   (python3-matplotlib, from Debian)"""
 import json
@@ -15,7 +15,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 SERIES = [("exact (best --instancing)", None, "black"),
-          ("exact, 4 spp", "exact 4 spp", "tab:gray"), ("lattice", "lattice", "tab:orange"),
+          ("exact, 4 spp", "exact 4 spp", "tab:gray"),
+          ("exact --footprint on, 4 spp", "exact footprint 4 spp", "tab:brown"),
+          ("lattice", "lattice", "tab:orange"),
           ("lattice, deep shadow maps", "lattice deep-map", "tab:green"),
           ("lattice --filter none", "lattice none", "tab:blue"),
           ("auto (sub-rays, no table)", "auto", "tab:purple")]
@@ -37,7 +39,7 @@ def main():
     for ax, key, ylabel in zip(axes, ("total_ms", "peak_memory_bytes"),
                                ("total time (s): load + build + render", "peak memory (MB)")):
         for name, label, colour in SERIES:
-            if label == "exact 4 spp" and key != "total_ms":
+            if label and label.startswith("exact") and key != "total_ms":
                 continue
             if pts := points(res, label, key):
                 ax.plot(*zip(*pts), "o-", color=colour, label=name)

@@ -28,7 +28,7 @@ echo "== samplers (where a pixel's samples fall, at 2 to 16 spp; the truths are 
 python3 "$here/samplers.py" "$build/bin/lattice" "$out" --work "$build/modes" > "$out/samplers.md"
 echo "== scatter (fur on a mesh, 100,000 instances)"
 python3 "$here/scatter.py" "$build/bin/lattice" "$out" > "$out/scatter.md"
-echo "== scale (hairs on the bunny, 20,000 to 10 million, exact, lattice and auto mode; about 35 minutes)"
+echo "== scale (hairs on the bunny, 20,000 to 10 million, exact, lattice and auto mode; about 15 minutes with its truths cached)"
 python3 "$here/scale.py" "$build/bin/lattice" "$out" --work "$build/scale" > "$out/scale.md"
 echo "== MPI (2 ranks x 1 thread against 1 rank x 2 threads; docs/distributed.md)"
 if command -v mpirun > /dev/null && "$build/bin/lattice" --version | grep -q "with MPI"; then

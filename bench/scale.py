@@ -8,7 +8,9 @@ scatters (seeds 1, 2, ...), so that every binary reads the same scene. For each 
 
 - exact mode at 1 spp with `--instancing` auto, always and never (never only up to
   NEVER_UP_TO hairs: flattening multiplies the hierarchy by the hair's 19 parts), its best
-  setting being the smallest total time; and exact mode at 4 spp at that setting;
+  setting being the smallest total time; and exact mode at 4 spp at that setting, with its
+  default point samples and with its footprint filter (`--footprint on`: each sample's
+  footprint spanned by 2 x 2 sub-rays, exact mode's most faithful setting per sample);
 - lattice mode at 1 spp, with its default filter (shadow rays through the tables), with the
   instances' shadows from deep shadow maps (`--instance-shadows deep-map`), and point-sampled
   (`--filter none`);
@@ -22,10 +24,10 @@ read as the stats are written, after the image). PSNR is against exact mode at T
 (stratified jitter) where that truth can be rendered in reasonable time (up to TRUTH_UP_TO
 hairs), cached in the work directory under the scene's bytes.
 
-Time: the full run (20 k to 10 M) takes about 35 minutes on 2 idle cores with its truths cached
-(twice that under a load average of 10), and the first time some 15 more for the truths (the
-1 M one the most); --quick (20 k and 200 k) a few minutes. Lattice mode's default filter at 4 M
-and 10 M is the bulk of it. 10 M hairs peak at about 5 GB in lattice mode and 7 in exact mode.
+Time: the full run (20 k to 10 M) takes about 15 minutes on 2 idle cores with its truths cached
+(two to three times that under a load average of 10), and the first time some 15 more for the
+truths (the 1 M one the most); --quick (20 k and 200 k) a few minutes. The 10 M renders are
+the bulk of it. 10 M hairs peak at about 5 GB in lattice mode and 7 in exact mode.
 Writes RESULTS/scale.json (or --name) and prints a Markdown table.
 
 usage: scale.py LATTICE RESULTS [--work DIR] [--quick] [--sizes 20000,...] [--name scale]"""
@@ -109,6 +111,8 @@ def measure(lattice, hairs, work, truth_up_to):
     ok = {k: v for k, v in runs.items() if "total_ms" in v}
     best = min(ok, key=lambda k: ok[k]["total_ms"]) if ok else "exact auto"
     run("exact 4 spp", ["--mode", "exact", "--instancing", best.split()[1], "--spp", "4"])
+    run("exact footprint 4 spp", ["--mode", "exact", "--instancing", best.split()[1], "--footprint",
+                                  "on", "--spp", "4"])
     run("lattice", ["--mode", "lattice"])
     run("lattice deep-map", ["--mode", "lattice", "--instance-shadows", "deep-map"])
     run("lattice none", ["--mode", "lattice", "--filter", "none"])
