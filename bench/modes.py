@@ -9,9 +9,10 @@ bench/results/samplers.md), exact mode with footprint filtering at 1, 2 and 4 sp
   mode (each primitive's cheaper answer).
 Renders are interleaved round by round so that load from other processes falls on all alike;
 the median render_ms is reported. Tables come from the cache (built before timing; their build
-time is reported apart). Then exact mode is swept over sample counts (EXACT_SPP) to compare the
-filtered modes with it at equal fidelity (the fewest samples as faithful) and at equal time (the
-most faithful exact render that takes no longer).
+time is reported apart). Then exact mode is swept over sample counts (EXACT_SPP), with point
+samples and with its footprint filter, to compare the filtered modes with each sweep at equal
+fidelity (the fewest samples as faithful) and at equal time (the most faithful exact render that
+takes no longer).
 Writes RESULTS/modes.json and prints a Markdown summary.
 
 usage: modes.py LATTICE RESULTS [--work DIR] [--runs N] [--only a,b] [--gt-spp N]"""
@@ -45,6 +46,9 @@ MODES = {
 FILTERED = ["exact footprint", "lattice", "auto"]
 # The sample counts of exact mode's sweep: near-square grids (stratify in renderer.cpp).
 EXACT_SPP = [1, 2, 4, 6, 9, 12, 16, 25, 36, 64]
+# Exact mode's two sweeps: point samples, and its footprint filter (each sample's footprint
+# spanned by sub-rays), the more faithful for its time on every scene here.
+SWEEPS = {"exact_sweep": [], "footprint_sweep": ["--footprint", "on"]}
 
 
 def render(lattice, scene, image, stats, args):
@@ -103,20 +107,22 @@ def measure(lattice, name, work, runs, gt_spp):
             times[m].append(render(lattice, scene, images[m], stats, MODES[m] + cache)["render_ms"])
     modes = {m: {"runs_ms": times[m], "ms": statistics.median(times[m]),
                  "psnr_db": psnr(lattice, images[m], truth), **first[m]} for m in MODES}
-    sweep = exact_sweep(lattice, scene, work, name, stats, truth,
-                        max(modes[m]["psnr_db"] for m in FILTERED),
-                        max(modes[m]["ms"] for m in FILTERED))
-    return {"scene": name, "loadavg": os.getloadavg()[0], "modes": modes, "exact_sweep": sweep}
+    sweeps = {k: exact_sweep(lattice, scene, work, name, stats, truth,
+                             max(modes[m]["psnr_db"] for m in FILTERED),
+                             max(modes[m]["ms"] for m in FILTERED), args)
+              for k, args in SWEEPS.items()}
+    return {"scene": name, "loadavg": os.getloadavg()[0], "modes": modes, **sweeps}
 
 
-def exact_sweep(lattice, scene, work, name, stats, truth, target_db, target_ms):
-    """Exact mode at EXACT_SPP, until it is both as faithful as target_db and slower than
-    target_ms: [{spp, ms, psnr_db}] (ms: the median of 3)."""
+def exact_sweep(lattice, scene, work, name, stats, truth, target_db, target_ms, args=()):
+    """Exact mode (with args) at EXACT_SPP, until it is both as faithful as target_db and slower
+    than target_ms: [{spp, ms, psnr_db}] (ms: the median of 3)."""
     image = os.path.join(work, f"{name}-exact-sweep.png")
     out = []
     for spp in EXACT_SPP:
         ms = statistics.median(
-            render(lattice, scene, image, stats, ["--mode", "exact", "--spp", str(spp)])["render_ms"]
+            render(lattice, scene, image, stats,
+                   ["--mode", "exact", "--spp", str(spp), *args])["render_ms"]
             for _ in range(3))
         out.append({"spp": spp, "ms": ms, "psnr_db": psnr(lattice, image, truth)})
         if out[-1]["psnr_db"] >= target_db and ms > target_ms:
@@ -135,6 +141,21 @@ def equal_time(sweep, ms):
     return max(within, key=lambda e: e["psnr_db"]) if within else None
 
 
+def compare_table(results, sweep_key, modes):
+    print("| scene | mode | exact spp at equal fidelity | exact time / mode time | "
+          "exact spp at equal time | mode - exact (dB) |")
+    print("| --- | --- | ---: | ---: | ---: | ---: |")
+    for r in results["scenes"]:
+        sweep = r[sweep_key]
+        for k in modes:
+            m = r["modes"][k]
+            f = equal_fidelity(sweep, m["psnr_db"])
+            t = equal_time(sweep, m["ms"])
+            fcells = f"{f['spp']} | {f['ms'] / m['ms']:.2f}" if f else f"over {sweep[-1]['spp']} | "
+            tcells = f"{t['spp']} | {m['psnr_db'] - t['psnr_db']:+.2f}" if t else "none as fast | "
+            print(f"| {r['scene']} | {k} | {fcells} | {tcells} |")
+
+
 def report(results, gt_spp):
     print("## Where lattices pay: every mode against exact mode at its best\n")
     print(f"Each scene at its own size, 2 threads, median of {results['runs']} interleaved renders "
@@ -145,23 +166,15 @@ def report(results, gt_spp):
         m = r["modes"]
         cells = " | ".join(f"{m[k]['psnr_db']:.2f} / {m[k]['ms']:.0f}" for k in MODES)
         print(f"| {r['scene']} | {r['loadavg']:.1f} | {cells} |")
-    print("\nAgainst exact mode swept over " + ", ".join(map(str, EXACT_SPP)) + " spp: at equal "
+    print("\nAgainst exact mode's point samples swept over " + ", ".join(map(str, EXACT_SPP)) + " spp: at equal "
           "fidelity, the fewest samples as faithful as the mode and their time over the mode's "
           "(above 1: the mode is faster); at equal time, the most faithful exact render that "
           "takes no longer, and the mode's lead over it in dB (above 0: the mode is more "
           "faithful).\n")
-    print("| scene | mode | exact spp at equal fidelity | exact time / mode time | "
-          "exact spp at equal time | mode - exact (dB) |")
-    print("| --- | --- | ---: | ---: | ---: | ---: |")
-    for r in results["scenes"]:
-        for k in FILTERED:
-            m = r["modes"][k]
-            f = equal_fidelity(r["exact_sweep"], m["psnr_db"])
-            t = equal_time(r["exact_sweep"], m["ms"])
-            fcells = f"{f['spp']} | {f['ms'] / m['ms']:.2f}" if f else \
-                f"over {r['exact_sweep'][-1]['spp']} | "
-            tcells = f"{t['spp']} | {m['psnr_db'] - t['psnr_db']:+.2f}" if t else "none as fast | "
-            print(f"| {r['scene']} | {k} | {fcells} | {tcells} |")
+    compare_table(results, "exact_sweep", FILTERED)
+    print("\nThe same against exact mode's footprint filter (`--footprint on`) swept over the same "
+          "counts, exact mode's most faithful setting for its time:\n")
+    compare_table(results, "footprint_sweep", [k for k in FILTERED if k != "exact footprint"])
     print("\nWhat answered each primitive, and the tables read (built once, before timing):\n")
     print("| scene | mode | answered by | tables | build ms |")
     print("| --- | --- | --- | ---: | ---: |")
