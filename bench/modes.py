@@ -40,9 +40,8 @@ MODES = {
     "lattice none": ["--mode", "lattice", "--filter", "none"],
     "auto": ["--mode", "auto"],
 }
-# The modes compared with exact mode's sweep at equal fidelity and equal time (footprint
-# filtering at 2 and 4 spp is in the table above it: exact mode's most faithful setting for
-# its time on every scene, which the point-sampled sweep is not).
+# The modes compared with exact mode's sweeps (SWEEPS) at equal fidelity and equal time;
+# footprint filtering at 2 and 4 spp is in the modes table only.
 FILTERED = ["exact footprint", "lattice", "auto"]
 # The sample counts of exact mode's sweep: near-square grids (stratify in renderer.cpp).
 EXACT_SPP = [1, 2, 4, 6, 9, 12, 16, 25, 36, 64]
@@ -166,9 +165,9 @@ def report(results, gt_spp):
         m = r["modes"]
         cells = " | ".join(f"{m[k]['psnr_db']:.2f} / {m[k]['ms']:.0f}" for k in MODES)
         print(f"| {r['scene']} | {r['loadavg']:.1f} | {cells} |")
-    print("\nAgainst exact mode's point samples swept over " + ", ".join(map(str, EXACT_SPP)) + " spp: at equal "
-          "fidelity, the fewest samples as faithful as the mode and their time over the mode's "
-          "(above 1: the mode is faster); at equal time, the most faithful exact render that "
+    print("\nAgainst exact mode's point samples swept over " + ", ".join(map(str, EXACT_SPP)) +
+          " spp: at equal fidelity, the fewest samples as faithful as the mode and their time "
+          "over the mode's (above 1: the mode is faster); at equal time, the most faithful exact render that "
           "takes no longer, and the mode's lead over it in dB (above 0: the mode is more "
           "faithful).\n")
     compare_table(results, "exact_sweep", FILTERED)
