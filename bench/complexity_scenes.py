@@ -15,7 +15,7 @@ covers about as many pixels as the hair and the lattice's cost per visit stays c
 Besides, the class of scene the costly-primitive comparison is made on:
 several hundred instances on a ball, here 400 placed evenly (a Fibonacci spiral), each turned
 at random about the ball's normal, filling most of the frame, so that the instances, not the
-ball and floor, take most of the time. Two primitives, as the issue describes them:
+ball and floor, take most of the time. Two primitives:
 
   ball-csg7      six tilted tori (major radius 3, minor 0.35) centred in an 8^3 box, minus a
                  sphere: 7 quartic leaves
