@@ -44,6 +44,23 @@ struct EmbreeAccel::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<Placed> objects;          // in the accelerator's order (Placed)
+    // Embree's float frame: world points less this, the centre of the boxes it holds, so that
+    // its rounding (and the margin its bounds are grown by, to_rtc_bounds) goes with the
+    // scene's size, not its distance from the world's origin. (Fur a million units out had its
+    // hairs' boxes grown by 2 units each, and took 17 times as long.) The callbacks read the
+    // world ray in double (QueryContext::ray), so only the float side moves.
+    Vec3 frame;
+    Ray in_frame(const Ray& r) const { return {r.o - frame, r.d, r.footprint}; }
+    RTCBounds held_bounds(const Bounds3& b) const {
+        return to_rtc_bounds({b.lo - frame, b.hi - frame});
+    }
+    // The centre of the boxes Embree will hold (embree_can_hold); the origin if none.
+    static Vec3 frame_of(const std::vector<Bounds3>& bounds) {
+        Bounds3 held;
+        for (const Bounds3& b : bounds)
+            if (!b.empty() && embree_can_hold(b)) held = merge(held, b);
+        return held.empty() ? Vec3{} : held.center();
+    }
     std::vector<std::uint32_t> numbered;  // an object's index given -> its index in objects
     // A crossing of objects[obj], under the number the caller gave the object.
     AccelHit caller_hit(double t, std::uint32_t obj, const Crossing& c) const {
@@ -422,7 +439,7 @@ struct EmbreeAccel::Impl {
             last_build = self->build;
             last_object = fp.object;
         }
-        *args->bounds_o = to_rtc_bounds(self->objects[fp.object].parts->part_bounds(fp.part, xf));
+        *args->bounds_o = self->held_bounds(self->objects[fp.object].parts->part_bounds(fp.part, xf));
     }
 
     static void bounds_direct(const RTCBoundsFunctionArguments* args) {
@@ -474,7 +491,7 @@ struct EmbreeAccel::Impl {
                 direct.push_back(direct_prim(i, c, parts > 1, o, xf));
                 o.direct = true;
                 o.cheap_blocker = cheap_to_test(o);
-                direct_bounds.push_back(to_rtc_bounds(b));
+                direct_bounds.push_back(held_bounds(b));
             }
         }
     }
@@ -489,7 +506,7 @@ struct EmbreeAccel::Impl {
         direct.push_back({i, kEveryPart, 1, {}});  // no capsule: every line meets it
         o.direct = true;
         o.cheap_blocker = cheap_to_test(o);
-        direct_bounds.push_back(to_rtc_bounds(b));
+        direct_bounds.push_back(held_bounds(b));
     }
 
     // The object's parts and cull parts, through the interfaces asked once (Placed).
@@ -533,7 +550,8 @@ struct EmbreeAccel::Impl {
             for (int c = 0; c < 3; ++c)
                 xfm[r * 4 + c] = static_cast<float>(
                     a.m.r[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)]);
-            xfm[r * 4 + 3] = static_cast<float>(a.t[static_cast<std::size_t>(r)]);
+            xfm[r * 4 + 3] = static_cast<float>(a.t[static_cast<std::size_t>(r)] -
+                                                frame[static_cast<std::size_t>(r)]);
         }
         rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xfm);
         rtcCommitGeometry(g);
@@ -611,6 +629,7 @@ EmbreeAccel::EmbreeAccel(const AccelObjects& objects, const AccelOptions& opt)
     m.enter_whole = cull_parts > opt.cull_part_budget;
     std::vector<Bounds3> placed_bounds;
     m.number_objects(placed_bounds);
+    m.frame = Impl::frame_of(placed_bounds);
     bar.set(100);
     m.device = rtcNewDevice(nullptr);
     if (!m.device) throw std::runtime_error("Embree: cannot create a device");
@@ -659,12 +678,13 @@ EmbreeAccel::~EmbreeAccel() = default;
 
 bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hit) const {
     // Every traceable ray is finite: the second test is only for the rare huge one.
-    const bool traceable = embree_can_trace(r, tmin, tmax);
-    if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
+    const Ray framed = m.in_frame(r);
+    const bool traceable = embree_can_trace(framed, tmin, tmax);
+    if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     QueryContext ctx(m, r, tmin, tmax, &hit);
 
-    if (traceable) trace_closest(m.scene, ctx, r, tmin, tmax);
+    if (traceable) trace_closest(m.scene, ctx, framed, tmin, tmax);
 
     for (const std::uint32_t i : m.unbounded) {
         const Placed& o = m.objects[i];
@@ -682,9 +702,10 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
                                    AccelHit& hit, std::vector<AccelHit>& partial,
                                    const LayerStop& stop, LastBlocker* last) const {
     LayerSink sink(partial, stop);
-    const bool traceable = embree_can_trace(r, tmin, tmax);
-    if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
+    const Ray framed = m.in_frame(r);
+    const bool traceable = embree_can_trace(framed, tmin, tmax);
+    if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     QueryContext ctx(m, r, tmin, tmax, &hit);
     ctx.self = m.our_number(self);
     ctx.sink = &sink;
@@ -692,12 +713,12 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
         if (m.blocked_by_kept(ctx, last)) {
             ctx.found = true;
         } else {
-            trace_any(m.scene, ctx, r, tmin, tmax);
+            trace_any(m.scene, ctx, framed, tmin, tmax);
             m.test_self_last(ctx);
             m.keep_blocker(ctx, last);
         }
     } else if (traceable)
-        trace_closest(m.scene, ctx, r, tmin, tmax);
+        trace_closest(m.scene, ctx, framed, tmin, tmax);
     const bool blocked = ctx.found && stop.shadow();
     // Unbounded shapes answer their closest crossing: only a lattice, which has a box, has
     // several sheets (coverage/sheets.h).
@@ -721,9 +742,10 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
 
 bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t self,
                            LastBlocker* last) const {
-    const bool traceable = embree_can_trace(r, tmin, tmax);
-    if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     const Impl& m = *impl_;
+    const Ray framed = m.in_frame(r);
+    const bool traceable = embree_can_trace(framed, tmin, tmax);
+    if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
     QueryContext ctx(m, r, tmin, tmax, nullptr);
     ctx.self = m.our_number(self);
     // Only rays Embree can trace test their run's blocker first: the others meet unbounded
@@ -739,7 +761,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     }
 
     if (traceable) {
-        trace_any(m.scene, ctx, r, tmin, tmax);
+        trace_any(m.scene, ctx, framed, tmin, tmax);
         m.test_self_last(ctx);
     }
     m.keep_blocker(ctx, last);

@@ -14,7 +14,8 @@
 namespace lat::embree_detail {
 
 // A float bound that surely contains the double one, so that Embree's float traversal never
-// prunes a primitive the double test would hit.
+// prunes a primitive the double test would hit. Its margin grows with the coordinates: the
+// accelerator hands Embree its world less the scene's centre (EmbreeAccel::Impl::frame).
 inline RTCBounds to_rtc_bounds(const Bounds3& b) {
     const double pad = 1e-6 * (max_component(abs(b.lo)) + max_component(abs(b.hi))) + 1e-9;
     RTCBounds r;

@@ -1,0 +1,89 @@
+// The accelerator culls as tightly far from the world's origin as at it: Embree's float side
+// works in a frame centred on the scene (EmbreeAccel::Impl::frame), so the margin its boxes are
+// grown by goes with the scene's size, not with its distance from the origin.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "accel/embree_accel.h"
+#include "geometry/sphere.h"
+
+namespace lat {
+namespace {
+
+// A sphere that counts the tests it is asked for.
+class CountedSphere final : public Shape {
+public:
+    CountedSphere(Vec3 c, double r) : s_(c, r) {}
+    Bounds3 bounds() const override { return s_.bounds(); }
+    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override {
+        ++tests;
+        return s_.intersect(r, tmin, tmax, hit);
+    }
+    bool occluded(const Ray& r, double tmin, double tmax) const override {
+        ++tests;
+        return s_.occluded(r, tmin, tmax);
+    }
+    void spans(const Ray& r, SpanList& out) const override { s_.spans(r, out); }
+    Vec3 normal(const Ray& r, const Crossing& c) const override { return s_.normal(r, c); }
+    bool inside(Vec3 p) const override { return s_.inside(p); }
+
+    mutable int tests = 0;
+
+private:
+    SphereShape s_;
+};
+
+const Transform kIdentity;
+constexpr int kSide = 10;          // spheres a side, one unit apart
+constexpr double kRadius = 0.05;  // a hair's width, as a fur's instances are
+
+// Rays down the gaps of a kSide x kSide grid of small spheres whose corner is at `corner`, and
+// rays onto each sphere: the spheres tested by the gaps' rays, and whether every sphere's own
+// ray met it where it should.
+struct GridRun {
+    int gap_tests = 0;
+    bool hits_right = true;
+};
+GridRun run_grid(Vec3 corner) {
+    std::vector<CountedSphere> spheres;
+    spheres.reserve(kSide * kSide);
+    for (int i = 0; i < kSide; ++i)
+        for (int j = 0; j < kSide; ++j) spheres.emplace_back(corner + Vec3{1.0 * i, 1.0 * j, 0}, kRadius);
+    std::vector<AccelObject> objects;
+    for (const CountedSphere& s : spheres) objects.push_back({&s, &kIdentity});
+    const EmbreeAccel accel(objects);
+
+    GridRun run;
+    for (int i = 0; i < kSide; ++i)
+        for (int j = 0; j < kSide; ++j) {
+            // Half a unit from every sphere's centre: far outside their boxes.
+            const Ray gap{corner + Vec3{i + 0.5, j + 0.5, -10}, {0, 0, 1}};
+            AccelHit hit;
+            run.hits_right &= !accel.intersect(gap, 0, kInfinity, hit);
+            run.hits_right &= !accel.occluded(gap, 0, kInfinity, EmbreeAccel::kNoObject, nullptr);
+        }
+    for (const CountedSphere& s : spheres) run.gap_tests += s.tests;
+    for (int k = 0; k < kSide * kSide; ++k) {
+        const Vec3 c = corner + Vec3{1.0 * (k / kSide), 1.0 * (k % kSide), 0};
+        const Ray onto{c + Vec3{0, 0, -10}, {0, 0, 1}};
+        AccelHit hit;
+        run.hits_right &= accel.intersect(onto, 0, kInfinity, hit) &&
+                          hit.object == static_cast<std::uint32_t>(k) &&
+                          std::abs(hit.t - (10 - kRadius)) < 1e-9;
+    }
+    return run;
+}
+
+TEST(AccelFrame, FarFromTheOriginRaysInTheGapsTestNothing) {
+    for (const Vec3 corner : {Vec3{0, 0, 0}, Vec3{1e6, 1e6, 0}, Vec3{-3e7, 2e7, 5e6}}) {
+        const GridRun run = run_grid(corner);
+        EXPECT_EQ(run.gap_tests, 0) << "grid at " << corner.x << ", " << corner.y << ", "
+                                    << corner.z;
+        EXPECT_TRUE(run.hits_right) << "grid at " << corner.x << ", " << corner.y << ", "
+                                    << corner.z;
+    }
+}
+
+}  // namespace
+}  // namespace lat
