@@ -3,9 +3,12 @@
 // grown by goes with the scene's size, not with its distance from the origin.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
 #include <vector>
 
 #include "accel/embree_accel.h"
+#include "geometry/chain.h"
 #include "geometry/sphere.h"
 
 namespace lat {
@@ -83,6 +86,47 @@ TEST(AccelFrame, FarFromTheOriginRaysInTheGapsTestNothing) {
         EXPECT_TRUE(run.hits_right) << "grid at " << corner.x << ", " << corner.y << ", "
                                     << corner.z;
     }
+}
+
+// Thin chains (a hair: spheres joined by cylinders) placed far from the origin, turned and
+// moved: rays through and around them answer alike whether the chains enter Embree as
+// instances of one prototype (a float transform a ray is carried through) or part by part in
+// world space. Far out, the instances' float transforms once lost a grazing ray's crossings.
+TEST(AccelFrame, FarFromTheOriginInstancesAnswerAsPartsPlacedFlat) {
+    std::vector<ChainSphere> spheres;
+    std::vector<ChainCylinder> cylinders;
+    for (int k = 0; k < 8; ++k) {
+        spheres.push_back({{0.3 * std::sin(k), 0.3 * std::cos(k), 0.4 * k}, 0.05});
+        if (k) cylinders.push_back({k - 1, k, 0.05});
+    }
+    const ChainShape chain(spheres, cylinders);
+    const Vec3 far{1e6 + 0.3, -2e6 + 0.7, 3e5 + 0.1};
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-2, 2), angle(0, 6.28);
+    std::vector<Transform> xf;
+    for (int i = 0; i < 40; ++i)
+        xf.push_back(Transform::translate(far + Vec3{u(rng), u(rng), u(rng)}) *
+                     Transform::rotate({1, 0.3, 0.2}, angle(rng)));
+    std::vector<AccelObject> objects;
+    for (const Transform& x : xf) objects.push_back({&chain, &x});
+    const EmbreeAccel flat(objects, {.instancing = Instancing::kNever});
+    const EmbreeAccel instanced(objects, {.instancing = Instancing::kAlways});
+
+    // A camera 30 units off, rays over a 6 x 6 window through the crowd: many graze a hair.
+    const Vec3 eye = far + Vec3{0, -30, 2};
+    int hits = 0, differ = 0;
+    for (int j = 0; j < 300; ++j)
+        for (int i = 0; i < 300; ++i) {
+            const Vec3 at = far + Vec3{-3 + i / 50.0, 0, -3 + j / 50.0};
+            const Ray r{eye, normalize(at - eye)};
+            AccelHit a, b;
+            const bool ha = flat.intersect(r, 0, kInfinity, a);
+            const bool hb = instanced.intersect(r, 0, kInfinity, b);
+            hits += ha;
+            differ += ha != hb || (ha && (a.object != b.object || a.t != b.t));
+        }
+    EXPECT_GT(hits, 2000);  // the window holds the crowd
+    EXPECT_EQ(differ, 0);
 }
 
 }  // namespace
