@@ -9,6 +9,7 @@
 
 #include "accel/embree_accel.h"
 #include "geometry/chain.h"
+#include "geometry/parts.h"
 #include "geometry/sphere.h"
 
 namespace lat {
@@ -127,6 +128,58 @@ TEST(AccelFrame, FarFromTheOriginInstancesAnswerAsPartsPlacedFlat) {
         }
     EXPECT_GT(hits, 2000);  // the window holds the crowd
     EXPECT_EQ(differ, 0);
+}
+
+// A shape culled by two thin capsules (a lattice's cull parts): a diagonal one across the unit
+// cube and one far from it. It meets nothing; it counts the rays the accelerator hands its
+// own cull test (CullParts::cull_meets), those its capsules in world space did not turn away.
+class TwoCapsules final : public Shape, public CullParts {
+public:
+    Bounds3 bounds() const override { return {{-0.05, -0.05, -0.05}, {6.05, 6.05, 6.05}}; }
+    bool intersect(const Ray&, double, double, Crossing&) const override { return false; }
+    void spans(const Ray&, SpanList&) const override {}
+    Vec3 normal(const Ray&, const Crossing&) const override { return {0, 0, 1}; }
+    bool inside(Vec3) const override { return false; }
+
+    std::size_t cull_count() const override { return 2; }
+    Bounds3 cull_bounds(std::size_t i, const Transform& xf, double) const override {
+        return expand(xf.bounds(Bounds3{capsule(i).a, capsule(i).b}), kRadius);
+    }
+    bool cull_meets(std::size_t i, const Ray& r) const override {
+        ++tests;
+        return capsule(i).meets_line(r.o, r.d, kRadius);
+    }
+    bool cull_capsule(std::size_t i, const Transform& xf, double, Capsule& c) const override {
+        c = {xf.point(capsule(i).a), xf.point(capsule(i).b), kRadius};
+        return true;
+    }
+
+    mutable int tests = 0;
+
+private:
+    static Capsule capsule(std::size_t i) {
+        return i == 0 ? Capsule{{0, 0, 0}, {1, 1, 1}, kRadius} : Capsule{{5, 5, 5}, {6, 6, 6}, kRadius};
+    }
+};
+
+// Rays through the diagonal capsule's box, half a unit from it: its capsule in world space
+// turns them all away, far from the origin as at it (in world-space float, 1e7 out, its ends
+// were rounded to whole units, and it was grown by as much to hold the exact one).
+TEST(AccelFrame, FarFromTheOriginCullCapsulesTurnAwayWhatTheyMiss) {
+    for (const Vec3 corner : {Vec3{0, 0, 0}, Vec3{1e7 + 0.37, -1e7 + 0.41, 1e7 + 0.29}}) {
+        const TwoCapsules shape;
+        std::vector<Transform> xf;
+        for (int i = 0; i < 10; ++i) xf.push_back(Transform::translate(corner + Vec3{10.0 * i, 0, 0}));
+        std::vector<AccelObject> objects;
+        for (const Transform& x : xf) objects.push_back({&shape, &x});
+        const EmbreeAccel accel(objects);
+        for (int i = 0; i < 10; ++i) {
+            const Ray r{corner + Vec3{10.0 * i + 0.9, 0.1, -5}, {0, 0, 1}};
+            AccelHit hit;
+            EXPECT_FALSE(accel.intersect(r, 0, kInfinity, hit));
+        }
+        EXPECT_EQ(shape.tests, 0) << "shapes at " << corner.x;
+    }
 }
 
 }  // namespace

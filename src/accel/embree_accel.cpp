@@ -142,8 +142,10 @@ struct EmbreeAccel::Impl {
         FloatCapsule capsule;      // CullParts::cull_capsule, if it has one
     };
     static_assert(sizeof(DirectPrim) == 36);
-    static DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
-                                  const Placed& o, const Transform& xf);
+    // Its capsule in float, in the frame (in world space it would be rounded to the world's
+    // float steps, far from the origin).
+    DirectPrim direct_prim(std::uint32_t object, std::uint32_t cull, bool shared,
+                           const Placed& o, const Transform& xf) const;
     std::vector<DirectPrim> direct;
     std::vector<RTCBounds> direct_bounds;    // world space, per direct primitive; build only
     std::vector<std::uint32_t> unbounded;    // objects tested outside Embree
@@ -196,7 +198,8 @@ struct EmbreeAccel::Impl {
     bool may_visit(QueryContext* ctx, unsigned prim) const {
         const DirectPrim& d = direct[prim];
         if (!d.shared) return true;
-        return !ctx->tested_already(d.object) && d.capsule.meets_line(ctx->ray.o, ctx->ray.d);
+        return !ctx->tested_already(d.object) &&
+               d.capsule.meets_line(ctx->ray.o - frame, ctx->ray.d);
     }
     bool first_visit(QueryContext* ctx, unsigned prim, const Ray& local) const {
         const DirectPrim& d = direct[prim];
@@ -580,11 +583,12 @@ static void on_embree_error(void* user, RTCError, const char* str) {
 
 EmbreeAccel::Impl::DirectPrim EmbreeAccel::Impl::direct_prim(std::uint32_t object,
                                                              std::uint32_t cull, bool shared,
-                                                             const Placed& o, const Transform& xf) {
+                                                             const Placed& o,
+                                                             const Transform& xf) const {
     DirectPrim d{object, cull, shared, {}};
     assert(!shared || o.cull);  // shared: one of several cull parts
     if (Capsule c; shared && o.cull->cull_capsule(cull, xf, o.widest_footprint, c))
-        d.capsule = FloatCapsule::holding(c);
+        d.capsule = FloatCapsule::holding({c.a - frame, c.b - frame, c.r});
     return d;
 }
 
