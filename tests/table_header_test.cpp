@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <filesystem>
 #include <fstream>
 #include <cstring>
@@ -13,6 +14,7 @@
 #include "lattice/boundary_grid.h"
 #include "lattice/cache/table_cache.h"
 #include "lattice/encoding.h"
+#include "lattice/encodings/hash14/hash14_table.h"
 #include "lattice/rasterizer.h"
 #include "lattice/table_file.h"
 #include "scene/table_metadata.h"
@@ -101,6 +103,23 @@ TEST_F(ForgedHeader, Hash14BucketCountCannotOverflowTheSizeCheck) {
     std::uint64_t buckets = std::uint64_t{1} << 63;
     std::memcpy(payload.data(), &buckets, 8);
     expect_refused(good, "hash14: inconsistent payload size");
+}
+
+// Overflow entries link back to earlier ones only (as the build lays them out), so no chain
+// can loop and make every lookup through it walk 2^20 links.
+TEST_F(ForgedHeader, Hash14ChainsCannotLoop) {
+    std::uint64_t buckets = 0;
+    std::memcpy(&buckets, payload.data(), 8);
+    const std::uint64_t total = (payload.size() - 8) / sizeof(Hash14Entry);
+    ASSERT_GT(total, buckets + 1);  // the hook's table has overflow entries
+    auto link = [&](std::uint64_t from, std::uint32_t to) {
+        std::memcpy(payload.data() + 8 + from * sizeof(Hash14Entry) + offsetof(Hash14Entry, next), &to, 4);
+    };
+    link(total - 1, static_cast<std::uint32_t>(total - 1));  // to itself
+    expect_refused(good, "hash14: overflow chain loops");
+    link(total - 1, static_cast<std::uint32_t>(buckets));  // back to the first overflow entry
+    link(buckets, static_cast<std::uint32_t>(total - 1));  // and forward again
+    expect_refused(good, "hash14: overflow chain loops");
 }
 
 TEST_F(ForgedHeader, MetadataMustDescribeThePrimitive) {

@@ -358,10 +358,17 @@ Hash14Table::Hash14Table(const std::uint8_t* payload, std::size_t size, std::uin
         throw std::runtime_error("hash14: inconsistent payload size");
     e_ = reinterpret_cast<const Hash14Entry*>(payload + kHeader);
     const std::uint64_t total = (size - kHeader) / sizeof(Hash14Entry);
-    // Every chain link must stay inside the table (a corrupt file must not crash lookups).
-    for (std::uint64_t k = 0; k < total; ++k)
-        if (e_[k].next != kEnd && (e_[k].next >= total || e_[k].next < buckets_))
+    // Every chain link must stay inside the table (a corrupt file must not crash lookups) and
+    // lead into the overflow area, and an overflow entry's link back to an earlier one (the
+    // build appends each entry after its bucket's head, linking it to the one there before), so
+    // that no chain loops: a loop would cost every lookup through it 2^20 steps.
+    for (std::uint64_t k = 0; k < total; ++k) {
+        const std::uint32_t next = e_[k].next;
+        if (next == kEnd) continue;
+        if (next >= total || next < buckets_)
             throw std::runtime_error("hash14: overflow chain out of range");
+        if (k >= buckets_ && next >= k) throw std::runtime_error("hash14: overflow chain loops");
+    }
 }
 
 bool Hash14Table::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const {
@@ -376,7 +383,7 @@ bool Hash14Table::lookup(std::uint32_t a, std::uint32_t b, TableHit& hit) const 
         if (e->next == kEnd) return false;
         e = e_ + e->next;
     }
-    return false;  // a cycle in a corrupt table
+    return false;  // a forged chain this long (open refuses loops)
 }
 
 }  // namespace lat
