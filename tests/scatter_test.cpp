@@ -234,8 +234,16 @@ TEST(Scatter, BadParametersAreInputErrors) {
                   .find("objects[0].on.type: cannot scatter over a quartic"), std::string::npos);
     EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5, "material": "fur", "tilt_deg": 100, )" + sphere + "}")
                   .find("objects[0].tilt_deg: must be between 0 and 90"), std::string::npos);
-    EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5000, "material": "fur", "min_distance": 1, )" + sphere + "}")
+    EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 40, "material": "fur", "min_distance": 1, )" + sphere + "}")
                   .find("objects[0].min_distance: only"), std::string::npos);
+    // Counts that no packing fits into the surface's bounds, and distances too small to file
+    // points by, are refused before any dart is thrown (5000 once took 50 tries an instance).
+    EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5000, "material": "fur", "min_distance": 1, )" + sphere + "}")
+                  .find("objects[0].min_distance: 5000 instances cannot be 1 apart on this surface: its bounds hold "
+                        "at most 51 points that far apart"), std::string::npos);
+    EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5, "material": "fur", "min_distance": 1e-300, )" + sphere + "}")
+                  .find("objects[0].min_distance: a minimum distance of 1e-300 is too small for a surface 2 across"),
+              std::string::npos);
     EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5, "material": "fur", "box": [[5, 5, 5], [6, 6, 6]],
                         "on": {"type": "halfspace", "normal": [0, 0, 1], "material": "skin"}})")
                   .find("objects[0].box: the box holds none of the surface"), std::string::npos);

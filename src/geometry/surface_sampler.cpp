@@ -92,9 +92,21 @@ public:
         }
         dom_ = domain(kind, cb);
         integrate();
+        // Samples lie in the box when there is one (sample() keeps no other), else on the
+        // bounded surfaces (sphere, torus) inside their canonical box, placed.
+        if (box) {
+            bounds_ = *box;
+        } else if (param_kind_unbounded(kind)) {
+            bounds_ = Bounds3::infinite();
+        } else {
+            const double r = kind == ParamKind::kTorus ? 1 + minor : 1, h = kind == ParamKind::kTorus ? minor : 1;
+            const Bounds3 canonical{{-r, -r, -h}, {r, r, h}};
+            for (int i = 0; i < 8; ++i) bounds_ = merge(bounds_, xf.point(canonical.corner(i)));
+        }
     }
 
     double area() const override { return area_; }
+    Bounds3 bounds() const override { return bounds_; }
 
     // Uniform in the parameter rectangle, kept with probability (world area element) / (its
     // largest value): area-uniform on the surface.
@@ -122,6 +134,7 @@ private:
     double det_ = 1;
     Domain dom_{};
     double area_ = 0, jac_max_ = 0;
+    Bounds3 bounds_;
 
     // The world point and unit normal at (u, v), and the world area element there: a surface
     // element of unit normal n and area dA becomes |det M| |M^-T n| dA under the linear part M.
@@ -169,11 +182,13 @@ public:
             const Vec3 a = xf.point(pos[t[0]]), b = xf.point(pos[t[1]]), c = xf.point(pos[t[2]]);
             sum += 0.5 * length(cross(b - a, c - a));
             cdf_.push_back(sum);
+            bounds_ = merge(merge(merge(bounds_, a), b), c);
         }
         if (!(sum > 0) || !std::isfinite(sum)) throw InputError("the mesh has no area to scatter on");
     }
 
     double area() const override { return cdf_.back(); }
+    Bounds3 bounds() const override { return bounds_; }
 
     SurfaceSample sample(CounterRng& rng) const override {
         const double x = rng.uniform() * cdf_.back();
@@ -193,6 +208,7 @@ private:
     std::shared_ptr<const TriangleMeshShape> mesh_;
     Transform xf_;
     std::vector<double> cdf_;  // running sum of world triangle areas
+    Bounds3 bounds_;           // of the triangles' corners, placed
 };
 
 }  // namespace

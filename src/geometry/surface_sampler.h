@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geometry/triangle_mesh.h"
+#include "math/bounds.h"
 #include "math/transform.h"
 #include "util/counter_rng.h"
 
@@ -27,6 +28,8 @@ public:
     virtual double area() const = 0;
     // One area-uniform sample.
     virtual SurfaceSample sample(CounterRng& rng) const = 0;
+    // A box holding every sample (world coordinates; up to rounding for meshes).
+    virtual Bounds3 bounds() const = 0;
 };
 
 // Canonical surfaces (axis along z), placed in the world by `xf`; the named shapes' semi-axes go

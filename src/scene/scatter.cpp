@@ -1,6 +1,9 @@
 #include "scene/scatter.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <unordered_map>
 
 #include <tbb/blocked_range.h>
@@ -15,6 +18,13 @@
 
 namespace lat {
 namespace {
+
+// A number in a message: %g, six significant digits.
+std::string shown(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", x);
+    return buf;
+}
 
 struct ScatterParams {
     int primitive = -1;
@@ -193,12 +203,35 @@ Affine placement(const SurfaceSample& s, const ScatterParams& p, Vec3 root, Coun
 // within d. Sequential, so the result does not depend on threads.
 std::vector<SurfaceSample> poisson_samples(const SurfaceSampler& sampler, const ScatterParams& p,
                                            const JsonValue& v) {
+    const double d = p.min_distance;
+    const auto fail = [&](const std::string& why) {
+        (v.has("min_distance") ? v.at("min_distance") : v).fail(why);
+    };
+    // Candidates are filed in cells of side d counted from the samples' bounds, at most this
+    // many a side, so that a cell's number is exact in a double and in an integer.
+    constexpr double kMaxCells = 0x1p40;
+    const Bounds3 b = sampler.bounds();
+    const Vec3 e = b.extent();
+    if (!(std::max({e.x, e.y, e.z}) / d <= kMaxCells))
+        fail("a minimum distance of " + shown(d) + " is too small for a surface " +
+             shown(std::max({e.x, e.y, e.z})) + " across (at most 2^40 distances)");
+    // Points d apart are the centres of disjoint balls of diameter d inside the bounds grown by
+    // d / 2: a count that cannot fit is refused now rather than after 50 tries an instance.
+    const double most = (e.x / d + 1) * (e.y / d + 1) * (e.z / d + 1) * (6 / M_PI);
+    if (static_cast<double>(p.count) > most * (1 + 1e-9) + 1)
+        fail(std::to_string(p.count) + " instances cannot be " + shown(d) +
+             " apart on this surface: its bounds hold at most " +
+             std::to_string(static_cast<long long>(most)) +
+             " points that far apart (lower the count or the distance)");
     std::vector<SurfaceSample> kept;
     std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid;
-    const double d = p.min_distance;
     auto cell = [&](Vec3 q, int dx, int dy, int dz) {
-        const auto c = [&](double x, int o) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(x / d)) + o) & 0x1FFFFF; };
-        return (c(q.x, dx) << 42) | (c(q.y, dy) << 21) | c(q.z, dz);
+        const auto c = [&](double x, double lo, int o) {
+            // (A sample outside the bounds by rounding is at most a cell outside.)
+            const double k = std::clamp(std::floor((x - lo) / d), -1.0, kMaxCells + 1);
+            return static_cast<std::uint64_t>(static_cast<std::int64_t>(k) + o) & 0x1FFFFF;
+        };
+        return (c(q.x, b.lo.x, dx) << 42) | (c(q.y, b.lo.y, dy) << 21) | c(q.z, b.lo.z, dz);
     };
     const std::size_t tries = 50 * p.count + 1000;
     for (std::size_t k = 0; k < tries && kept.size() < p.count; ++k) {
