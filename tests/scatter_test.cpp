@@ -241,6 +241,17 @@ TEST(Scatter, BadParametersAreInputErrors) {
     EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5000, "material": "fur", "min_distance": 1, )" + sphere + "}")
                   .find("objects[0].min_distance: 5000 instances cannot be 1 apart on this surface: its bounds hold "
                         "at most 51 points that far apart"), std::string::npos);
+    // Scales whose placement overflows or underflows are refused (Scene::transform inverts
+    // each placement, and once found none).
+    for (const char* scale : {"1e300", "1e-300", "[1e-300, 2e-300]"})
+        EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5, "material": "fur", "scale": )" +
+                        std::string(scale) + ", " + sphere + "}")
+                      .find(" has no invertible finite placement: a scale of "),
+                  std::string::npos)
+            << scale;
+    EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5, "material": "fur", "scale": 1e300, )" + sphere + "}")
+                  .find("objects[0].scale: instance 0 has no invertible finite placement: a scale of 1e+300 is too extreme"),
+              std::string::npos);
     EXPECT_NE(error(R"({"type": "scatter", "primitive": "hair", "count": 5, "material": "fur", "min_distance": 1e-300, )" + sphere + "}")
                   .find("objects[0].min_distance: a minimum distance of 1e-300 is too small for a surface 2 across"),
               std::string::npos);

@@ -1,6 +1,7 @@
 #include "scene/scatter.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -196,7 +197,7 @@ Affine placement(const SurfaceSample& s, const ScatterParams& p, Vec3 root, Coun
     // must write matrices that read back bit for bit.
     for (std::size_t r = 0; r < 3; ++r) a.m.r[r] = Vec3{x[r], y[r], z[r]} * k + Vec3{0, 0, 0};
     a.t = s.p - a.m * root + Vec3{0, 0, 0};
-    return a;  // a rotation times k > 0: never singular
+    return a;  // a rotation times k > 0, singular only by overflow (expand_scatter checks)
 }
 
 // Poisson-disk (dart throwing): candidates in stream order, each kept when no kept point lies
@@ -302,14 +303,26 @@ void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser&
     out.where = v.path();
     out.placements.resize(n);
     ProgressBar bar("place", n, progress, 1000);
+    // The first instance whose placement makes no transform (Scene::transform inverts each).
+    std::atomic<std::size_t> first_bad{n};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& range) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
             CounterRng point_rng(p.seed, 2 * i), rng(p.seed, 2 * i + 1);
             const SurfaceSample s = points.empty() ? sampler->sample(point_rng) : points[i];
             out.placements[i] = placement(s, p, root, rng);
+            if (!Transform::from_affine(out.placements[i]))
+                for (std::size_t b = first_bad.load(); i < b && !first_bad.compare_exchange_weak(b, i);) {
+                }
         }
         bar.add(range.size());
     });
+    if (const std::size_t i = first_bad.load(); i < n) {
+        std::string scale = shown(p.scale_lo);
+        if (p.scale_hi != p.scale_lo) scale = "[" + scale + ", " + shown(p.scale_hi) + "]";
+        (v.has("scale") ? v.at("scale") : v)
+            .fail("instance " + std::to_string(i) + " has no invertible finite placement: a scale of " +
+                  scale + " is too extreme for this primitive and surface");
+    }
 }
 
 }  // namespace lat
