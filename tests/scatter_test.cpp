@@ -262,6 +262,23 @@ TEST(Scatter, BadParametersAreInputErrors) {
                   .find("objects[0].on: object index 3 does not exist"), std::string::npos);
 }
 
+// A mesh whose placed area underflows to zero or overflows is refused at the scatter's `on`,
+// with the file and place (the sampler's own message had neither).
+TEST(Scatter, MeshWithoutAFiniteAreaIsALocatedError) {
+    const test::TempDir dir;
+    test::spit(dir.file("tet.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+    const std::string path = dir.file("s.json");
+    auto error = [&](const char* scale) {
+        test::spit(path, std::string(kHead) + R"({"type": "mesh", "name": "m", "file": "tet.obj",
+            "material": "skin", "transform": [{"scale": )" + scale + R"(}]},
+            {"type": "scatter", "primitive": "hair", "on": "m", "count": 5, "material": "fur"}]})");
+        return test::error_of([&] { load_scene(path); });
+    };
+    EXPECT_NE(error("1e150").find(path + ": objects[1].on: the mesh's area, placed, is too large for a double"),
+              std::string::npos);
+    EXPECT_NE(error("1e-150").find(path + ": objects[1].on: the mesh has no area to scatter on"), std::string::npos);
+}
+
 // A count within the limit that the memory available cannot hold is refused before anything
 // is placed (on a machine with less than 49 GB available; elsewhere the test has no case).
 TEST(Scatter, CountsOverTheMemoryAvailableAreInputErrors) {

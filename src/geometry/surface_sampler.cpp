@@ -184,7 +184,8 @@ public:
             cdf_.push_back(sum);
             bounds_ = merge(merge(merge(bounds_, a), b), c);
         }
-        if (!(sum > 0) || !std::isfinite(sum)) throw InputError("the mesh has no area to scatter on");
+        if (!std::isfinite(sum)) throw InputError("the mesh's area, placed, is too large for a double");
+        if (!(sum > 0)) throw InputError("the mesh has no area to scatter on");
     }
 
     double area() const override { return cdf_.back(); }

@@ -55,6 +55,7 @@ std::unique_ptr<SurfaceSampler> make_param_sampler(ParamKind kind, double minor,
                                                    const Transform& xf,
                                                    const std::optional<Bounds3>& box);
 
+// Throws InputError(what), without location, when the placed mesh has no area or too much.
 std::unique_ptr<SurfaceSampler> make_mesh_sampler(std::shared_ptr<const TriangleMeshShape> mesh,
                                                   const Transform& xf);
 

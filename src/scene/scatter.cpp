@@ -64,7 +64,12 @@ std::unique_ptr<SurfaceSampler> sampler_for(const JsonValue& v, const JsonValue&
     const std::optional<Bounds3> box = parse_box(v);
     if (type == "mesh") {
         if (box) v.at("box").fail("a box clips quadrics only; a mesh is scattered over whole");
-        return make_mesh_sampler(parser.mesh(on), user);
+        std::shared_ptr<const TriangleMeshShape> mesh = parser.mesh(on);
+        try {
+            return make_mesh_sampler(std::move(mesh), user);
+        } catch (const InputError& e) {
+            v.at("on").fail(e.what());  // (the sampler's messages have no location)
+        }
     }
     auto axis = [&] { return on.has("axis") ? normalize(on.at("axis").direction()) : Vec3{0, 0, 1}; };
     ParamKind kind;
