@@ -99,7 +99,8 @@ public:
         } else if (param_kind_unbounded(kind)) {
             bounds_ = Bounds3::infinite();
         } else {
-            const double r = kind == ParamKind::kTorus ? 1 + minor : 1, h = kind == ParamKind::kTorus ? minor : 1;
+            const bool torus = kind == ParamKind::kTorus;
+            const double r = torus ? 1 + minor : 1, h = torus ? minor : 1;
             const Bounds3 canonical{{-r, -r, -h}, {r, r, h}};
             for (int i = 0; i < 8; ++i) bounds_ = merge(bounds_, xf.point(canonical.corner(i)));
         }
@@ -162,7 +163,12 @@ private:
         // any surface we parametrise (the area element varies smoothly).
         jac_max_ *= 1.02;
         area_ = sum * du * dv;
-        if (!(area_ > 0) || !std::isfinite(area_)) throw InputError("the box holds none of the surface");
+        if (!std::isfinite(area_))
+            throw InputError("the surface's area, placed, is not a finite number (its size or "
+                             "placement is too extreme)");
+        if (!(area_ > 0))
+            throw InputError(box_ ? "the box holds none of the surface"
+                                  : "the surface has no area to scatter on");
         const double acceptance = area_ / (jac_max_ * (dom_.u1 - dom_.u0) * (dom_.v1 - dom_.v0));
         if (acceptance < kMinAcceptance)
             throw InputError("the box holds too small a part of the surface to sample (" +
@@ -184,7 +190,9 @@ public:
             cdf_.push_back(sum);
             bounds_ = merge(merge(merge(bounds_, a), b), c);
         }
-        if (!std::isfinite(sum)) throw InputError("the mesh's area, placed, is too large for a double");
+        if (!std::isfinite(sum))
+            throw InputError("the mesh's area, placed, is not a finite number (its size or "
+                             "placement is too extreme)");
         if (!(sum > 0)) throw InputError("the mesh has no area to scatter on");
     }
 

@@ -315,9 +315,11 @@ void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser&
             CounterRng point_rng(p.seed, 2 * i), rng(p.seed, 2 * i + 1);
             const SurfaceSample s = points.empty() ? sampler->sample(point_rng) : points[i];
             out.placements[i] = placement(s, p, root, rng);
-            if (!Transform::from_affine(out.placements[i]))
-                for (std::size_t b = first_bad.load(); i < b && !first_bad.compare_exchange_weak(b, i);) {
+            if (!Transform::from_affine(out.placements[i])) {
+                std::size_t b = first_bad.load();
+                while (i < b && !first_bad.compare_exchange_weak(b, i)) {
                 }
+            }
         }
         bar.add(range.size());
     });
@@ -325,8 +327,9 @@ void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser&
         std::string scale = shown(p.scale_lo);
         if (p.scale_hi != p.scale_lo) scale = "[" + scale + ", " + shown(p.scale_hi) + "]";
         (v.has("scale") ? v.at("scale") : v)
-            .fail("instance " + std::to_string(i) + " has no invertible finite placement: a scale of " +
-                  scale + " is too extreme for this primitive and surface");
+            .fail("instance " + std::to_string(i) +
+                  " has no invertible finite placement: a scale of " + scale +
+                  " is too extreme for this primitive and surface");
     }
 }
 
