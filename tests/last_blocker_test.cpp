@@ -11,32 +11,12 @@
 
 #include "accel/embree_accel.h"
 #include "geometry/chain.h"
-#include "geometry/sphere.h"
+#include "counted_sphere.h"
 
 namespace lat {
 namespace {
 
-// A sphere that counts its occlusion tests.
-class CountedSphere final : public Shape {
-public:
-    CountedSphere(Vec3 c, double r) : s_(c, r) {}
-    Bounds3 bounds() const override { return s_.bounds(); }
-    bool intersect(const Ray& r, double tmin, double tmax, Crossing& hit) const override {
-        return s_.intersect(r, tmin, tmax, hit);
-    }
-    bool occluded(const Ray& r, double tmin, double tmax) const override {
-        ++tests;
-        return s_.occluded(r, tmin, tmax);
-    }
-    void spans(const Ray& r, SpanList& out) const override { s_.spans(r, out); }
-    Vec3 normal(const Ray& r, const Crossing& c) const override { return s_.normal(r, c); }
-    bool inside(Vec3 p) const override { return s_.inside(p); }
-
-    mutable int tests = 0;
-
-private:
-    SphereShape s_;
-};
+using test::CountedSphere;
 
 const Transform kIdentity;
 
