@@ -198,8 +198,7 @@ struct EmbreeAccel::Impl {
     bool may_visit(QueryContext* ctx, unsigned prim) const {
         const DirectPrim& d = direct[prim];
         if (!d.shared) return true;
-        return !ctx->tested_already(d.object) &&
-               d.capsule.meets_line(ctx->ray.o - frame, ctx->ray.d);
+        return !ctx->tested_already(d.object) && d.capsule.meets_line(ctx->framed_o, ctx->ray.d);
     }
     bool first_visit(QueryContext* ctx, unsigned prim, const Ray& local) const {
         const DirectPrim& d = direct[prim];
@@ -686,7 +685,7 @@ bool EmbreeAccel::intersect(const Ray& r, double tmin, double tmax, AccelHit& hi
     const Ray framed = m.in_frame(r);
     const bool traceable = embree_can_trace(framed, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
-    QueryContext ctx(m, r, tmin, tmax, &hit);
+    QueryContext ctx(m, r, framed, tmin, tmax, &hit);
 
     if (traceable) trace_closest(m.scene, ctx, framed, tmin, tmax);
 
@@ -710,7 +709,7 @@ bool EmbreeAccel::intersect_layers(const Ray& r, double tmin, double tmax, std::
     const Ray framed = m.in_frame(r);
     const bool traceable = embree_can_trace(framed, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
-    QueryContext ctx(m, r, tmin, tmax, &hit);
+    QueryContext ctx(m, r, framed, tmin, tmax, &hit);
     ctx.self = m.our_number(self);
     ctx.sink = &sink;
     if (traceable && stop.shadow()) {
@@ -750,7 +749,7 @@ bool EmbreeAccel::occluded(const Ray& r, double tmin, double tmax, std::uint32_t
     const Ray framed = m.in_frame(r);
     const bool traceable = embree_can_trace(framed, tmin, tmax);
     if (!traceable && !ray_is_finite(r, tmin, tmax)) return false;
-    QueryContext ctx(m, r, tmin, tmax, nullptr);
+    QueryContext ctx(m, r, framed, tmin, tmax, nullptr);
     ctx.self = m.our_number(self);
     // Only rays Embree can trace test their run's blocker first: the others meet unbounded
     // objects alone.

@@ -54,8 +54,10 @@ struct Placed {
 struct QueryContext {
     // h: where the closest hit goes (for a shadow ray's transmittance, what blocked it); null
     // for plain occlusion, which needs none.
-    QueryContext(const EmbreeAccel::Impl& m, const Ray& r, double t0, double t1, AccelHit* h)
-        : accel(&m), ray(r), tmin(t0), tmax(t1), hit(h) {
+    // framed: r in the accelerator's float frame (EmbreeAccel::Impl::in_frame).
+    QueryContext(const EmbreeAccel::Impl& m, const Ray& r, const Ray& framed, double t0, double t1,
+                 AccelHit* h)
+        : accel(&m), ray(r), framed_o(framed.o), tmin(t0), tmax(t1), hit(h) {
         rtcInitIntersectContext(&rtc);
         if (!r.footprint) return;
         object_footprint.width0 = r.footprint->width0;
@@ -70,6 +72,7 @@ struct QueryContext {
     RTCIntersectContext rtc;
     const EmbreeAccel::Impl* accel;
     Ray ray;  // world space, double
+    Vec3 framed_o;  // its origin in the accelerator's float frame, for the float capsules
     // The ray's footprint in the space of the object being tested: its width, spread and
     // purpose the world ray's, its directions across and bound handed on per object
     // (hand_across; between, the last object's). Every object-space ray handed to a shape

@@ -5,7 +5,6 @@
 
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <numbers>
 #include <string>
@@ -14,6 +13,7 @@
 
 #include "geometry/name_suggestion.h"
 #include "geometry/sparse_poly.h"
+#include "util/error.h"
 
 namespace lat {
 namespace {
@@ -53,12 +53,6 @@ std::string cat(const Parts&... parts) {
 
 [[noreturn]] void fail(std::size_t column, const std::string& message) {
     throw PolynomialParseError(column, message);
-}
-
-std::string format_number(double v, int digits) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-    return buf;
 }
 
 // Non-printable bytes show as hex, e.g. "0xc3".

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdio>
 #include <string>
 #include <unordered_map>
 
@@ -19,13 +18,6 @@
 
 namespace lat {
 namespace {
-
-// A number in a message: %g, six significant digits.
-std::string shown(double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", x);
-    return buf;
-}
 
 struct ScatterParams {
     int primitive = -1;
@@ -219,13 +211,13 @@ std::vector<SurfaceSample> poisson_samples(const SurfaceSampler& sampler, const 
     const Bounds3 b = sampler.bounds();
     const Vec3 e = b.extent();
     if (!(std::max({e.x, e.y, e.z}) / d <= kMaxCells))
-        fail("a minimum distance of " + shown(d) + " is too small for a surface " +
-             shown(std::max({e.x, e.y, e.z})) + " across (at most 2^40 distances)");
+        fail("a minimum distance of " + format_number(d) + " is too small for a surface " +
+             format_number(std::max({e.x, e.y, e.z})) + " across (at most 2^40 distances)");
     // Points d apart are the centres of disjoint balls of diameter d inside the bounds grown by
     // d / 2: a count that cannot fit is refused now rather than after 50 tries an instance.
     const double most = (e.x / d + 1) * (e.y / d + 1) * (e.z / d + 1) * (6 / M_PI);
     if (static_cast<double>(p.count) > most * (1 + 1e-9) + 1)
-        fail(std::to_string(p.count) + " instances cannot be " + shown(d) +
+        fail(std::to_string(p.count) + " instances cannot be " + format_number(d) +
              " apart on this surface: its bounds hold at most " +
              std::to_string(static_cast<long long>(most)) +
              " points that far apart (lower the count or the distance)");
@@ -324,8 +316,8 @@ void expand_scatter(const JsonValue& v, const JsonValue& on, const ObjectParser&
         bar.add(range.size());
     });
     if (const std::size_t i = first_bad.load(); i < n) {
-        std::string scale = shown(p.scale_lo);
-        if (p.scale_hi != p.scale_lo) scale = "[" + scale + ", " + shown(p.scale_hi) + "]";
+        std::string scale = format_number(p.scale_lo);
+        if (p.scale_hi != p.scale_lo) scale = "[" + scale + ", " + format_number(p.scale_hi) + "]";
         (v.has("scale") ? v.at("scale") : v)
             .fail("instance " + std::to_string(i) +
                   " has no invertible finite placement: a scale of " + scale +

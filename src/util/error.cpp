@@ -1,5 +1,7 @@
 #include "util/error.h"
 
+#include <cstdio>
+
 namespace lat {
 
 std::string located_message(const std::string& file, const std::string& where,
@@ -49,6 +51,12 @@ std::string quoted(std::string_view bytes, std::size_t max_bytes) {
     out += printable(bytes, max_bytes);
     out += '\'';
     return out;
+}
+
+std::string format_number(double v, int digits) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return buf;
 }
 
 }  // namespace lat

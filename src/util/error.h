@@ -28,5 +28,7 @@ std::string printable(std::string_view bytes, std::size_t max_bytes = 40);
 std::string message_line(std::string_view message, std::size_t max_bytes = 16384);
 // printable(bytes) in single quotes.
 std::string quoted(std::string_view bytes, std::size_t max_bytes = 40);
+// A number in a message, to `digits` significant digits (printf's %g).
+std::string format_number(double v, int digits = 6);
 
 }  // namespace lat
